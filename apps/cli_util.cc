@@ -1,0 +1,31 @@
+#include "apps/cli_util.h"
+
+#include <exception>
+#include <iostream>
+
+namespace handlabel {
+
+int ParseCommandLine(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    std::cout << app.help();
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "handlabel " << app.get_name() << ": " << e.what() << "\n"
+              << "Run 'handlabel " << app.get_name() << " --help' for usage.\n";
+    return 2;
+  }
+  return -1;
+}
+
+int RunReportingErrors(const char* command, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    std::cerr << "handlabel " << command << ": error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace handlabel

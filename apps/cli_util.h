@@ -1,0 +1,16 @@
+#pragma once
+// Shared command-line plumbing for the subcommands (CLI11 stays inside apps/).
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace handlabel {
+
+// Parses argv into `app`. Returns -1 when the command should go on, otherwise the exit
+// status to return at once: 0 after --help, 2 after a usage error (message printed).
+int ParseCommandLine(CLI::App& app, int argc, char** argv);
+
+// Runs `body`, turning exceptions into a one-line message on stderr and status 1.
+int RunReportingErrors(const char* command, const std::function<int()>& body);
+
+}  // namespace handlabel

@@ -1,0 +1,51 @@
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include "apps/commands.h"
+
+namespace handlabel {
+namespace {
+
+void PrintUsage(std::ostream& out) {
+  out << "handlabel: offline auto-labeling of multi-view hand captures\n\n"
+         "Usage: handlabel <command> [options]\n"
+         "       handlabel <command> --help   options of one command\n\n"
+         "Commands:\n";
+  for (const Command& c : AllCommands()) {
+    std::string name = c.name;
+    name.resize(std::max<size_t>(name.size(), 12), ' ');
+    out << "  " << name << "  " << c.summary << "\n";
+  }
+  out << "\nDocumentation: README.md and docs/ in the source tree.\n";
+}
+
+}  // namespace
+
+const std::vector<Command>& AllCommands() {
+  static const std::vector<Command> commands = {
+      {"version", "print version, git hash and dependency versions", RunVersion},
+  };
+  return commands;
+}
+
+int RunHandlabel(int argc, char** argv) {
+  if (argc < 2) {
+    PrintUsage(std::cerr);
+    return 2;
+  }
+  const std::string name = argv[1];
+  if (name == "--help" || name == "-h" || name == "help") {
+    PrintUsage(std::cout);
+    return 0;
+  }
+  if (name == "--version") return RunVersion(argc - 1, argv + 1);
+  for (const Command& c : AllCommands()) {
+    if (name == c.name) return c.run(argc - 1, argv + 1);
+  }
+  std::cerr << "handlabel: unknown command '" << name << "'\n"
+            << "Run 'handlabel --help' for the list of commands.\n";
+  return 2;
+}
+
+}  // namespace handlabel

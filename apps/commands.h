@@ -1,0 +1,24 @@
+#pragma once
+// The `handlabel` subcommands. Each is `int RunX(int argc, char** argv)` where argv[0]
+// is the subcommand name; exit status 0 = success, 1 = the work failed (message on
+// stderr), 2 = bad usage.
+
+#include <vector>
+
+namespace handlabel {
+
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*run)(int argc, char** argv);
+};
+
+// The table, in the order `handlabel --help` lists it.
+const std::vector<Command>& AllCommands();
+
+// Dispatches argv[1] to its subcommand; argv[0] is the program name.
+int RunHandlabel(int argc, char** argv);
+
+int RunVersion(int argc, char** argv);
+
+}  // namespace handlabel

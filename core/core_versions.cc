@@ -1,0 +1,24 @@
+#include "core/core_versions.h"
+
+#include <png.h>
+#include <zlib.h>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+namespace handlabel {
+
+VersionList CoreLibraryVersions() {
+  return {
+      {"Eigen", std::to_string(EIGEN_WORLD_VERSION) + "." +
+                    std::to_string(EIGEN_MAJOR_VERSION) + "." +
+                    std::to_string(EIGEN_MINOR_VERSION)},
+      {"nlohmann_json", std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." +
+                            std::to_string(NLOHMANN_JSON_VERSION_MINOR) + "." +
+                            std::to_string(NLOHMANN_JSON_VERSION_PATCH)},
+      {"zlib", zlibVersion()},
+      {"libpng", png_get_libpng_ver(nullptr)},
+  };
+}
+
+}  // namespace handlabel

@@ -1,0 +1,9 @@
+#include "fitting/fitting_versions.h"
+
+#include <ceres/version.h>
+
+namespace handlabel {
+
+VersionList FittingLibraryVersions() { return {{"Ceres", CERES_VERSION_STRING}}; }
+
+}  // namespace handlabel

@@ -1,0 +1,30 @@
+#include "pipeline/build_info.h"
+
+#include <oneapi/tbb/version.h>
+#include <yaml-cpp/yaml.h>
+
+#include "calib/calib_versions.h"
+#include "fitting/fitting_versions.h"
+#include "network/network_versions.h"
+#include "pipeline/build_config.h"
+
+namespace handlabel {
+
+BuildInfo GetBuildInfo() {
+  BuildInfo info{HANDLABEL_VERSION, HANDLABEL_GIT_HASH, HANDLABEL_BUILD_TYPE, {}};
+  auto append = [&info](const VersionList& list) {
+    for (const auto& entry : list) {
+      bool seen = false;
+      for (const auto& existing : info.dependencies) seen |= existing.first == entry.first;
+      if (!seen) info.dependencies.push_back(entry);
+    }
+  };
+  append(CoreLibraryVersions());
+  append(CalibLibraryVersions());
+  append(FittingLibraryVersions());
+  append(NetworkLibraryVersions());
+  append({{"oneTBB", TBB_VERSION_STRING}});
+  return info;
+}
+
+}  // namespace handlabel

@@ -1,0 +1,44 @@
+// Shared GoogleTest main: re-seeds the test random generator before every test from a
+// hash of the test's full name, and prints the seed when a test fails.
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <iostream>
+
+#include "tests/test_util.h"
+
+namespace handlabel::testing {
+namespace {
+
+std::mt19937_64 g_rng;
+uint64_t g_seed = 0;
+
+class SeedPerTest : public ::testing::EmptyTestEventListener {
+  void OnTestStart(const ::testing::TestInfo& info) override {
+    // FNV-1a, stable across compilers (std::hash is not).
+    uint64_t h = 1469598103934665603ull;
+    for (const char* s : {info.test_suite_name(), ".", info.name()}) {
+      for (; *s; ++s) h = (h ^ static_cast<unsigned char>(*s)) * 1099511628211ull;
+    }
+    g_seed = h;
+    g_rng.seed(h);
+  }
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    if (info.result()->Failed()) std::cerr << "  test seed: " << g_seed << "\n";
+  }
+};
+
+}  // namespace
+
+std::mt19937_64& TestRng() { return g_rng; }
+uint64_t TestSeed() { return g_seed; }
+
+}  // namespace handlabel::testing
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleMock(&argc, argv);
+  ::testing::UnitTest::GetInstance()->listeners().Append(
+      new handlabel::testing::SeedPerTest);
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,67 @@
+#pragma once
+// Shared test helpers: a per-test seeded random generator and matchers for matrices
+// and rigid transforms.
+
+#include <gmock/gmock.h>
+
+#include <Eigen/Core>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "core/rigid3.h"
+
+namespace handlabel::testing {
+
+// Re-seeded before every test from the test's full name (see tests/main.cc), so a
+// failure reproduces when the test runs alone.
+std::mt19937_64& TestRng();
+uint64_t TestSeed();
+
+inline double Uniform(double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(TestRng());
+}
+inline double Gaussian(double sigma) {
+  return std::normal_distribution<double>(0.0, sigma)(TestRng());
+}
+inline Eigen::Vector3d RandomVector3(double lo, double hi) {
+  return {Uniform(lo, hi), Uniform(lo, hi), Uniform(lo, hi)};
+}
+inline Eigen::Quaterniond RandomRotation() {
+  Eigen::Vector4d q(Gaussian(1), Gaussian(1), Gaussian(1), Gaussian(1));
+  return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+}
+
+// Elementwise |a - b| <= tol, with the worst entry named in the explanation.
+MATCHER_P2(MatrixNear, expected, tol, "") {
+  const Eigen::MatrixXd a = arg;
+  const Eigen::MatrixXd b = expected;
+  if (a.rows() != b.rows() || a.cols() != b.cols()) {
+    *result_listener << "shape " << a.rows() << "x" << a.cols() << " vs " << b.rows()
+                     << "x" << b.cols();
+    return false;
+  }
+  if (a.size() == 0) return true;
+  Eigen::Index r, c;
+  const double worst = (a - b).cwiseAbs().maxCoeff(&r, &c);
+  if (!(worst <= tol)) {
+    *result_listener << "largest difference " << worst << " at (" << r << "," << c
+                     << "): " << a(r, c) << " vs " << b(r, c);
+    return false;
+  }
+  return true;
+}
+
+// Rotation angle within rot_tol_rad and translation distance within trans_tol.
+MATCHER_P3(Rigid3Near, expected, rot_tol_rad, trans_tol, "") {
+  const double angle = ::handlabel::RotationAngleBetween(arg, expected);
+  const double dist = (arg.translation - expected.translation).norm();
+  if (!(angle <= rot_tol_rad) || !(dist <= trans_tol)) {
+    *result_listener << "rotation differs by " << angle << " rad, translation by "
+                     << dist;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace handlabel::testing
