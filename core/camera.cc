@@ -22,7 +22,8 @@ Camera::Camera(CameraModelId model, int width, int height, std::vector<double> p
                      std::to_string(width) + "x" + std::to_string(height));
   }
   for (double p : params_) {
-    if (!std::isfinite(p)) throw InputError(source, "params", "finite numbers", "NaN/inf");
+    if (!std::isfinite(p))
+      throw InputError(source, "params", "finite numbers", "NaN/inf");
   }
   if (fx() <= 0 || fy() <= 0) {
     throw InputError(source, "params", "positive focal lengths");
@@ -51,8 +52,7 @@ bool Camera::Project(const Eigen::Vector3d& point_in_cam, Eigen::Vector2d* uv) c
   return ProjectToImage(model_, params_.data(), point_in_cam.data(), uv->data());
 }
 
-bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_cam,
-                                 Eigen::Vector2d* uv,
+bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_cam, Eigen::Vector2d* uv,
                                  Eigen::Matrix<double, 2, 3>* d_point,
                                  Eigen::MatrixXd* d_params) const {
   using D3 = Dual<3>;
@@ -70,7 +70,8 @@ bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_cam,
     using D12 = Dual<12>;
     D12 q[3] = {D12(point_in_cam.x()), D12(point_in_cam.y()), D12(point_in_cam.z())};
     D12 par[12];
-    for (size_t i = 0; i < params_.size(); ++i) par[i] = D12(params_[i], static_cast<int>(i));
+    for (size_t i = 0; i < params_.size(); ++i)
+      par[i] = D12(params_[i], static_cast<int>(i));
     D12 o[2];
     ProjectToImage(model_, par, q, o);
     const int n = static_cast<int>(params_.size());

@@ -17,7 +17,8 @@ class Camera {
   // Throws InputError (naming `source`) if the parameter count or size is wrong.
   Camera(CameraModelId model, int width, int height, std::vector<double> params,
          const std::string& source = "camera");
-  static Camera Pinhole(double fx, double fy, double cx, double cy, int width, int height);
+  static Camera Pinhole(double fx, double fy, double cx, double cy, int width,
+                        int height);
 
   CameraModelId model() const { return model_; }
   int width() const { return width_; }

@@ -97,7 +97,8 @@ void DistortNormalized(const Intrinsics<T>& in, const T& x, const T& y, T* xd, T
     const T theta = atan(r);
     const T t2 = theta * theta;
     const T theta_d =
-        theta * (T(1.0) + t2 * (in.d[0] + t2 * (in.d[1] + t2 * (in.d[2] + t2 * in.d[3]))));
+        theta *
+        (T(1.0) + t2 * (in.d[0] + t2 * (in.d[1] + t2 * (in.d[2] + t2 * in.d[3]))));
     const T scale = theta_d / r;
     *xd = x * scale;
     *yd = y * scale;

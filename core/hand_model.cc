@@ -21,7 +21,8 @@ void ExpectShape(const std::string& source, const char* field, Eigen::Index rows
 
 void HandModel::Check(const std::string& source) const {
   const Eigen::Index v = v_template.rows();
-  if (v < 4) throw InputError(source, "v_template", "at least 4 vertices", std::to_string(v));
+  if (v < 4)
+    throw InputError(source, "v_template", "at least 4 vertices", std::to_string(v));
   ExpectShape(source, "shapedirs", shapedirs.rows(), shapedirs.cols(), 3 * v,
               shapedirs.cols());
   ExpectShape(source, "posedirs", posedirs.rows(), posedirs.cols(), 3 * v,
@@ -45,9 +46,9 @@ void HandModel::Check(const std::string& source) const {
   if (parents[0] != -1) throw InputError(source, "kintree_table", "root parent -1");
   for (int j = 1; j < kNumHandJoints; ++j) {
     if (parents[j] < 0 || parents[j] >= j) {
-      throw InputError(source, "kintree_table",
-                       "parents that precede their children (MANO's tree)",
-                       "joint " + std::to_string(j) + " -> " + std::to_string(parents[j]));
+      throw InputError(
+          source, "kintree_table", "parents that precede their children (MANO's tree)",
+          "joint " + std::to_string(j) + " -> " + std::to_string(parents[j]));
     }
   }
   if (pose_pca_basis.size() != 0) {

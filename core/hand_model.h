@@ -33,7 +33,7 @@ constexpr int kNumPoseParams = 45;     // 15 non-root joints x axis-angle
 // CMC/MCP/IP/tip, index MCP/PIP/DIP/tip, middle, ring, pinky).
 constexpr std::array<int, kNumHandKeypoints> kSnapFromNative = {
     0, 13, 14, 15, 16, 1, 2, 3, 17, 4, 5, 6, 18, 10, 11, 12, 19, 7, 8, 9, 20};
-constexpr std::array<int, kNumHandJoints> kManoParents = {-1, 0, 1, 2, 0, 4,  5,  0,
+constexpr std::array<int, kNumHandJoints> kManoParents = {-1, 0, 1, 2,  0,  4, 5,  0,
                                                           7,  8, 0, 10, 11, 0, 13, 14};
 
 struct HandModel {

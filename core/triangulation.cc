@@ -12,10 +12,13 @@ namespace handlabel {
 void RobustTriangulationOptions::Check() const {
   const std::string src = "RobustTriangulationOptions";
   if (!(inlier_threshold_px > 0)) {
-    throw InputError(src, "inlier_threshold_px", "> 0", std::to_string(inlier_threshold_px));
+    throw InputError(src, "inlier_threshold_px", "> 0",
+                     std::to_string(inlier_threshold_px));
   }
-  if (min_inliers < 2) throw InputError(src, "min_inliers", ">= 2", std::to_string(min_inliers));
-  if (max_pairs < 1) throw InputError(src, "max_pairs", ">= 1", std::to_string(max_pairs));
+  if (min_inliers < 2)
+    throw InputError(src, "min_inliers", ">= 2", std::to_string(min_inliers));
+  if (max_pairs < 1)
+    throw InputError(src, "max_pairs", ">= 1", std::to_string(max_pairs));
 }
 
 std::optional<Eigen::Vector3d> TriangulateWeighted(
@@ -67,7 +70,8 @@ RobustTriangulation TriangulateRobust(const Rig& rig,
 
   std::vector<std::pair<int, int>> pairs;
   for (size_t i = 0; i < usable.size(); ++i) {
-    for (size_t j = i + 1; j < usable.size(); ++j) pairs.emplace_back(usable[i], usable[j]);
+    for (size_t j = i + 1; j < usable.size(); ++j)
+      pairs.emplace_back(usable[i], usable[j]);
   }
   if (static_cast<int>(pairs.size()) > options.max_pairs) {
     std::mt19937_64 rng(options.seed);

@@ -11,9 +11,9 @@
 namespace handlabel {
 
 struct ViewObservation {
-  int camera = 0;            // index into the rig
-  Eigen::Vector2d uv_px;     // distorted pixel, as detected
-  double confidence = 1.0;   // >= 0; 0 ignores the view
+  int camera = 0;           // index into the rig
+  Eigen::Vector2d uv_px;    // distorted pixel, as detected
+  double confidence = 1.0;  // >= 0; 0 ignores the view
 };
 
 // Linear triangulation (DLT) in undistorted normalised coordinates; each view's two

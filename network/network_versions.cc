@@ -1,7 +1,7 @@
 #include "network/network_versions.h"
 
-#include <torch/version.h>
 #include <ATen/Parallel.h>
+#include <torch/version.h>
 
 namespace handlabel {
 

@@ -15,7 +15,8 @@ BuildInfo GetBuildInfo() {
   auto append = [&info](const VersionList& list) {
     for (const auto& entry : list) {
       bool seen = false;
-      for (const auto& existing : info.dependencies) seen |= existing.first == entry.first;
+      for (const auto& existing : info.dependencies)
+        seen |= existing.first == entry.first;
       if (!seen) info.dependencies.push_back(entry);
     }
   };

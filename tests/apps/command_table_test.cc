@@ -26,13 +26,15 @@ TEST(CommandTable, UnknownSubcommandExitsWithStatus2AndNamesIt) {
   EXPECT_NE(r.err.find("'frobnicate'"), std::string::npos) << r.err;
 }
 
-TEST(CommandTable, NoArgumentsIsAUsageError) { EXPECT_EQ(RunHandlabelCommand({}).status, 2); }
+TEST(CommandTable, NoArgumentsIsAUsageError) {
+  EXPECT_EQ(RunHandlabelCommand({}).status, 2);
+}
 
 TEST(CommandTable, VersionPrintsVersionHashAndDependencies) {
   const testing::CommandResult r = RunHandlabelCommand({"version"});
   EXPECT_EQ(r.status, 0);
-  for (const char* needle : {"handlabel 0.", "git ", "Eigen", "Ceres", "OpenCV",
-                             "LibTorch", "oneTBB"}) {
+  for (const char* needle :
+       {"handlabel 0.", "git ", "Eigen", "Ceres", "OpenCV", "LibTorch", "oneTBB"}) {
     EXPECT_NE(r.out.find(needle), std::string::npos) << needle << " in\n" << r.out;
   }
 }

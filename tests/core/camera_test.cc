@@ -57,7 +57,8 @@ TEST(Camera, UndistortOfDistortIsIdentityOverWholeImageIncludingCorners) {
     // A dense grid that includes the four corner pixels and the borders.
     for (int v = 0; v <= 48; ++v) {
       for (int u = 0; u <= 64; ++u) {
-        const Eigen::Vector2d uv(u * (cam.width() - 1) / 64.0, v * (cam.height() - 1) / 48.0);
+        const Eigen::Vector2d uv(u * (cam.width() - 1) / 64.0,
+                                 v * (cam.height() - 1) / 48.0);
         const Eigen::Vector2d xy_distorted((uv.x() - cam.cx()) / cam.fx(),
                                            (uv.y() - cam.cy()) / cam.fy());
         const Eigen::Vector2d xy = cam.Undistort(xy_distorted);

@@ -18,7 +18,8 @@ Rig EightCameraRig() {
   Rig rig;
   for (int i = 0; i < 8; ++i) {
     const double a = 2 * M_PI * i / 8;
-    const Eigen::Vector3d eye(0.8 * std::cos(a), 0.3 * std::sin(3 * a), 0.8 * std::sin(a));
+    const Eigen::Vector3d eye(0.8 * std::cos(a), 0.3 * std::sin(3 * a),
+                              0.8 * std::sin(a));
     rig.Add({"cam" + std::to_string(i),
              Camera(CameraModelId::kOpenCV, 640, 480,
                     {600.0 + 10 * i, 600.0 + 10 * i, 320, 240, -0.1, 0.02, 0.001, 0}),
@@ -33,7 +34,8 @@ std::vector<ViewObservation> Observe(const Rig& rig, const Eigen::Vector3d& poin
   for (size_t i = 0; i < rig.size(); ++i) {
     Eigen::Vector2d uv;
     EXPECT_TRUE(rig[i].ProjectWorld(point, &uv));
-    obs.push_back({static_cast<int>(i), uv + Eigen::Vector2d(Gaussian(noise_px), Gaussian(noise_px)), 1.0});
+    obs.push_back({static_cast<int>(i),
+                   uv + Eigen::Vector2d(Gaussian(noise_px), Gaussian(noise_px)), 1.0});
   }
   return obs;
 }
