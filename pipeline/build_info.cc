@@ -7,6 +7,7 @@
 #include "fitting/fitting_versions.h"
 #include "network/network_versions.h"
 #include "pipeline/build_config.h"
+#include "pipeline/git_hash.h"
 
 namespace handlabel {
 
