@@ -1,0 +1,88 @@
+#include "pipeline/frame_log.h"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/errors.h"
+#include "pipeline/atomic_file.h"
+
+namespace handlabel {
+namespace {
+
+FrameRecord ParseRecord(const std::string& line, const std::string& source) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(line);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(source, "record", "one JSON object per line", e.what());
+  }
+  FrameRecord r;
+  try {
+    r.frame = j.at("frame").get<std::string>();
+    r.status = j.at("status").get<std::string>();
+    r.path = j.value("path", "");
+    r.reason = j.value("reason", "");
+    r.seconds = j.value("seconds", 0.0);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(source, "record", "fields frame and status", e.what());
+  }
+  if (r.status != "ok" && r.status != "failed") {
+    throw InputError(source, "status", "'ok' or 'failed'", "'" + r.status + "'");
+  }
+  return r;
+}
+
+}  // namespace
+
+std::vector<FrameRecord> FrameLog::Read(const std::string& path) {
+  std::vector<FrameRecord> records;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return records;
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  size_t start = 0;
+  int line_number = 0;
+  while (start < text.size()) {
+    const size_t end = text.find('\n', start);
+    if (end == std::string::npos) break;  // partial last line from a crash: ignore
+    ++line_number;
+    const std::string line = text.substr(start, end - start);
+    if (!line.empty()) {
+      records.push_back(ParseRecord(line, path + ":" + std::to_string(line_number)));
+    }
+    start = end + 1;
+  }
+  return records;
+}
+
+FrameLog::FrameLog(std::string path) : path_(std::move(path)) {
+  for (FrameRecord& r : Read(path_)) latest_[r.frame] = std::move(r);
+}
+
+bool FrameLog::IsDone(const std::string& frame) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = latest_.find(frame);
+  return it != latest_.end() && it->second.status == "ok";
+}
+
+void FrameLog::Record(const FrameRecord& record) {
+  nlohmann::json j = {{"frame", record.frame},
+                      {"status", record.status},
+                      {"path", record.path},
+                      {"seconds", record.seconds}};
+  if (!record.reason.empty()) j["reason"] = record.reason;
+  std::lock_guard<std::mutex> lock(mutex_);
+  AppendLineDurably(path_, j.dump());
+  latest_[record.frame] = record;
+}
+
+std::vector<FrameRecord> FrameLog::Latest() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<FrameRecord> out;
+  for (const auto& [frame, record] : latest_) out.push_back(record);
+  return out;
+}
+
+}  // namespace handlabel

@@ -1,0 +1,45 @@
+#pragma once
+// The resume log of one labeling shard: an append-only JSON-lines file with one record
+// per frame that reached a final state. A record is appended only after the frame's
+// outputs were renamed into place, so "in the log with status ok" implies "outputs
+// complete". A crash can leave a partial last line; it is ignored on load.
+
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace handlabel {
+
+struct FrameRecord {
+  std::string frame;   // frame id
+  std::string status;  // "ok" or "failed"
+  std::string path;    // which stage produced the label ("network", "refined", "fit")
+  std::string reason;  // why it failed (empty when ok)
+  double seconds = 0;  // wall time spent on the frame
+};
+
+class FrameLog {
+ public:
+  // Loads `path` if it exists. Throws InputError naming the file and line for a
+  // malformed complete line (a partial last line is not an error).
+  explicit FrameLog(std::string path);
+
+  // True if the frame finished with status ok.
+  bool IsDone(const std::string& frame) const;
+  // Appends durably; thread-safe. A later record for the same frame supersedes.
+  void Record(const FrameRecord& record);
+  // Latest record per frame, sorted by frame id.
+  std::vector<FrameRecord> Latest() const;
+  const std::string& path() const { return path_; }
+
+  // Reads a log without keeping it open for appends (merge, reports).
+  static std::vector<FrameRecord> Read(const std::string& path);
+
+ private:
+  std::string path_;
+  mutable std::mutex mutex_;
+  std::map<std::string, FrameRecord> latest_;
+};
+
+}  // namespace handlabel

@@ -1,0 +1,86 @@
+#include "pipeline/frame_log.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/errors.h"
+#include "pipeline/atomic_file.h"
+
+namespace handlabel {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string TempDir() {
+  const fs::path dir = fs::temp_directory_path() /
+                       ("handlabel_" + std::string(::testing::UnitTest::GetInstance()
+                                                       ->current_test_info()
+                                                       ->name()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST(FrameLog, RecordsSurviveReopenAndLaterRecordsSupersede) {
+  const std::string path = TempDir() + "/shard-0-of-1.jsonl";
+  {
+    FrameLog log(path);
+    log.Record({"000001", "failed", "", "no views", 0.1});
+    log.Record({"000002", "ok", "network", "", 0.2});
+    log.Record({"000001", "ok", "fit", "", 0.3});
+  }
+  FrameLog reopened(path);
+  EXPECT_TRUE(reopened.IsDone("000001"));
+  EXPECT_TRUE(reopened.IsDone("000002"));
+  EXPECT_FALSE(reopened.IsDone("000003"));
+  const auto latest = reopened.Latest();
+  ASSERT_EQ(latest.size(), 2u);
+  EXPECT_EQ(latest[0].path, "fit");
+}
+
+TEST(FrameLog, PartialLastLineFromACrashIsIgnored) {
+  const std::string path = TempDir() + "/log.jsonl";
+  {
+    FrameLog log(path);
+    log.Record({"a", "ok", "network", "", 0});
+  }
+  std::ofstream(path, std::ios::app) << "{\"frame\": \"b\", \"sta";  // killed mid-write
+  FrameLog log(path);
+  EXPECT_TRUE(log.IsDone("a"));
+  EXPECT_FALSE(log.IsDone("b"));
+}
+
+TEST(FrameLog, MalformedCompleteLineNamesFileAndLine) {
+  const std::string path = TempDir() + "/log.jsonl";
+  std::ofstream(path) << "{\"frame\":\"a\",\"status\":\"ok\"}\n{\"frame\":\"b\"}\n";
+  try {
+    FrameLog log(path);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("log.jsonl:2"), std::string::npos) << e.what();
+  }
+}
+
+TEST(AtomicFile, ReplacesContentAndLeavesNoTemporary) {
+  const std::string dir = TempDir();
+  const std::string path = dir + "/sub/label.json";
+  WriteFileAtomically(path, "first");
+  WriteFileAtomically(path, "second");
+  EXPECT_EQ(ReadAll(path), "second");
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 1);
+  std::ofstream(dir + "/sub/x.json.tmp.123") << "half";
+  EXPECT_EQ(RemoveStaleTemporaries(dir), 1);
+  EXPECT_EQ(ReadAll(path), "second");
+}
+
+}  // namespace
+}  // namespace handlabel
