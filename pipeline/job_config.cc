@@ -1,0 +1,225 @@
+#include "pipeline/job_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <set>
+
+#include "core/errors.h"
+
+namespace handlabel {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Walks one YAML mapping, remembering which keys were read so unknown ones are reported.
+class Section {
+ public:
+  Section(const YAML::Node& node, std::string file, std::string prefix)
+      : node_(node), file_(std::move(file)), prefix_(std::move(prefix)) {
+    if (node_ && !node_.IsMap()) {
+      throw InputError(file_, prefix_.empty() ? "(top level)" : prefix_, "a mapping");
+    }
+  }
+
+  template <typename T>
+  void Read(const char* key, T* value) {
+    seen_.insert(key);
+    if (!node_ || !node_[key]) return;
+    try {
+      *value = node_[key].as<T>();
+    } catch (const YAML::Exception&) {
+      throw InputError(file_, Name(key), TypeName(value), "'" + Text(key) + "'");
+    }
+  }
+
+  Section Child(const char* key) {
+    seen_.insert(key);
+    return Section(node_ ? node_[key] : YAML::Node(), file_, Name(key));
+  }
+
+  void RejectUnknownKeys() const {
+    if (!node_) return;
+    for (const auto& entry : node_) {
+      const std::string key = entry.first.as<std::string>();
+      if (!seen_.count(key)) {
+        std::string known;
+        for (const std::string& k : seen_) known += (known.empty() ? "" : ", ") + k;
+        throw InputError(file_, Name(key.c_str()), "a known key (" + known + ")",
+                         "unknown key");
+      }
+    }
+  }
+
+  std::string Name(const char* key) const {
+    return prefix_.empty() ? key : prefix_ + "." + key;
+  }
+
+ private:
+  std::string Text(const char* key) const {
+    YAML::Emitter out;
+    out << node_[key];
+    return out.c_str();
+  }
+  static const char* TypeName(std::string*) { return "a string"; }
+  static const char* TypeName(int*) { return "an integer"; }
+  static const char* TypeName(uint64_t*) { return "a non-negative integer"; }
+  static const char* TypeName(double*) { return "a number"; }
+  static const char* TypeName(bool*) { return "true or false"; }
+  static const char* TypeName(std::vector<std::string>*) { return "a list of strings"; }
+
+  YAML::Node node_;
+  std::string file_;
+  std::string prefix_;
+  std::set<std::string> seen_;
+};
+
+template <typename E>
+E ParseEnum(const std::string& text, const std::vector<std::pair<const char*, E>>& options,
+            const std::string& file, const std::string& field) {
+  std::string names;
+  for (const auto& [name, value] : options) {
+    if (text == name) return value;
+    names += (names.empty() ? "" : " | ") + std::string(name);
+  }
+  throw InputError(file, field, names, "'" + text + "'");
+}
+
+std::string Resolve(const std::string& path, const fs::path& base) {
+  if (path.empty() || fs::path(path).is_absolute()) return path;
+  return (base / path).lexically_normal().string();
+}
+
+}  // namespace
+
+std::string ToString(RefineMode mode) {
+  switch (mode) {
+    case RefineMode::kOff: return "off";
+    case RefineMode::kAlways: return "always";
+    case RefineMode::kFallback: return "fallback";
+  }
+  return "?";
+}
+
+void JobConfig::Check() const {
+  const std::string& f = source_file;
+  const std::set<std::string> formats = {"native", "dexycb", "ho3d", "oakink"};
+  if (!formats.count(input_format)) {
+    throw InputError(f, "input.format", "native | dexycb | ho3d | oakink",
+                     "'" + input_format + "'");
+  }
+  if (input_path.empty()) throw InputError(f, "input.path", "the capture folder");
+  if (cameras_source != "capture" && cameras_source != "file") {
+    throw InputError(f, "cameras.source", "capture | file", "'" + cameras_source + "'");
+  }
+  if (cameras_source == "file" && cameras_file.empty()) {
+    throw InputError(f, "cameras.file", "a rig file when cameras.source is file");
+  }
+  if (output_dir.empty()) throw InputError(f, "output.dir", "an output folder");
+  if (batch_size < 1) throw InputError(f, "network.batch_size", ">= 1", std::to_string(batch_size));
+  if (threads < 0) throw InputError(f, "network.threads", ">= 0", std::to_string(threads));
+  if (network_weights.empty() && refine_mode != RefineMode::kAlways) {
+    throw InputError(f, "refine.mode",
+                     "'always' when network.weights is empty (without a network every "
+                     "frame must be fitted)",
+                     "'" + ToString(refine_mode) + "'");
+  }
+  if (network_weights.empty() && keypoints != KeypointSource::kFiles) {
+    throw InputError(f, "evidence.keypoints_2d", "'files' when there is no network");
+  }
+  if (!(quality.max_reprojection_px > 0)) {
+    throw InputError(f, "refine.max_reprojection_px", "> 0");
+  }
+  if (!(quality.max_view_disagreement_mm > 0)) {
+    throw InputError(f, "refine.max_view_disagreement_mm", "> 0");
+  }
+  if (quality.min_confidence < 0 || quality.min_confidence > 1) {
+    throw InputError(f, "refine.min_confidence", "a value in [0, 1]");
+  }
+  if (quality.min_views < 1) throw InputError(f, "refine.min_views", ">= 1");
+  for (const std::string& m : meshes) {
+    if (m != "ply" && m != "obj") throw InputError(f, "output.meshes", "ply and/or obj", "'" + m + "'");
+  }
+}
+
+JobConfig LoadJobConfig(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError(path, "", "a readable YAML job file", "cannot open it");
+  } catch (const YAML::Exception& e) {
+    throw InputError(path, "", "valid YAML", e.what());
+  }
+  JobConfig job;
+  job.source_file = path;
+  const fs::path base = fs::path(path).parent_path();
+
+  Section top(root, path, "");
+  top.Read("name", &job.name);
+  top.Read("seed", &job.seed);
+  top.Read("hand_model", &job.hand_model);
+
+  Section input = top.Child("input");
+  input.Read("format", &job.input_format);
+  input.Read("path", &job.input_path);
+  input.Read("frames", &job.frames);
+  input.RejectUnknownKeys();
+
+  Section cameras = top.Child("cameras");
+  cameras.Read("source", &job.cameras_source);
+  cameras.Read("file", &job.cameras_file);
+  cameras.RejectUnknownKeys();
+
+  Section network = top.Child("network");
+  network.Read("weights", &job.network_weights);
+  network.Read("batch_size", &job.batch_size);
+  network.Read("threads", &job.threads);
+  network.RejectUnknownKeys();
+
+  Section refine = top.Child("refine");
+  std::string mode = "fallback";
+  refine.Read("mode", &mode);
+  job.refine_mode = ParseEnum<RefineMode>(
+      mode, {{"off", RefineMode::kOff}, {"always", RefineMode::kAlways},
+             {"fallback", RefineMode::kFallback}},
+      path, refine.Name("mode"));
+  refine.Read("max_reprojection_px", &job.quality.max_reprojection_px);
+  refine.Read("max_view_disagreement_mm", &job.quality.max_view_disagreement_mm);
+  refine.Read("min_confidence", &job.quality.min_confidence);
+  refine.Read("min_views", &job.quality.min_views);
+  refine.RejectUnknownKeys();
+
+  Section evidence = top.Child("evidence");
+  std::string keypoints = "network", masks = "files";
+  evidence.Read("keypoints_2d", &keypoints);
+  evidence.Read("masks", &masks);
+  job.keypoints = ParseEnum<KeypointSource>(
+      keypoints, {{"network", KeypointSource::kNetwork}, {"files", KeypointSource::kFiles},
+                  {"both", KeypointSource::kBoth}},
+      path, evidence.Name("keypoints_2d"));
+  job.masks = ParseEnum<MaskSource>(
+      masks, {{"none", MaskSource::kNone}, {"files", MaskSource::kFiles},
+              {"network", MaskSource::kNetwork}},
+      path, evidence.Name("masks"));
+  evidence.RejectUnknownKeys();
+
+  Section output = top.Child("output");
+  output.Read("dir", &job.output_dir);
+  output.Read("meshes", &job.meshes);
+  output.Read("overlays", &job.overlays);
+  output.Read("evaluate", &job.evaluate);
+  output.Read("baseline", &job.baseline);
+  output.RejectUnknownKeys();
+  top.RejectUnknownKeys();
+
+  job.input_path = Resolve(job.input_path, base);
+  job.cameras_file = Resolve(job.cameras_file, base);
+  job.hand_model = Resolve(job.hand_model, base);
+  job.network_weights = Resolve(job.network_weights, base);
+  job.output_dir = Resolve(job.output_dir, base);
+  job.Check();
+  return job;
+}
+
+}  // namespace handlabel
