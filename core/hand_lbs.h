@@ -23,8 +23,8 @@ using Points3d = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 struct HandParams {
   Eigen::Vector3d global_orient = Eigen::Vector3d::Zero();  // root axis-angle
   Eigen::Matrix<double, kNumPoseParams, 1> hand_pose =
-      Eigen::Matrix<double, kNumPoseParams, 1>::Zero();      // 15 joints, axis-angle
-  Eigen::VectorXd betas;                                   // <= model's count; missing = 0
+      Eigen::Matrix<double, kNumPoseParams, 1>::Zero();  // 15 joints, axis-angle
+  Eigen::VectorXd betas;                                 // <= model's count; missing = 0
   Eigen::Vector3d transl = Eigen::Vector3d::Zero();
 };
 
@@ -42,3 +42,5 @@ HandMesh PoseHand(const HandModel& model, const HandParams& params);
 Eigen::Matrix<double, kNumPoseParams, 1> HandPoseFromPca(const HandModel& model,
                                                          const Eigen::VectorXd& coeffs,
                                                          bool flat_hand_mean);
+
+}  // namespace handlabel

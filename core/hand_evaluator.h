@@ -1,0 +1,336 @@
+#pragma once
+// HandEvaluator: the MANO forward pass (same semantics as PoseHand in hand_lbs.h)
+// templated on the scalar type, for ceres::Jet (autodiff in fitting), core's Dual
+// (Jacobians inside core) and double. Built once per model; it precomputes
+//   - rest joints as a linear function of betas: J(b) = J_regressor * v_template +
+//     (J_regressor * shapedirs) * b, so joints never touch the mesh;
+//   - row-major per-vertex blend shapes and sparse skinning weights, so any subset of
+//     vertices (e.g. the 5 fingertips of the keypoint path) costs only its own rows.
+//
+// Parameter arrays (all raw pointers, so Ceres parameter blocks can be passed as is):
+//   global_orient  3            root axis-angle; the root rotates about rest joint 0
+//   hand_pose      pose_dim()   45 axis-angle values of the 15 non-root joints (native
+//                               order), or num_pca_comps PCA coefficients (options)
+//   betas          num_betas()  may be nullptr (= zeros)
+//   transl         3            added last; may be nullptr (= zeros)
+// Outputs are row-major point arrays (x, y, z per point) in the model's frame.
+//
+// Typical use (fitting): a cost functor holds `const HandEvaluator&` and calls
+//   evaluator.Keypoints(orient, pose, betas, transl, keypoints63);
+// For keypoints and a vertex subset in one pass, call Pose() once and then
+// KeypointsFromState() / VerticesFromState() on the same state.
+//
+// Scalar requirements: T(double), + - * / with T and double, comparison with T, and
+// sqrt/sin/cos found by ADL or in std (true for double, Dual<N>, ceres::Jet).
+
+#include <Eigen/Core>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/hand_model.h"
+
+namespace handlabel {
+
+// Rotation matrix (row-major 3x3) from axis-angle w: R = I + a [w]x + b [w]x^2 with
+// a = sin(t)/t, b = (1 - cos(t))/t^2, t = |w|. Below t^2 = 1e-8 a and b come from their
+// Taylor series in t^2 (no sqrt), so values and derivatives stay exact at w = 0 for
+// Jets and Duals (error < 1e-18).
+template <typename T>
+void AxisAngleToRotation(const T* w, T* r) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const T theta2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+  T a, b;
+  if (theta2 > T(1e-8)) {
+    const T theta = sqrt(theta2);
+    a = sin(theta) / theta;
+    b = (T(1.0) - cos(theta)) / theta2;
+  } else {
+    a = T(1.0) - theta2 / 6.0;
+    b = T(0.5) - theta2 / 24.0;
+  }
+  // [w]x^2 = w w^T - t^2 I.
+  r[0] = T(1.0) + b * (w[0] * w[0] - theta2);
+  r[1] = b * (w[0] * w[1]) - a * w[2];
+  r[2] = b * (w[0] * w[2]) + a * w[1];
+  r[3] = b * (w[0] * w[1]) + a * w[2];
+  r[4] = T(1.0) + b * (w[1] * w[1] - theta2);
+  r[5] = b * (w[1] * w[2]) - a * w[0];
+  r[6] = b * (w[0] * w[2]) - a * w[1];
+  r[7] = b * (w[1] * w[2]) + a * w[0];
+  r[8] = T(1.0) + b * (w[2] * w[2] - theta2);
+}
+
+struct HandEvaluatorOptions {
+  // Length of the betas arrays the evaluator reads (the first n shape coefficients of
+  // the model); -1 = all of the model's.
+  int num_betas = -1;
+  // 0: hand_pose is 45 axis-angle values. n > 0: hand_pose is n PCA coefficients,
+  // pose = coeffs * pose_pca_basis[:n] (+ pose_mean unless flat_hand_mean).
+  int num_pca_comps = 0;
+  // PCA mode only: do not add the model's pose_mean (MANO's flat_hand_mean).
+  bool flat_hand_mean = false;
+};
+
+// Most shape coefficients an evaluator reads (MANO has 10).
+constexpr int kMaxHandBetas = 32;
+
+// Intermediate results of one forward pass, shared by the keypoint and vertex outputs.
+template <typename T>
+struct HandPoseState {
+  T rest_joints[kNumHandJoints * 3];         // J(betas), native order
+  T world[kNumHandJoints * 12];              // G_j as row-major [R | t]; t = posed joint
+  T skin_t[kNumHandJoints * 3];              // translation of G_j * [I | -J_j]
+  T pose_feature[9 * (kNumHandJoints - 1)];  // vec(R_j - I), j = 1..15
+  T betas[kMaxHandBetas];                    // first num_betas() used
+  T transl[3];
+};
+
+class HandEvaluator {
+ public:
+  // Copies what it needs from `model` (which may be destroyed afterwards). Throws
+  // InputError if the options do not fit the model (too many betas, PCA without basis).
+  explicit HandEvaluator(const HandModel& model,
+                         const HandEvaluatorOptions& options = {});
+
+  int num_vertices() const { return num_vertices_; }
+  int num_betas() const { return num_betas_; }
+  // Length of the hand_pose arrays: 45, or the number of PCA coefficients.
+  int pose_dim() const {
+    return options_.num_pca_comps > 0 ? options_.num_pca_comps : 45;
+  }
+  const HandEvaluatorOptions& options() const { return options_; }
+  const std::array<int, 5>& tip_vertex_ids() const { return tip_vertex_ids_; }
+
+  // 45 axis-angle values from hand_pose (identity copy unless in PCA mode).
+  template <typename T>
+  void AxisAnglePose(const T* hand_pose, T* pose45) const;
+
+  // Rest joints J(betas), 16 x 3.
+  template <typename T>
+  void RestJoints(const T* betas, T* joints48) const;
+
+  // Everything up to skinning.
+  template <typename T>
+  void Pose(const T* global_orient, const T* hand_pose, const T* betas, const T* transl,
+            HandPoseState<T>* state) const;
+
+  // 16 posed joints (native order) + transl.
+  template <typename T>
+  void JointsFromState(const HandPoseState<T>& state, T* joints48) const;
+  // 21 keypoints in SNAP order (16 joints + the model's 5 tip vertices).
+  template <typename T>
+  void KeypointsFromState(const HandPoseState<T>& state, T* keypoints63) const;
+  // Posed vertices `ids` (any order, repeats allowed) into out[3 * i + c].
+  template <typename T>
+  void VerticesFromState(const HandPoseState<T>& state, const std::vector<int>& ids,
+                         T* out) const;
+  // All vertices into out[3 * v + c].
+  template <typename T>
+  void AllVerticesFromState(const HandPoseState<T>& state, T* out) const;
+
+  // One-call conveniences.
+  template <typename T>
+  void Keypoints(const T* global_orient, const T* hand_pose, const T* betas,
+                 const T* transl, T* keypoints63) const {
+    HandPoseState<T> state;
+    Pose(global_orient, hand_pose, betas, transl, &state);
+    KeypointsFromState(state, keypoints63);
+  }
+  template <typename T>
+  void Joints(const T* global_orient, const T* hand_pose, const T* betas, const T* transl,
+              T* joints48) const {
+    HandPoseState<T> state;
+    Pose(global_orient, hand_pose, betas, transl, &state);
+    JointsFromState(state, joints48);
+  }
+  template <typename T>
+  void Vertices(const T* global_orient, const T* hand_pose, const T* betas,
+                const T* transl, const std::vector<int>& ids, T* out) const {
+    HandPoseState<T> state;
+    Pose(global_orient, hand_pose, betas, transl, &state);
+    VerticesFromState(state, ids, out);
+  }
+  template <typename T>
+  void AllVertices(const T* global_orient, const T* hand_pose, const T* betas,
+                   const T* transl, T* out) const {
+    HandPoseState<T> state;
+    Pose(global_orient, hand_pose, betas, transl, &state);
+    AllVerticesFromState(state, out);
+  }
+
+ private:
+  template <typename T>
+  void SkinVertex(const HandPoseState<T>& state, int v, T* out) const;
+
+  using RowMatrix =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+  HandEvaluatorOptions options_;
+  int num_vertices_ = 0;
+  int num_betas_ = 0;
+  std::array<int, kNumHandJoints> parents_{};
+  std::array<int, 5> tip_vertex_ids_{};
+  Eigen::Matrix<double, 3 * kNumHandJoints, 1>
+      joint_template_;          // J_regressor * v_template
+  RowMatrix joint_shapedirs_;   // 48 x num_betas: J_regressor * shapedirs
+  Eigen::VectorXd v_template_;  // 3V
+  RowMatrix shapedirs_;         // 3V x num_betas
+  RowMatrix posedirs_;          // 3V x 135
+  // Sparse skinning weights (exact zeros dropped): vertex v uses entries
+  // weight_start_[v] .. weight_start_[v + 1] - 1.
+  std::vector<int> weight_start_;
+  std::vector<int> weight_joint_;
+  std::vector<double> weight_value_;
+  RowMatrix pca_basis_;  // num_pca_comps x 45
+  Eigen::Matrix<double, 45, 1> pca_mean_ = Eigen::Matrix<double, 45, 1>::Zero();
+};
+
+// ---------------------------------------------------------------------------------
+// Template definitions.
+
+template <typename T>
+void HandEvaluator::AxisAnglePose(const T* hand_pose, T* pose45) const {
+  const int n = options_.num_pca_comps;
+  if (n == 0) {
+    for (int i = 0; i < 45; ++i) pose45[i] = hand_pose[i];
+    return;
+  }
+  for (int i = 0; i < 45; ++i) {
+    T sum = T(pca_mean_[i]);
+    for (int k = 0; k < n; ++k) sum += pca_basis_(k, i) * hand_pose[k];
+    pose45[i] = sum;
+  }
+}
+
+template <typename T>
+void HandEvaluator::RestJoints(const T* betas, T* joints48) const {
+  for (int i = 0; i < 3 * kNumHandJoints; ++i) {
+    T sum = T(joint_template_[i]);
+    if (betas != nullptr) {
+      for (int s = 0; s < num_betas_; ++s) sum += joint_shapedirs_(i, s) * betas[s];
+    }
+    joints48[i] = sum;
+  }
+}
+
+template <typename T>
+void HandEvaluator::Pose(const T* global_orient, const T* hand_pose, const T* betas,
+                         const T* transl, HandPoseState<T>* state) const {
+  RestJoints(betas, state->rest_joints);
+  for (int s = 0; s < num_betas_; ++s) state->betas[s] = betas ? betas[s] : T(0.0);
+  T pose45[45];
+  AxisAnglePose(hand_pose, pose45);
+  for (int c = 0; c < 3; ++c) state->transl[c] = transl ? transl[c] : T(0.0);
+  for (int j = 0; j < kNumHandJoints; ++j) {
+    T local[9];
+    AxisAngleToRotation(j == 0 ? global_orient : pose45 + 3 * (j - 1), local);
+    if (j > 0) {
+      T* feature = state->pose_feature + 9 * (j - 1);
+      for (int i = 0; i < 9; ++i) feature[i] = local[i];
+      feature[0] -= 1.0;
+      feature[4] -= 1.0;
+      feature[8] -= 1.0;
+    }
+    const T* rest = state->rest_joints + 3 * j;
+    T* g = state->world + 12 * j;
+    const int parent = parents_[j];
+    if (parent < 0) {
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) g[4 * r + c] = local[3 * r + c];
+        g[4 * r + 3] = rest[r];
+      }
+    } else {
+      const T* gp = state->world + 12 * parent;
+      const T* rest_parent = state->rest_joints + 3 * parent;
+      T offset[3] = {rest[0] - rest_parent[0], rest[1] - rest_parent[1],
+                     rest[2] - rest_parent[2]};
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+          g[4 * r + c] = gp[4 * r] * local[c] + gp[4 * r + 1] * local[3 + c] +
+                         gp[4 * r + 2] * local[6 + c];
+        }
+        g[4 * r + 3] = gp[4 * r] * offset[0] + gp[4 * r + 1] * offset[1] +
+                       gp[4 * r + 2] * offset[2] + gp[4 * r + 3];
+      }
+    }
+    for (int r = 0; r < 3; ++r) {
+      state->skin_t[3 * j + r] =
+          g[4 * r + 3] -
+          (g[4 * r] * rest[0] + g[4 * r + 1] * rest[1] + g[4 * r + 2] * rest[2]);
+    }
+  }
+}
+
+template <typename T>
+void HandEvaluator::JointsFromState(const HandPoseState<T>& state, T* joints48) const {
+  for (int j = 0; j < kNumHandJoints; ++j) {
+    for (int c = 0; c < 3; ++c) {
+      joints48[3 * j + c] = state.world[12 * j + 4 * c + 3] + state.transl[c];
+    }
+  }
+}
+
+template <typename T>
+void HandEvaluator::KeypointsFromState(const HandPoseState<T>& state,
+                                       T* keypoints63) const {
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const int native = kSnapFromNative[k];
+    T* out = keypoints63 + 3 * k;
+    if (native < kNumHandJoints) {
+      for (int c = 0; c < 3; ++c) {
+        out[c] = state.world[12 * native + 4 * c + 3] + state.transl[c];
+      }
+    } else {
+      SkinVertex(state, tip_vertex_ids_[native - kNumHandJoints], out);
+    }
+  }
+}
+
+template <typename T>
+void HandEvaluator::VerticesFromState(const HandPoseState<T>& state,
+                                      const std::vector<int>& ids, T* out) const {
+  for (size_t i = 0; i < ids.size(); ++i) SkinVertex(state, ids[i], out + 3 * i);
+}
+
+template <typename T>
+void HandEvaluator::AllVerticesFromState(const HandPoseState<T>& state, T* out) const {
+  for (int v = 0; v < num_vertices_; ++v) SkinVertex(state, v, out + 3 * v);
+}
+
+template <typename T>
+void HandEvaluator::SkinVertex(const HandPoseState<T>& state, int v, T* out) const {
+  constexpr int kFeatures = 9 * (kNumHandJoints - 1);
+  T p[3];  // v_posed
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::Index row = 3 * v + c;
+    T sum = T(v_template_[row]);
+    const double* sd = shapedirs_.data() + row * num_betas_;
+    for (int s = 0; s < num_betas_; ++s) sum += sd[s] * state.betas[s];
+    const double* pd = posedirs_.data() + row * kFeatures;
+    for (int k = 0; k < kFeatures; ++k) sum += pd[k] * state.pose_feature[k];
+    p[c] = sum;
+  }
+  // Blend the 3x4 skinning transforms, then apply once.
+  T m[12];
+  for (T& x : m) x = T(0.0);
+  for (int e = weight_start_[v]; e < weight_start_[v + 1]; ++e) {
+    const int j = weight_joint_[e];
+    const double w = weight_value_[e];
+    const T* g = state.world + 12 * j;
+    for (int r = 0; r < 3; ++r) {
+      m[4 * r] += w * g[4 * r];
+      m[4 * r + 1] += w * g[4 * r + 1];
+      m[4 * r + 2] += w * g[4 * r + 2];
+      m[4 * r + 3] += w * state.skin_t[3 * j + r];
+    }
+  }
+  for (int r = 0; r < 3; ++r) {
+    out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3] +
+             state.transl[r];
+  }
+}
+
+}  // namespace handlabel
