@@ -26,7 +26,11 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <vector>
+
+#include "core/dual.h"
+#include "core/scalar_ops.h"
 
 #include "core/axis_angle.h"
 #include "core/hand_model.h"
@@ -50,12 +54,27 @@ constexpr int kMaxHandBetas = 32;
 // Intermediate results of one forward pass, shared by the keypoint and vertex outputs.
 template <typename T>
 struct HandPoseState {
-  T rest_joints[kNumHandJoints * 3];         // J(betas), native order
-  T world[kNumHandJoints * 12];              // G_j as row-major [R | t]; t = posed joint
-  T skin_t[kNumHandJoints * 3];              // translation of G_j * [I | -J_j]
-  T pose_feature[9 * (kNumHandJoints - 1)];  // vec(R_j - I), j = 1..15
-  T betas[kMaxHandBetas];                    // first num_betas() used
+  static constexpr bool kIsDouble = std::is_same_v<T, double>;
+  T rest_joints[kNumHandJoints * 3];  // J(betas), native order
+  T world[kNumHandJoints * 12];       // G_j as row-major [R | t]; t = posed joint
+  T skin_t[kNumHandJoints * 3];       // translation of G_j * [I | -J_j]
   T transl[3];
+  // Pose blend shapes. T = double: pose_feature = vec(R_j - I), j = 1..15.
+  // Dual/Jet types: v_posed is linear in betas and, per joint, a function of that
+  // joint's 3 axis-angle values only, so it is evaluated in doubles and its derivative
+  // enters through the chain rule (first order is exact for these types):
+  //   v_posed = value + shapedirs * betas_delta
+  //             + sum_j (posedirs_j * d vec(R_j) / d w_j) * w_delta_j
+  // which costs 55 instead of 145 dual multiply-adds per vertex coordinate.
+  // Arrays a path does not use have size 1: dual types zero-initialise, so unused
+  // storage would cost time on every call.
+  T pose_feature[kIsDouble ? 9 * (kNumHandJoints - 1) : 1];  // double path
+  T betas[kIsDouble ? kMaxHandBetas : 1];                    // double path
+  double feature_value[9 * (kNumHandJoints - 1)];            // dual: vec(R_j - I)
+  double feature_jac[9 * (kNumHandJoints - 1)][3];           // dual: d feature / d w_j
+  double betas_value[kMaxHandBetas];                         // dual
+  T betas_delta[kIsDouble ? 1 : kMaxHandBetas];  // dual: betas - value (derivatives)
+  T pose_delta[kIsDouble ? 1 : kNumPoseParams];  // dual: axis-angle pose - value
 };
 
 class HandEvaluator {
@@ -170,7 +189,7 @@ void HandEvaluator::AxisAnglePose(const T* hand_pose, T* pose45) const {
   }
   for (int i = 0; i < 45; ++i) {
     T sum = T(pca_mean_[i]);
-    for (int k = 0; k < n; ++k) sum += pca_basis_(k, i) * hand_pose[k];
+    for (int k = 0; k < n; ++k) AddScaled(pca_basis_(k, i), hand_pose[k], &sum);
     pose45[i] = sum;
   }
 }
@@ -180,7 +199,9 @@ void HandEvaluator::RestJoints(const T* betas, T* joints48) const {
   for (int i = 0; i < 3 * kNumHandJoints; ++i) {
     T sum = T(joint_template_[i]);
     if (betas != nullptr) {
-      for (int s = 0; s < num_betas_; ++s) sum += joint_shapedirs_(i, s) * betas[s];
+      for (int s = 0; s < num_betas_; ++s) {
+        AddScaled(joint_shapedirs_(i, s), betas[s], &sum);
+      }
     }
     joints48[i] = sum;
   }
@@ -190,19 +211,51 @@ template <typename T>
 void HandEvaluator::Pose(const T* global_orient, const T* hand_pose, const T* betas,
                          const T* transl, HandPoseState<T>* state) const {
   RestJoints(betas, state->rest_joints);
-  for (int s = 0; s < num_betas_; ++s) state->betas[s] = betas ? betas[s] : T(0.0);
-  T pose45[45];
-  AxisAnglePose(hand_pose, pose45);
+  for (int s = 0; s < num_betas_; ++s) {
+    if constexpr (HandPoseState<T>::kIsDouble) {
+      state->betas[s] = betas ? betas[s] : 0.0;
+    } else if (betas) {
+      state->betas_value[s] = ScalarPart(betas[s]);
+      state->betas_delta[s] = betas[s] - state->betas_value[s];
+    } else {
+      state->betas_value[s] = 0.0;
+      state->betas_delta[s] = T(0.0);
+    }
+  }
+  // Axis-angle pose: the caller's array, or its PCA expansion.
+  std::vector<T> pca_pose;
+  const T* pose45 = hand_pose;
+  if (options_.num_pca_comps > 0) {
+    pca_pose.resize(kNumPoseParams);
+    AxisAnglePose(hand_pose, pca_pose.data());
+    pose45 = pca_pose.data();
+  }
   for (int c = 0; c < 3; ++c) state->transl[c] = transl ? transl[c] : T(0.0);
   for (int j = 0; j < kNumHandJoints; ++j) {
     T local[9];
     AxisAngleToRotation(j == 0 ? global_orient : pose45 + 3 * (j - 1), local);
     if (j > 0) {
-      T* feature = state->pose_feature + 9 * (j - 1);
-      for (int i = 0; i < 9; ++i) feature[i] = local[i];
-      feature[0] -= 1.0;
-      feature[4] -= 1.0;
-      feature[8] -= 1.0;
+      if constexpr (HandPoseState<T>::kIsDouble) {
+        T* feature = state->pose_feature + 9 * (j - 1);
+        for (int i = 0; i < 9; ++i) feature[i] = local[i];
+        feature[0] -= 1.0;
+        feature[4] -= 1.0;
+        feature[8] -= 1.0;
+      } else {
+        // Value and 9x3 Jacobian of vec(R_j) w.r.t. the joint's own axis-angle.
+        Dual<3> w[3], r[9];
+        for (int i = 0; i < 3; ++i) {
+          const double value = ScalarPart(pose45[3 * (j - 1) + i]);
+          w[i] = Dual<3>(value, i);
+          state->pose_delta[3 * (j - 1) + i] = pose45[3 * (j - 1) + i] - value;
+        }
+        AxisAngleToRotation(w, r);
+        for (int e = 0; e < 9; ++e) {
+          const int k = 9 * (j - 1) + e;
+          state->feature_value[k] = r[e].a - (e % 4 == 0 ? 1.0 : 0.0);
+          for (int i = 0; i < 3; ++i) state->feature_jac[k][i] = r[e].v[i];
+        }
+      }
     }
     const T* rest = state->rest_joints + 3 * j;
     T* g = state->world + 12 * j;
@@ -219,17 +272,13 @@ void HandEvaluator::Pose(const T* global_orient, const T* hand_pose, const T* be
                      rest[2] - rest_parent[2]};
       for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 3; ++c) {
-          g[4 * r + c] = gp[4 * r] * local[c] + gp[4 * r + 1] * local[3 + c] +
-                         gp[4 * r + 2] * local[6 + c];
+          g[4 * r + c] = Dot3(gp + 4 * r, 1, local + c, 3, T(0.0));
         }
-        g[4 * r + 3] = gp[4 * r] * offset[0] + gp[4 * r + 1] * offset[1] +
-                       gp[4 * r + 2] * offset[2] + gp[4 * r + 3];
+        g[4 * r + 3] = Dot3(gp + 4 * r, 1, offset, 1, gp[4 * r + 3]);
       }
     }
     for (int r = 0; r < 3; ++r) {
-      state->skin_t[3 * j + r] =
-          g[4 * r + 3] -
-          (g[4 * r] * rest[0] + g[4 * r + 1] * rest[1] + g[4 * r + 2] * rest[2]);
+      state->skin_t[3 * j + r] = g[4 * r + 3] - Dot3(g + 4 * r, 1, rest, 1, T(0.0));
     }
   }
 }
@@ -276,12 +325,31 @@ void HandEvaluator::SkinVertex(const HandPoseState<T>& state, int v, T* out) con
   T p[3];  // v_posed
   for (int c = 0; c < 3; ++c) {
     const Eigen::Index row = 3 * v + c;
-    T sum = T(v_template_[row]);
     const double* sd = shapedirs_.data() + row * num_betas_;
-    for (int s = 0; s < num_betas_; ++s) sum += sd[s] * state.betas[s];
     const double* pd = posedirs_.data() + row * kFeatures;
-    for (int k = 0; k < kFeatures; ++k) sum += pd[k] * state.pose_feature[k];
-    p[c] = sum;
+    if constexpr (std::is_same_v<T, double>) {
+      T sum = v_template_[row];
+      for (int s = 0; s < num_betas_; ++s) sum += sd[s] * state.betas[s];
+      for (int k = 0; k < kFeatures; ++k) sum += pd[k] * state.pose_feature[k];
+      p[c] = sum;
+    } else {
+      double value = v_template_[row];
+      for (int s = 0; s < num_betas_; ++s) value += sd[s] * state.betas_value[s];
+      double grad[kNumPoseParams] = {};
+      for (int k = 0; k < kFeatures; ++k) {
+        value += pd[k] * state.feature_value[k];
+        double* g = grad + 3 * (k / 9);
+        g[0] += pd[k] * state.feature_jac[k][0];
+        g[1] += pd[k] * state.feature_jac[k][1];
+        g[2] += pd[k] * state.feature_jac[k][2];
+      }
+      T sum = T(value);
+      for (int s = 0; s < num_betas_; ++s) AddScaled(sd[s], state.betas_delta[s], &sum);
+      for (int i = 0; i < kNumPoseParams; ++i) {
+        AddScaled(grad[i], state.pose_delta[i], &sum);
+      }
+      p[c] = sum;
+    }
   }
   // Blend the 3x4 skinning transforms, then apply once.
   T m[12];
@@ -291,15 +359,14 @@ void HandEvaluator::SkinVertex(const HandPoseState<T>& state, int v, T* out) con
     const double w = weight_value_[e];
     const T* g = state.world + 12 * j;
     for (int r = 0; r < 3; ++r) {
-      m[4 * r] += w * g[4 * r];
-      m[4 * r + 1] += w * g[4 * r + 1];
-      m[4 * r + 2] += w * g[4 * r + 2];
-      m[4 * r + 3] += w * state.skin_t[3 * j + r];
+      AddScaled(w, g[4 * r], &m[4 * r]);
+      AddScaled(w, g[4 * r + 1], &m[4 * r + 1]);
+      AddScaled(w, g[4 * r + 2], &m[4 * r + 2]);
+      AddScaled(w, state.skin_t[3 * j + r], &m[4 * r + 3]);
     }
   }
   for (int r = 0; r < 3; ++r) {
-    out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3] +
-             state.transl[r];
+    out[r] = Dot3(m + 4 * r, 1, p, 1, m[4 * r + 3] + state.transl[r]);
   }
 }
 
