@@ -144,6 +144,18 @@ void BM_KeypointsPca12Jet(benchmark::State& state) {
   }
 }
 
+// Analytic keypoint Jacobian (doubles), 63 x 61.
+void BM_KeypointsAnalyticJacobian(benchmark::State& state) {
+  const HandEvaluator evaluator(RandomManoSizedModel(static_cast<int>(state.range(0))));
+  const std::vector<double> x = RandomParams(kNumParams);
+  std::vector<double> keypoints(63), jacobian(63 * kNumParams);
+  for (auto _ : state) {
+    evaluator.KeypointsAndJacobian(x.data(), x.data() + 3, x.data() + 48, x.data() + 58,
+                                   keypoints.data(), jacobian.data());
+    benchmark::DoNotOptimize(jacobian.data());
+  }
+}
+
 using Dual61 = Dual<kNumParams>;
 using Jet61 = ceres::Jet<double, kNumParams>;
 
@@ -155,6 +167,7 @@ BENCHMARK_TEMPLATE(BM_AllVertices, double)
 BENCHMARK_TEMPLATE(BM_Keypoints, double)->Arg(4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_Keypoints, Dual61)->Arg(4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_Keypoints, Jet61)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_KeypointsAnalyticJacobian)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_KeypointsPca12Jet)->Arg(4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_AllVertices, Dual61)->Arg(4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_AllVertices, Jet61)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);

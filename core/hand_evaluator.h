@@ -120,6 +120,18 @@ class HandEvaluator {
   template <typename T>
   void AllVerticesFromState(const HandPoseState<T>& state, T* out) const;
 
+  // Parameters of the Jacobian below: 3 + pose_dim() + num_betas() + 3.
+  int num_params() const { return 3 + pose_dim() + num_betas_ + 3; }
+
+  // 21 keypoints (SNAP order) and their analytic Jacobian, doubles only: `jacobian`
+  // is row-major 63 x num_params(), columns (global_orient, hand_pose, betas, transl).
+  // Several times cheaper than dual numbers because it uses the kinematic structure
+  // (a joint's rotation moves only its subtree); for analytic Ceres cost functions.
+  // betas / transl may be nullptr (zeros; their columns are still filled).
+  void KeypointsAndJacobian(const double* global_orient, const double* hand_pose,
+                            const double* betas, const double* transl,
+                            double* keypoints63, double* jacobian) const;
+
   // One-call conveniences.
   template <typename T>
   void Keypoints(const T* global_orient, const T* hand_pose, const T* betas,

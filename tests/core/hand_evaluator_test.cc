@@ -179,3 +179,49 @@ TEST(HandEvaluator, DualJacobianMatchesCentralDifferences) {
 
 }  // namespace
 }  // namespace handlabel
+
+namespace handlabel {
+namespace {
+
+// Analytic keypoint Jacobian against Dual forward mode, axis-angle and PCA modes.
+TEST(HandEvaluator, AnalyticKeypointJacobianMatchesDuals) {
+  const nlohmann::json fixture = testing::LoadLbsFixtureJson();
+  const HandModel model = testing::LbsFixtureModel(fixture);
+  for (int pca : {0, 7}) {
+    HandEvaluatorOptions options;
+    options.num_pca_comps = pca;
+    const HandEvaluator ev(model, options);
+    const int np = ev.num_params();
+    ASSERT_EQ(np, 3 + (pca ? pca : 45) + 10 + 3);
+    for (int case_index : {0, 3, 4}) {
+      const nlohmann::json& c = fixture["cases"][case_index];
+      Eigen::VectorXd pca_coeffs(pca);
+      for (int i = 0; i < pca; ++i) pca_coeffs[i] = testing::Uniform(-0.5, 0.5);
+      Eigen::VectorXd x(np);
+      x << JsonVector(c["global_orient"]), pca ? pca_coeffs : JsonVector(c["hand_pose"]),
+          JsonVector(c["betas"]), JsonVector(c["transl"]);
+      using D = Dual<kNumParams>;
+      std::vector<D> xd(np);
+      for (int k = 0; k < np; ++k) xd[k] = D(x[k], k);
+      std::vector<D> expected(63);
+      const int pd = ev.pose_dim();
+      ev.Keypoints(xd.data(), xd.data() + 3, xd.data() + 3 + pd, xd.data() + 3 + pd + 10,
+                   expected.data());
+      Eigen::Matrix<double, 63, Eigen::Dynamic, Eigen::RowMajor> jac(63, np);
+      Eigen::Matrix<double, 63, 1> keypoints;
+      ev.KeypointsAndJacobian(x.data(), x.data() + 3, x.data() + 3 + pd,
+                              x.data() + 3 + pd + 10, keypoints.data(), jac.data());
+      Eigen::MatrixXd expected_jac(63, np);
+      Eigen::VectorXd expected_kp(63);
+      for (int i = 0; i < 63; ++i) {
+        expected_kp[i] = expected[i].a;
+        expected_jac.row(i) = expected[i].v.head(np).transpose();
+      }
+      EXPECT_THAT(keypoints, MatrixNear(expected_kp, 1e-12)) << "pca " << pca;
+      EXPECT_THAT(jac, MatrixNear(expected_jac, 1e-10)) << "pca " << pca;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace handlabel
