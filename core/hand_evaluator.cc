@@ -150,7 +150,7 @@ void HandEvaluator::KeypointsAndJacobian(const double* global_orient,
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     const int native = kSnapFromNative[k];
     auto rows = jac.middleRows<3>(3 * k);
-    Eigen::Matrix<double, 3, 3> d_orient;
+    Eigen::Matrix3d d_orient = Eigen::Matrix3d::Zero();
     d_pose.setZero();
     Vec3 point;
     if (native < kNumHandJoints) {

@@ -18,10 +18,13 @@
 // Typical use (fitting): a cost functor holds `const HandEvaluator&` and calls
 //   evaluator.Keypoints(orient, pose, betas, transl, keypoints63);
 // For keypoints and a vertex subset in one pass, call Pose() once and then
-// KeypointsFromState() / VerticesFromState() on the same state.
+// KeypointsFromState() / VerticesFromState() on the same state. For analytic Ceres
+// cost functions, KeypointsAndJacobian() returns keypoints and their Jacobian in
+// doubles, several times faster than Jets. Usage and timings: docs/hand-model.md.
 //
-// Scalar requirements: T(double), + - * / with T and double, comparison with T, and
-// sqrt/sin/cos found by ADL or in std (true for double, Dual<N>, ceres::Jet).
+// Scalar requirements: double, or a first-order dual type with public members `a`
+// (value) and `v` (Eigen derivative vector) supporting T(double), + - * / with T and
+// double, comparison, and sqrt/sin/cos by ADL (Dual<N>, ceres::Jet<double, N>).
 
 #include <Eigen/Core>
 #include <cmath>
@@ -29,11 +32,11 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/dual.h"
-#include "core/scalar_ops.h"
-
 #include "core/axis_angle.h"
+#include "core/dual.h"
+#include "core/errors.h"
 #include "core/hand_model.h"
+#include "core/scalar_ops.h"
 
 namespace handlabel {
 
@@ -323,7 +326,12 @@ void HandEvaluator::KeypointsFromState(const HandPoseState<T>& state,
 template <typename T>
 void HandEvaluator::VerticesFromState(const HandPoseState<T>& state,
                                       const std::vector<int>& ids, T* out) const {
-  for (size_t i = 0; i < ids.size(); ++i) SkinVertex(state, ids[i], out + 3 * i);
+  for (size_t i = 0; i < ids.size(); ++i) {
+    HL_CHECK(
+        ids[i] >= 0 && ids[i] < num_vertices_,
+        "vertex id " + std::to_string(ids[i]) + " of " + std::to_string(num_vertices_));
+    SkinVertex(state, ids[i], out + 3 * i);
+  }
 }
 
 template <typename T>
