@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/dual.h"
+#include "core/hand_anatomy.h"
 #include "core/hand_evaluator.h"
 #include "core/hand_lbs.h"
 
@@ -156,6 +157,22 @@ void BM_KeypointsAnalyticJacobian(benchmark::State& state) {
   }
 }
 
+// Anatomical angles + limit residuals of all 15 joints with Jets (fitting's prior).
+void BM_AnatomyResidualsJet(benchmark::State& state) {
+  // Identity frames: the cost does not depend on the frames' values.
+  std::vector<double> x = RandomParams(kNumParams);
+  HandAnatomy anatomy;
+  for (auto& f : anatomy.frames) f.setIdentity();
+  const HandLimits limits = DefaultHandLimits();
+  const std::vector<ceres::Jet<double, kNumParams>> xj = SeedJet<kNumParams>(x);
+  std::vector<ceres::Jet<double, kNumParams>> angles(45), residuals(45);
+  for (auto _ : state) {
+    HandAnatomicalAngles(anatomy, xj.data() + 3, angles.data());
+    LimitResiduals(limits, angles.data(), residuals.data());
+    benchmark::DoNotOptimize(residuals.data());
+  }
+}
+
 using Dual61 = Dual<kNumParams>;
 using Jet61 = ceres::Jet<double, kNumParams>;
 
@@ -168,6 +185,7 @@ BENCHMARK_TEMPLATE(BM_Keypoints, double)->Arg(4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_Keypoints, Dual61)->Arg(4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_Keypoints, Jet61)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_KeypointsAnalyticJacobian)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_AnatomyResidualsJet)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_KeypointsPca12Jet)->Arg(4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_AllVertices, Dual61)->Arg(4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_AllVertices, Jet61)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);

@@ -30,9 +30,12 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "core/axis_angle.h"
+#include "core/dual.h"
 #include "core/hand_model.h"
+#include "core/scalar_ops.h"
 
 namespace handlabel {
 
@@ -68,9 +71,10 @@ struct HandAnatomy {
 HandAnatomy ComputeHandAnatomy(const HandModel& model);
 
 // (twist, spread, bend) in radians of non-root joint `joint` from its axis-angle.
+// Plain scalar evaluation; AnatomicalAngles below is the one to call.
 template <typename T>
-void AnatomicalAngles(const HandAnatomy& anatomy, int joint, const T* axis_angle,
-                      T* angles) {
+void AnatomicalAnglesDirect(const HandAnatomy& anatomy, int joint, const T* axis_angle,
+                            T* angles) {
   using std::atan2;
   using std::sqrt;
   T r[9];
@@ -94,6 +98,29 @@ void AnatomicalAngles(const HandAnatomy& anatomy, int joint, const T* axis_angle
   angles[kTwist] = twist * anatomy.angle_signs[kTwist];
   angles[kSpread] = spread * anatomy.angle_signs[kSpread];
   angles[kBend] = bend * anatomy.angle_signs[kBend];
+}
+
+// (twist, spread, bend) in radians of non-root joint `joint` from its axis-angle, for
+// double, Dual<N> or ceres::Jet. For dual types the 3 angles depend on 3 inputs only,
+// so they are evaluated with Dual<3> and chained into T (exact for first-order duals,
+// about 10x cheaper than evaluating with 61-wide Jets).
+template <typename T>
+void AnatomicalAngles(const HandAnatomy& anatomy, int joint, const T* axis_angle,
+                      T* angles) {
+  if constexpr (std::is_same_v<T, double>) {
+    AnatomicalAnglesDirect(anatomy, joint, axis_angle, angles);
+  } else {
+    Dual<3> w[3], a[3];
+    for (int i = 0; i < 3; ++i) w[i] = Dual<3>(ScalarPart(axis_angle[i]), i);
+    AnatomicalAnglesDirect(anatomy, joint, w, a);
+    for (int k = 0; k < 3; ++k) {
+      T out = T(a[k].a);
+      for (int i = 0; i < 3; ++i) {
+        AddScaled(a[k].v[i], axis_angle[i] - ScalarPart(axis_angle[i]), &out);
+      }
+      angles[k] = out;
+    }
+  }
 }
 
 // Angles of all 15 non-root joints: angles45[3 * (j - 1) + axis].

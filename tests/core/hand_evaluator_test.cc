@@ -225,3 +225,43 @@ TEST(HandEvaluator, AnalyticKeypointJacobianMatchesDuals) {
 
 }  // namespace
 }  // namespace handlabel
+
+namespace handlabel {
+namespace {
+
+TEST(HandEvaluator, FewerBetasThanTheModelUseTheLeadingOnes) {
+  const nlohmann::json fixture = testing::LoadLbsFixtureJson();
+  const HandModel model = testing::LbsFixtureModel(fixture);
+  HandEvaluatorOptions options;
+  options.num_betas = 4;
+  const HandEvaluator ev(model, options);
+  ASSERT_EQ(ev.num_betas(), 4);
+  HandParams p = JsonHandParams(fixture["cases"][3]);
+  p.betas = p.betas.head(4).eval();
+  const HandMesh mesh = PoseHand(model, p);
+  RowPoints vertices(model.num_vertices(), 3);
+  ev.AllVertices(p.global_orient.data(), p.hand_pose.data(), p.betas.data(),
+                 p.transl.data(), vertices.data());
+  EXPECT_THAT(vertices, MatrixNear(mesh.vertices, 1e-12));
+  // Dual path too (it evaluates the blend shapes differently).
+  std::vector<Dual<4>> betas(4);
+  for (int s = 0; s < 4; ++s) betas[s] = Dual<4>(p.betas[s], s);
+  std::vector<Dual<4>> orient(p.global_orient.data(), p.global_orient.data() + 3);
+  std::vector<Dual<4>> pose(p.hand_pose.data(), p.hand_pose.data() + 45);
+  std::vector<Dual<4>> keypoints(63);
+  ev.Keypoints(orient.data(), pose.data(), betas.data(), static_cast<Dual<4>*>(nullptr),
+               keypoints.data());
+  const HandMesh no_transl = [&] {
+    HandParams q = p;
+    q.transl.setZero();
+    return PoseHand(model, q);
+  }();
+  for (int k = 0; k < 21; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(keypoints[3 * k + c].a, no_transl.keypoints(k, c), 1e-12);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace handlabel
