@@ -49,6 +49,9 @@ struct HandEvaluatorOptions {
   int num_pca_comps = 0;
   // PCA mode only: do not add the model's pose_mean (MANO's flat_hand_mean).
   bool flat_hand_mean = false;
+  // Model-independent checks (the evaluator's constructor also checks against the
+  // model); throws InputError.
+  void Check() const;
 };
 
 // Most shape coefficients an evaluator reads (MANO has 10).

@@ -140,6 +140,13 @@ TEST(HandEvaluator, RejectsOptionsThatDoNotFitTheModel) {
   options = {};
   options.num_pca_comps = 46;
   EXPECT_THROW(HandEvaluator(model, options), InputError);
+  options = {};
+  options.num_betas = -2;
+  EXPECT_THROW(options.Check(), InputError);
+  options = {};
+  options.num_pca_comps = -1;
+  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_NO_THROW(HandEvaluatorOptions().Check());
 }
 
 // Dual derivatives of keypoints and all vertices w.r.t. all 61 parameters versus
