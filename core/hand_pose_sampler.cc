@@ -112,6 +112,7 @@ void HandPoseSamplerOptions::Check() const {
 SampledHandPose SampleHandPoseOfKind(const HandAnatomy& anatomy, const HandLimits& limits,
                                      HandPoseKind kind, double jitter_deg,
                                      std::mt19937_64& rng) {
+  limits.Check("hand pose sampler limits");
   const Archetype archetype = MakeArchetype(kind);
   std::normal_distribution<double> jitter(0.0, 1.0);
   SampledHandPose out;
