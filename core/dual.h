@@ -139,6 +139,13 @@ Dual<N> atan(const Dual<N>& x) {
   return r;
 }
 template <int N>
+Dual<N> atan2(const Dual<N>& y, const Dual<N>& x) {
+  Dual<N> r;
+  r.a = std::atan2(y.a, x.a);
+  r.v = (y.v * x.a - x.v * y.a) / (x.a * x.a + y.a * y.a);
+  return r;
+}
+template <int N>
 Dual<N> sin(const Dual<N>& x) {
   Dual<N> r;
   r.a = std::sin(x.a);

@@ -42,3 +42,5 @@ HandMesh PoseHand(const HandModel& model, const HandParams& params);
 Eigen::Matrix<double, kNumPoseParams, 1> HandPoseFromPca(const HandModel& model,
                                                          const Eigen::VectorXd& coeffs,
                                                          bool flat_hand_mean);
+
+}  // namespace handlabel
