@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <functional>
 #include <iostream>
 
@@ -33,6 +36,17 @@ class SeedPerTest : public ::testing::EmptyTestEventListener {
 
 std::mt19937_64& TestRng() { return g_rng; }
 uint64_t TestSeed() { return g_seed; }
+
+std::string ScratchDir() {
+  const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("handlabel_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
+       std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
 
 }  // namespace handlabel::testing
 

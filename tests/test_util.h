@@ -18,6 +18,11 @@ namespace handlabel::testing {
 std::mt19937_64& TestRng();
 uint64_t TestSeed();
 
+// A fresh, empty folder for the running test, unique per test name and process, so
+// tests that ctest runs in parallel never share files. Removed again at the next call
+// for the same test; left behind after a failure for inspection.
+std::string ScratchDir();
+
 inline double Uniform(double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(TestRng());
 }

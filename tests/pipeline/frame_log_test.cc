@@ -7,21 +7,14 @@
 
 #include "core/errors.h"
 #include "pipeline/atomic_file.h"
+#include "tests/test_util.h"
 
 namespace handlabel {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string TempDir() {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("handlabel_" + std::string(::testing::UnitTest::GetInstance()
-                                                       ->current_test_info()
-                                                       ->name()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir.string();
-}
+std::string TempDir() { return testing::ScratchDir(); }
 
 std::string ReadAll(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/errors.h"
+#include "tests/test_util.h"
 
 namespace handlabel {
 namespace {
@@ -15,9 +16,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 std::string WriteJob(const std::string& yaml) {
-  const fs::path dir = fs::temp_directory_path() / "handlabel_job_config_test";
-  fs::create_directories(dir);
-  const fs::path path = dir / "job.yaml";
+  const fs::path path = fs::path(testing::ScratchDir()) / "job.yaml";
   std::ofstream(path) << yaml;
   return path.string();
 }
