@@ -605,13 +605,25 @@ class Reader {
     const std::vector<int64_t> shape = IntsOf(s[0], "ndarray shape");
     const bool fortran = IntOf(s[2], "ndarray fortran flag") != 0;
     const Node& d = N(s[1]);
+    const NodeKind raw_kind = N(s[3]).kind;
+    if (!d.text.empty() && d.text[0] == 'O' &&
+        (raw_kind == NodeKind::kList || raw_kind == NodeKind::kTuple)) {
+      // Object array (np.save of a sparse matrix, ...): its elements are pickled
+      // objects, kept as a list; a 0-d one converts to its single element.
+      const std::vector<int> items = N(s[3]).items;
+      N(id).kind = NodeKind::kList;
+      N(id).global_name = "numpy object array";
+      N(id).integer = static_cast<int64_t>(shape.size());
+      N(id).items = items;
+      for (int item : items) Nest(id, item);
+      return;
+    }
     if (!d.dtype_supported) {
       N(id).kind = NodeKind::kUnsupported;
       N(id).global_name = "numpy.ndarray";
       N(id).text = "dtype '" + d.text + "'";
       return;
     }
-    const NodeKind raw_kind = N(s[3]).kind;
     if (raw_kind != NodeKind::kBytes && raw_kind != NodeKind::kPy2Str &&
         raw_kind != NodeKind::kText) {
       Fail("the array's raw bytes", KindName(s[3]));
@@ -1429,6 +1441,10 @@ class Reader {
       case NodeKind::kList:
       case NodeKind::kTuple:
       case NodeKind::kSet: {
+        if (n.global_name == "numpy object array" && n.integer == 0 &&
+            n.items.size() == 1) {
+          return Convert(n.items[0], depth + 1);
+        }
         v.kind = K::kList;
         v.type_name = n.kind == NodeKind::kList    ? "list"
                       : n.kind == NodeKind::kTuple ? "tuple"
