@@ -25,6 +25,7 @@ void PrintUsage(std::ostream& out) {
 const std::vector<Command>& AllCommands() {
   static const std::vector<Command> commands = {
       {"version", "print version, git hash and dependency versions", RunVersion},
+      {"model", "inspect and convert hand model files (MANO, smplx npz, own)", RunModel},
   };
   return commands;
 }
