@@ -25,6 +25,8 @@ void PrintUsage(std::ostream& out) {
 const std::vector<Command>& AllCommands() {
   static const std::vector<Command> commands = {
       {"version", "print version, git hash and dependency versions", RunVersion},
+      {"label", "label a capture as a job (YAML), resumable, shardable", RunLabel},
+      {"merge", "join the shards of a labeling job (manifest + summary)", RunMerge},
   };
   return commands;
 }
