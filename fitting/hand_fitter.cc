@@ -409,7 +409,7 @@ class FitRun {
     const HandMesh mesh = PoseHand(model_, result.params);
     result.vertices = mesh.vertices;
     result.keypoints = mesh.keypoints;
-    for (const ViewKeypoints& view : input.views) {
+    for (const KeypointView& view : input.views) {
       double sum = 0.0;
       int n = 0;
       for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -496,7 +496,7 @@ HandParams HandFitter::InitFromKeypoints3d(const Points3d& keypoints,
       .InitFromKeypoints3d(keypoints, weights, fallback);
 }
 
-HandParams HandFitter::InitFromViews(const std::vector<ViewKeypoints>& views) const {
+HandParams HandFitter::InitFromViews(const std::vector<KeypointView>& views) const {
   Rig rig;
   for (size_t v = 0; v < views.size(); ++v) {
     RigCamera camera = views[v].camera;

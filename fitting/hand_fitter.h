@@ -27,7 +27,7 @@
 #include "core/hand_model.h"
 #include "fitting/points3d_cost.h"
 #include "fitting/robust_loss.h"
-#include "fitting/view_keypoints.h"
+#include "fitting/keypoint_view.h"
 
 namespace handlabel {
 
@@ -91,7 +91,7 @@ struct HandFitOptions {
 };
 
 struct FitInput {
-  std::vector<ViewKeypoints> views;  // 2D keypoints per view (may be empty)
+  std::vector<KeypointView> views;  // 2D keypoints per view (may be empty)
   // Per view: silhouette mask (rows = image height), or empty = none for that view.
   // Empty vector = no silhouettes. Cameras come from `views`.
   std::vector<MaskImage> masks;
@@ -134,7 +134,7 @@ class HandFitter {
                                  const Eigen::VectorXd& weights) const;
   // The baseline's start: each keypoint triangulated robustly over the views
   // (core/triangulation.h), then InitFromKeypoints3d.
-  HandParams InitFromViews(const std::vector<ViewKeypoints>& views) const;
+  HandParams InitFromViews(const std::vector<KeypointView>& views) const;
 
   // Staged solve from `init`.
   FitResult Fit(const FitInput& input, const HandParams& init) const;

@@ -25,7 +25,7 @@
 #include "core/camera_models.h"
 #include "core/hand_evaluator.h"
 #include "fitting/robust_loss.h"
-#include "fitting/view_keypoints.h"
+#include "fitting/keypoint_view.h"
 
 namespace handlabel {
 
@@ -41,7 +41,7 @@ struct KeypointViewData {
 };
 
 inline std::vector<KeypointViewData> MakeKeypointViewData(
-    const std::vector<ViewKeypoints>& views, double sigma_px) {
+    const std::vector<KeypointView>& views, double sigma_px) {
   std::vector<KeypointViewData> out(views.size());
   for (size_t v = 0; v < views.size(); ++v) {
     const Camera& cam = views[v].camera.camera;
@@ -62,7 +62,7 @@ class MultiViewKeypointCost {
  public:
   // `evaluator` must outlive the functor; `views` are copied.
   MultiViewKeypointCost(const HandEvaluator& evaluator,
-                        const std::vector<ViewKeypoints>& views, const RobustLoss& loss,
+                        const std::vector<KeypointView>& views, const RobustLoss& loss,
                         double sigma_px)
       : evaluator_(evaluator),
         views_(MakeKeypointViewData(views, sigma_px)),
@@ -109,7 +109,7 @@ class MultiViewKeypointCost {
   }
 
   static ceres::CostFunction* Create(const HandEvaluator& evaluator,
-                                     const std::vector<ViewKeypoints>& views,
+                                     const std::vector<KeypointView>& views,
                                      const RobustLoss& loss, double sigma_px) {
     auto* functor = new MultiViewKeypointCost(evaluator, views, loss, sigma_px);
     return new ceres::AutoDiffCostFunction<MultiViewKeypointCost, ceres::DYNAMIC, 3,
@@ -127,7 +127,7 @@ class MultiViewKeypointCost {
 class MultiViewKeypointCostFunction : public ceres::CostFunction {
  public:
   MultiViewKeypointCostFunction(const HandEvaluator& evaluator,
-                                const std::vector<ViewKeypoints>& views,
+                                const std::vector<KeypointView>& views,
                                 const RobustLoss& loss, double sigma_px)
       : evaluator_(evaluator),
         views_(MakeKeypointViewData(views, sigma_px)),
@@ -137,7 +137,7 @@ class MultiViewKeypointCostFunction : public ceres::CostFunction {
         {3, evaluator.pose_dim(), evaluator.num_betas(), 3});
   }
   static ceres::CostFunction* Create(const HandEvaluator& evaluator,
-                                     const std::vector<ViewKeypoints>& views,
+                                     const std::vector<KeypointView>& views,
                                      const RobustLoss& loss, double sigma_px) {
     return new MultiViewKeypointCostFunction(evaluator, views, loss, sigma_px);
   }

@@ -112,7 +112,7 @@ TEST_F(CostGradientsTest, KeypointReprojectionAutodiff) {
 }
 
 TEST_F(CostGradientsTest, KeypointReprojectionAnalyticMatchesAutodiff) {
-  std::vector<ViewKeypoints> views = frame_.views;
+  std::vector<KeypointView> views = frame_.views;
   views[1].confidence[3] = 0.0;  // a missing detection
   views[2].confidence[4] = 0.3;
   for (RobustLossType type :

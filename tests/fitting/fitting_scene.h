@@ -14,7 +14,7 @@
 #include "core/hand_lbs.h"
 #include "core/hand_pose_sampler.h"
 #include "core/rig.h"
-#include "fitting/view_keypoints.h"
+#include "fitting/keypoint_view.h"
 
 namespace handlabel::testing {
 
@@ -42,7 +42,7 @@ inline std::vector<RigCamera> DexYcbLikeRig() {
 struct SceneFrame {
   HandParams params;
   HandMesh mesh;
-  std::vector<ViewKeypoints> views;  // exact projections, confidence 1
+  std::vector<KeypointView> views;  // exact projections, confidence 1
 };
 
 inline SceneFrame RandomSceneFrame(const HandModel& model, std::mt19937_64& rng,
@@ -64,7 +64,7 @@ inline SceneFrame RandomSceneFrame(const HandModel& model, std::mt19937_64& rng,
   f.params.transl = -centre + 0.04 * Eigen::Vector3d(g(rng), g(rng), g(rng));
   f.mesh = PoseHand(model, f.params);
   for (const RigCamera& cam : DexYcbLikeRig()) {
-    ViewKeypoints view;
+    KeypointView view;
     view.camera = cam;
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       Eigen::Vector2d uv;
@@ -79,12 +79,12 @@ inline SceneFrame RandomSceneFrame(const HandModel& model, std::mt19937_64& rng,
 
 // sigma_px Gaussian noise on every keypoint, a fraction of keypoints replaced by
 // uniform outliers in the image, and the listed views occluded (confidence 0).
-inline void CorruptViews(std::vector<ViewKeypoints>* views, double sigma_px,
+inline void CorruptViews(std::vector<KeypointView>* views, double sigma_px,
                          double outlier_fraction, const std::vector<int>& occluded,
                          std::mt19937_64& rng) {
   std::normal_distribution<double> g(0.0, sigma_px);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (ViewKeypoints& view : *views) {
+  for (KeypointView& view : *views) {
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       if (u(rng) < outlier_fraction) {
         view.uv_px(k, 0) = 640.0 * u(rng);
