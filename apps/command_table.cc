@@ -26,6 +26,8 @@ const std::vector<Command>& AllCommands() {
   static const std::vector<Command> commands = {
       {"version", "print version, git hash and dependency versions", RunVersion},
       {"model", "inspect and convert hand model files (MANO, smplx npz, own)", RunModel},
+      {"label", "label a capture as a job (YAML), resumable, shardable", RunLabel},
+      {"merge", "join the shards of a labeling job (manifest + summary)", RunMerge},
   };
   return commands;
 }
