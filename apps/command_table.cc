@@ -25,6 +25,8 @@ void PrintUsage(std::ostream& out) {
 const std::vector<Command>& AllCommands() {
   static const std::vector<Command> commands = {
       {"version", "print version, git hash and dependency versions", RunVersion},
+      {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",
+       RunCameras},
   };
   return commands;
 }
