@@ -23,5 +23,6 @@ int RunVersion(int argc, char** argv);
 int RunModel(int argc, char** argv);
 int RunLabel(int argc, char** argv);
 int RunMerge(int argc, char** argv);
+int RunCameras(int argc, char** argv);
 
 }  // namespace handlabel
