@@ -25,6 +25,7 @@ void PrintUsage(std::ostream& out) {
 const std::vector<Command>& AllCommands() {
   static const std::vector<Command> commands = {
       {"version", "print version, git hash and dependency versions", RunVersion},
+      {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
   };
   return commands;
 }

@@ -20,5 +20,6 @@ const std::vector<Command>& AllCommands();
 int RunHandlabel(int argc, char** argv);
 
 int RunVersion(int argc, char** argv);
+int RunSynth(int argc, char** argv);
 
 }  // namespace handlabel
