@@ -24,5 +24,6 @@ int RunModel(int argc, char** argv);
 int RunLabel(int argc, char** argv);
 int RunMerge(int argc, char** argv);
 int RunCameras(int argc, char** argv);
+int RunSynth(int argc, char** argv);
 
 }  // namespace handlabel
