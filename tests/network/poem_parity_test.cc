@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "network/poem_checkpoint.h"
+#include "network/poem_import.h"
 #include "network/poem_model.h"
 #include "tests/network/tensor_bundle.h"
 #include "tests/test_util.h"
@@ -55,10 +56,11 @@ double MaxAbsDiff(const torch::Tensor& a, const torch::Tensor& b) {
   return (a.to(torch::kFloat64) - b.to(torch::kFloat64)).abs().max().item<double>();
 }
 
-void ExpectParity(const PoemConfig& config, int batch, int seed) {
+// Returns the oracle's folder (with its torch.save checkpoint) for further checks.
+std::string ExpectParity(const PoemConfig& config, int batch, int seed) {
   at::set_num_threads(1);  // as the oracle
   OracleRun run = RunOracle(config, batch, seed);
-  if (run.outputs.empty()) return;
+  if (run.outputs.empty()) return "";
   PoemModel model(config);
   const StateDictReport report =
       LoadPoemStateDict(model, run.weights, run.dir + "/weights", {"mano_layer."});
@@ -86,6 +88,16 @@ void ExpectParity(const PoemConfig& config, int batch, int seed) {
     EXPECT_LT(MaxAbsDiff(out.layer_coords[l], ref.at("layer_coords")[l]), 1e-4)
         << "decoder layer " << l;
   }
+
+  // The same weights read from the torch.save file (released-checkpoint format) with
+  // our own zip + restricted pickle readers give the same model.
+  StateDictReport imported;
+  PoemModel from_pth = ImportReleasedPoemCheckpoint(
+      run.dir + "/PtEmbedMultiviewStereo.pth.tar", config, &imported);
+  EXPECT_EQ(imported.ignored, (std::vector<std::string>{"mano_layer.th_faces"}));
+  from_pth->eval();
+  EXPECT_TRUE(torch::equal(from_pth->forward(b).layer_coords, out.layer_coords));
+  return run.dir;
 }
 
 TEST(PoemParity, TinyThreeViewsMatchesPythonOracle) {
