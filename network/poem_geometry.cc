@@ -103,7 +103,7 @@ torch::Tensor DenormalizePositions(const torch::Tensor& xyz,
 }
 
 torch::Tensor TransformPoints(const torch::Tensor& T, const torch::Tensor& points) {
-  const int64_t B = T.size(0), N = T.size(1), P = points.size(1);
+  const int64_t B = T.size(0), P = points.size(1);
   const torch::Tensor x = points.index({Slice(), Slice(), 0}).view({B, 1, P});
   const torch::Tensor y = points.index({Slice(), Slice(), 1}).view({B, 1, P});
   const torch::Tensor z = points.index({Slice(), Slice(), 2}).view({B, 1, P});
@@ -112,7 +112,6 @@ torch::Tensor TransformPoints(const torch::Tensor& T, const torch::Tensor& point
     out.push_back(Entry(T, r, 0) * x + Entry(T, r, 1) * y + Entry(T, r, 2) * z +
                   Entry(T, r, 3));
   }
-  (void)N;
   return torch::stack(out, -1);
 }
 

@@ -191,7 +191,6 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
       reg_branches);
   out->layer_coords =
       DenormalizePositions(torch::nan_to_num(coords_out), c.position_range);
-  (void)E;
 }
 
 PoemModelImpl::PoemModelImpl(const PoemConfig& config) : config_(config) {

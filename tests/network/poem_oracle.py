@@ -480,13 +480,20 @@ def main():
     ap.add_argument("--out", required=True)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--batch", type=int, default=2)
+    ap.add_argument("--shapes-only", action="store_true",
+                    help="write only {key: shape} of the state_dict to OUT/shapes.json")
     args = ap.parse_args()
     torch.set_num_threads(1)
     with open(args.config) as f:
         cfg = json.load(f)
     gen = torch.Generator().manual_seed(args.seed)
-    sd = random_state_dict(cfg, gen)
     os.makedirs(args.out, exist_ok=True)
+    if args.shapes_only:
+        sd = random_state_dict(cfg, gen)
+        with open(os.path.join(args.out, "shapes.json"), "w") as f:
+            json.dump({k: list(v.shape) for k, v in sd.items()}, f, indent=1)
+        return
+    sd = random_state_dict(cfg, gen)
     torch.save(sd, os.path.join(args.out, "PtEmbedMultiviewStereo.pth.tar"))
     write_bundle(os.path.join(args.out, "weights"), sd)
     images, K, M = make_inputs(cfg, args.batch, gen)

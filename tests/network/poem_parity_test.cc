@@ -112,5 +112,33 @@ TEST(PoemParity, TinyResNet34FourViewsMatchesPythonOracle) {
   ExpectParity(c, 1, 2);
 }
 
+// The full released architecture: the oracle's key set and shapes (written from the
+// specification) equal the C++ model's (ResNet34, 6 blocks; views do not change keys).
+TEST(PoemParity, ReleasedStateDictKeysAndShapesMatchOracle) {
+  const std::string dir = testing::ScratchDir();
+  std::ofstream(dir + "/config.json")
+      << ReleasedPoemConfig(PoemDataset::kDexYCB).ToJson();
+  const std::string cmd = "/usr/bin/python3 " + std::string(HANDLABEL_SOURCE_DIR) +
+                          "/tests/network/poem_oracle.py --shapes-only --config " + dir +
+                          "/config.json --out " + dir + " > " + dir + "/oracle.log 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0)
+      << "the Python oracle failed (needs /usr/bin/python3 with torch)";
+  std::ifstream f(dir + "/shapes.json");
+  const nlohmann::json shapes = nlohmann::json::parse(f);
+  PoemModel model(ReleasedPoemConfig(PoemDataset::kDexYCB));
+  const auto sd = PoemStateDict(model);
+  int64_t parameters = 0;
+  for (const auto& [key, shape] : shapes.items()) {
+    if (key.rfind("mano_layer.", 0) == 0) continue;
+    ASSERT_TRUE(sd.count(key)) << "C++ model lacks " << key;
+    EXPECT_EQ(sd.at(key).sizes().vec(), shape.get<std::vector<int64_t>>()) << key;
+  }
+  for (const auto& [key, tensor] : sd) {
+    EXPECT_TRUE(shapes.contains(key)) << "oracle lacks " << key;
+  }
+  for (const auto& p : model->parameters()) parameters += p.numel();
+  RecordProperty("released_parameters", std::to_string(parameters));
+}
+
 }  // namespace
 }  // namespace handlabel
