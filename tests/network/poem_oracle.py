@@ -423,6 +423,53 @@ def forward(cfg, sd, images, K, master_from_cam):
     return out
 
 
+# ----------------------------------------------------------------------------- losses
+def reference_losses(out, targets, regressor, K, master_from_cam, crop):
+    """The reference training losses with the released weights (10, 10, 1, 1, 1)."""
+    diag = math.sqrt(2.0 * crop * crop)
+    gt_j, gt_v, gt_uv = targets["joints_3d"], targets["vertices_3d"], targets["joints_2d"]
+    terms = collections.OrderedDict()
+    terms["heatmap_joints"] = (((out["joints_2d"] - gt_uv) / diag) ** 2).sum(-1).mean()
+    terms["triangulated_joints"] = F.mse_loss(out["triangulated_joints"], gt_j)
+    total = 10 * terms["heatmap_joints"] + 10 * terms["triangulated_joints"]
+    extr = torch.linalg.inv(master_from_cam)  # cam_from_master (B, N, 4, 4)
+    layers = out["layer_coords"]
+    for i in range(layers.shape[0]):
+        joints, verts = layers[i][:, :J], layers[i][:, J:]
+        j3d = F.mse_loss(joints, gt_j)
+        j_mesh = F.mse_loss(regressor @ verts, regressor @ gt_v)
+        v3d = F.l1_loss(verts, gt_v)
+        n = K.shape[1]
+        pts = joints.unsqueeze(1).repeat(1, n, 1, 1)
+        cam = (extr[..., :3, :3] @ pts.transpose(2, 3)).transpose(2, 3) + extr[..., :3, 3].unsqueeze(2)
+        uvw = (K @ cam.transpose(2, 3)).transpose(2, 3)
+        z = uvw[..., 2:].clone()
+        z[z.abs() < 1e-7] = 1e-7
+        uv = uvw[..., :2] / z
+        off = torch.clamp(uv - gt_uv, min=-0.5 * diag, max=0.5 * diag) / diag
+        j2d = (off ** 2).sum(-1).mean()
+        recon = j3d + j_mesh + v3d + j2d
+        terms["dec%d_recon" % i] = recon
+        total = total + recon
+        if i == layers.shape[0] - 1:
+            terms["joints_3d"], terms["joints_3d_from_mesh"] = j3d, j_mesh
+            terms["vertices_3d"], terms["joints_2d"] = v3d, j2d
+    terms["total"] = total
+    return terms
+
+
+def make_targets(out, gen):
+    B = out["triangulated_joints"].shape[0]
+    center = out["ball_center"].view(B, 1, 3)
+    targets = {
+        "joints_3d": center + 0.05 * torch.randn((B, J, 3), generator=gen),
+        "vertices_3d": center + 0.05 * torch.randn((B, V, 3), generator=gen),
+        "joints_2d": out["joints_2d"] + 5 * torch.randn(out["joints_2d"].shape, generator=gen),
+    }
+    regressor = torch.rand((J, V), generator=gen) * (torch.rand((J, V), generator=gen) < 0.01)
+    return targets, regressor
+
+
 # --------------------------------------------------------------------------- inputs
 def look_at(eye, target, up):
     z = target - eye
@@ -502,6 +549,10 @@ def main():
     write_bundle(os.path.join(args.out, "inputs"),
                  {"images": images, "intrinsics": K, "master_from_cam": M})
     write_bundle(os.path.join(args.out, "outputs"), out)
+    targets, regressor = make_targets(out, gen)
+    losses = reference_losses(out, targets, regressor, K, M, cfg["crop_size"])
+    write_bundle(os.path.join(args.out, "targets"), dict(targets, regressor=regressor))
+    write_bundle(os.path.join(args.out, "losses"), {k: v.reshape(1) for k, v in losses.items()})
 
 
 if __name__ == "__main__":

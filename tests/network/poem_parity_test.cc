@@ -12,6 +12,7 @@
 
 #include "network/poem_checkpoint.h"
 #include "network/poem_import.h"
+#include "network/poem_loss.h"
 #include "network/poem_model.h"
 #include "tests/network/tensor_bundle.h"
 #include "tests/test_util.h"
@@ -20,7 +21,7 @@ namespace handlabel {
 namespace {
 
 struct OracleRun {
-  std::map<std::string, torch::Tensor> weights, inputs, outputs;
+  std::map<std::string, torch::Tensor> weights, inputs, outputs, targets, losses;
   std::string dir;
 };
 
@@ -47,6 +48,8 @@ OracleRun RunOracle(const PoemConfig& config, int batch, int seed) {
   run.weights = testing::ReadTensorBundle(run.dir + "/weights");
   run.inputs = testing::ReadTensorBundle(run.dir + "/inputs");
   run.outputs = testing::ReadTensorBundle(run.dir + "/outputs");
+  run.targets = testing::ReadTensorBundle(run.dir + "/targets");
+  run.losses = testing::ReadTensorBundle(run.dir + "/losses");
   return run;
 }
 
@@ -88,6 +91,20 @@ std::string ExpectParity(const PoemConfig& config, int batch, int seed) {
     EXPECT_LT(MaxAbsDiff(out.layer_coords[l], ref.at("layer_coords")[l]), 1e-4)
         << "decoder layer " << l;
   }
+
+  // The training losses agree with the oracle's implementation of the reference's.
+  PoemTargets t;
+  t.joints_3d = run.targets.at("joints_3d");
+  t.vertices_3d = run.targets.at("vertices_3d");
+  t.joints_2d = run.targets.at("joints_2d");
+  const PoemLoss loss = ComputePoemLoss(out, b, t, run.targets.at("regressor"));
+  auto expect_term = [&](const std::string& name, const torch::Tensor& value) {
+    const double want = run.losses.at(name).item<double>();
+    EXPECT_NEAR(value.item<double>(), want, 1e-4 * std::max(1.0, std::abs(want))) << name;
+  };
+  expect_term("total", loss.total);
+  for (const auto& [name, value] : loss.terms) expect_term(name, value);
+  EXPECT_EQ(loss.terms.size() + 1, run.losses.size());
 
   // The same weights read from the torch.save file (released-checkpoint format) with
   // our own zip + restricted pickle readers give the same model.
