@@ -7,6 +7,7 @@
 
 #include "core/errors.h"
 #include "network/hand_mesh_predictor.h"
+#include "network/poem_batch.h"
 #include "network/poem_checkpoint.h"
 #include "network/poem_import.h"
 #include "network/poem_model.h"
@@ -82,31 +83,8 @@ class PoemPredictor : public HandMeshPredictor {
 
   void RunBatch(const std::vector<HandMeshInput>& frames, size_t begin, size_t end,
                 std::vector<HandMeshPrediction>* out) {
-    const PoemConfig& c = model_->config();
-    const int64_t B = end - begin, N = c.num_views, S = c.crop_size;
-    PoemBatch batch;
-    batch.images = torch::empty({B, N, 3, S, S});
-    batch.intrinsics = torch::empty({B, N, 3, 3});
-    batch.master_from_cam = torch::empty({B, N, 4, 4});
-    batch.view_weights = torch::empty({B, N});
-    float* img = batch.images.data_ptr<float>();
-    auto K = batch.intrinsics.accessor<float, 4>();
-    auto T = batch.master_from_cam.accessor<float, 4>();
-    auto W = batch.view_weights.accessor<float, 2>();
-    for (int64_t b = 0; b < B; ++b) {
-      for (int64_t n = 0; n < N; ++n) {
-        const HandMeshViewInput& v = frames[begin + b].views[n];
-        std::copy(v.pixels.begin(), v.pixels.end(), img + (b * N + n) * 3 * S * S);
-        const Matrix3x4d m = v.cam_from_master.Inverse().ToMatrix();
-        for (int i = 0; i < 3; ++i) {
-          for (int j = 0; j < 3; ++j)
-            K[b][n][i][j] = static_cast<float>(v.intrinsics(i, j));
-          for (int j = 0; j < 4; ++j) T[b][n][i][j] = static_cast<float>(m(i, j));
-        }
-        for (int j = 0; j < 4; ++j) T[b][n][3][j] = j == 3 ? 1.0f : 0.0f;
-        W[b][n] = static_cast<float>(v.weight);
-      }
-    }
+    const int64_t B = end - begin, N = model_->config().num_views;
+    const PoemBatch batch = MakePoemBatch(frames, begin, end, model_->config());
     const PoemOutputs o = model_->forward(batch);
     const torch::Tensor joints = o.joints().to(torch::kFloat64).contiguous();
     const torch::Tensor verts = o.vertices().to(torch::kFloat64).contiguous();

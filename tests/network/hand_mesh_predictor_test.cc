@@ -9,27 +9,6 @@
 namespace handlabel {
 namespace {
 
-std::vector<HandMeshInput> ToInputs(const PoemBatch& b) {
-  std::vector<HandMeshInput> frames(b.images.size(0));
-  const int64_t N = b.images.size(1);
-  for (size_t f = 0; f < frames.size(); ++f) {
-    for (int64_t n = 0; n < N; ++n) {
-      HandMeshViewInput v;
-      const torch::Tensor img = b.images[f][n].contiguous();
-      v.pixels.assign(img.data_ptr<float>(), img.data_ptr<float>() + img.numel());
-      Matrix3x4d m;
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j)
-          v.intrinsics(i, j) = b.intrinsics[f][n][i][j].item<float>();
-        for (int j = 0; j < 4; ++j) m(i, j) = b.master_from_cam[f][n][i][j].item<float>();
-      }
-      v.cam_from_master = Rigid3::FromMatrix(m).Inverse();
-      frames[f].views.push_back(v);
-    }
-  }
-  return frames;
-}
-
 TEST(HandMeshPredictor, PoemFromCheckpointMatchesTheModel) {
   const PoemConfig c = TinyPoemConfig(2);
   const std::string path = testing::ScratchDir() + "/tiny.pt";
@@ -43,7 +22,7 @@ TEST(HandMeshPredictor, PoemFromCheckpointMatchesTheModel) {
   EXPECT_EQ(predictor->num_views(), 2);
   EXPECT_EQ(predictor->crop_size(), 64);
   const PoemBatch batch = testing::MakeSyntheticBatch(c, 3, 4);
-  const auto predictions = predictor->Predict(ToInputs(batch));
+  const auto predictions = predictor->Predict(testing::ToInputs(batch));
   ASSERT_EQ(predictions.size(), 3u);
 
   PoemModel model = MakeRandomPoemModel(c, 21);
@@ -51,7 +30,7 @@ TEST(HandMeshPredictor, PoemFromCheckpointMatchesTheModel) {
   torch::NoGradGuard g;
   PoemBatch b = batch;
   // The predictor rebuilds master_from_cam from Rigid3 in double; feed the same.
-  const auto frames = ToInputs(batch);
+  const auto frames = testing::ToInputs(batch);
   for (int f = 0; f < 3; ++f)
     for (int n = 0; n < 2; ++n) {
       const Matrix3x4d m = frames[f].views[n].cam_from_master.Inverse().ToMatrix();
@@ -76,7 +55,7 @@ TEST(HandMeshPredictor, ValidatesFramesBeforeRunning) {
   o.num_views = 2;
   o.num_threads = 1;
   auto predictor = CreateHandMeshPredictor(o);
-  auto frames = ToInputs(testing::MakeSyntheticBatch(TinyPoemConfig(2), 1, 1));
+  auto frames = testing::ToInputs(testing::MakeSyntheticBatch(TinyPoemConfig(2), 1, 1));
   auto bad = frames;
   bad[0].views.pop_back();
   EXPECT_THROW(predictor->Predict(bad), InputError);

@@ -5,6 +5,7 @@
 #include <torch/torch.h>
 
 #include "core/rigid3.h"
+#include "network/hand_mesh_predictor.h"
 #include "network/poem_loss.h"
 #include "network/poem_model.h"
 #include "tests/test_util.h"
@@ -87,6 +88,28 @@ inline torch::Tensor MakeTestRegressor() {
   for (int j = 0; j < 21; ++j)
     for (int k = 0; k < 4; ++k) r[j][(j * 37 + k * 11) % 778] = 0.25;
   return r;
+}
+
+// The torch-free frame structs of a batch (view weights 1).
+inline std::vector<HandMeshInput> ToInputs(const PoemBatch& b) {
+  std::vector<HandMeshInput> frames(b.images.size(0));
+  const int64_t N = b.images.size(1);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    for (int64_t n = 0; n < N; ++n) {
+      HandMeshViewInput v;
+      const torch::Tensor img = b.images[f][n].contiguous();
+      v.pixels.assign(img.data_ptr<float>(), img.data_ptr<float>() + img.numel());
+      Matrix3x4d m;
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j)
+          v.intrinsics(i, j) = b.intrinsics[f][n][i][j].item<float>();
+        for (int j = 0; j < 4; ++j) m(i, j) = b.master_from_cam[f][n][i][j].item<float>();
+      }
+      v.cam_from_master = Rigid3::FromMatrix(m).Inverse();
+      frames[f].views.push_back(v);
+    }
+  }
+  return frames;
 }
 
 }  // namespace handlabel::testing

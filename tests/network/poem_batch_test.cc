@@ -1,0 +1,55 @@
+#include "network/poem_batch.h"
+
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "tests/network/poem_test_util.h"
+
+namespace handlabel {
+namespace {
+
+TEST(PoemBatch, FromFrameStructsReproducesTheTensors) {
+  const PoemConfig c = TinyPoemConfig(3);
+  const PoemBatch original = testing::MakeSyntheticBatch(c, 2, 7);
+  auto frames = testing::ToInputs(original);
+  frames[1].views[2].weight = 0;
+  const PoemBatch b = MakePoemBatch(frames, 0, 2, c);
+  EXPECT_TRUE(torch::equal(b.images, original.images));
+  EXPECT_TRUE(torch::equal(b.intrinsics, original.intrinsics));
+  EXPECT_TRUE(torch::allclose(b.master_from_cam, original.master_from_cam, 0, 1e-6));
+  EXPECT_EQ(b.view_weights[1][2].item<float>(), 0.0f);
+  EXPECT_EQ(b.view_weights[0][2].item<float>(), 1.0f);
+}
+
+TEST(PoemBatch, TargetsFromEigenAndTrainStepRuns) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const PoemBatch batch =
+      MakePoemBatch(testing::ToInputs(testing::MakeSyntheticBatch(c, 1, 3)), 0, 1, c);
+  HandMeshTargets g;
+  g.joints = Keypoints3::Constant(0.1);
+  g.joints.col(2).setConstant(0.6);
+  g.vertices =
+      Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>::Constant(778, 3, 0.6);
+  g.joints_2d = {Keypoints2::Constant(30), Keypoints2::Constant(20)};
+  g.view_weights = {1, 0};
+  const PoemTargets t = MakePoemTargets({g}, 0, 1, c);
+  EXPECT_FLOAT_EQ(t.joints_3d[0][4][2].item<float>(), 0.6f);
+  EXPECT_FLOAT_EQ(t.joints_2d[0][1][3][0].item<float>(), 20.0f);
+  EXPECT_FLOAT_EQ(t.joints_2d_weights[0][1][0].item<float>(), 0.0f);
+  PoemModel model = MakeRandomPoemModel(c, 2);
+  torch::optim::Adam adam(model->parameters(), torch::optim::AdamOptions(1e-4));
+  const TrainStepResult r =
+      TrainStep(model, adam, batch, t, testing::MakeTestRegressor());
+  EXPECT_TRUE(std::isfinite(r.total));
+
+  g.joints_2d.pop_back();
+  try {
+    MakePoemTargets({g}, 0, 1, c);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "joints_2d");
+  }
+}
+
+}  // namespace
+}  // namespace handlabel
