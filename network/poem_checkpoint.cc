@@ -90,6 +90,8 @@ StateDictReport LoadPoemStateDict(PoemModel& model,
     if (!value.sizes().equals(it->second.sizes())) {
       shape_errors.push_back(key + " " + ShapeString(value) + " vs model " +
                              ShapeString(it->second));
+    } else if (value.is_floating_point() && !torch::isfinite(value).all().item<bool>()) {
+      throw InputError(source, key, "finite values", "NaN or infinity");
     }
   }
   for (const auto& [key, value] : target) {

@@ -27,7 +27,7 @@ struct StateDictReport {
 // Copies `tensors` into the model (converted to float32, or int64 for
 // num_batches_tracked). Keys starting with one of `ignored_prefixes` are skipped and
 // reported. Throws InputError naming `source` if a key is missing or unexpected or a
-// shape differs, listing all of them.
+// shape differs, listing all of them, or if a tensor holds NaN or infinity.
 StateDictReport LoadPoemStateDict(PoemModel& model,
                                   const std::map<std::string, torch::Tensor>& tensors,
                                   const std::string& source,

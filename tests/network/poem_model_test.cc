@@ -155,6 +155,19 @@ TEST(PoemCheckpoint, StateDictMismatchListsKeysAndShapes) {
   }
 }
 
+TEST(PoemCheckpoint, RefusesNonFiniteWeightsNamingTheKey) {
+  PoemModel model = MakeRandomPoemModel(TinyPoemConfig(2), 11);
+  auto sd = PoemStateDict(model);
+  sd["uv_out.conv.bias"] = sd["uv_out.conv.bias"].clone();
+  sd["uv_out.conv.bias"][3] = NAN;
+  try {
+    LoadPoemStateDict(model, sd, "test.pth");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "uv_out.conv.bias");
+  }
+}
+
 TEST(PoemTrain, StepsReduceTheLossOnAFixedBatch) {
   const PoemConfig c = TinyPoemConfig(2);
   PoemModel model = MakeRandomPoemModel(c, 5);
