@@ -27,7 +27,7 @@ struct QualityThresholds {
 struct JobConfig {
   std::string source_file;  // the YAML file (for error messages)
   std::string name = "job";
-  uint64_t seed = 0;        // recorded in every label; drives any randomness
+  uint64_t seed = 0;  // recorded in every label; drives any randomness
 
   // input
   std::string input_format = "native";  // native | dexycb | ho3d | oakink
