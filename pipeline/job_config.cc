@@ -143,6 +143,11 @@ void JobConfig::Check() const {
     throw InputError(f, "refine.min_confidence", "a value in [0, 1]");
   }
   if (quality.min_views < 1) throw InputError(f, "refine.min_views", ">= 1");
+  if (!(quality.min_hand_span_m > 0 &&
+        quality.max_hand_span_m > quality.min_hand_span_m)) {
+    throw InputError(f, "refine.min_hand_span_m / max_hand_span_m",
+                     "0 < min_hand_span_m < max_hand_span_m");
+  }
   for (const std::string& m : meshes) {
     if (m != "ply" && m != "obj")
       throw InputError(f, "output.meshes", "ply and/or obj", "'" + m + "'");
@@ -196,6 +201,8 @@ JobConfig LoadJobConfig(const std::string& path) {
   refine.Read("max_view_disagreement_mm", &job.quality.max_view_disagreement_mm);
   refine.Read("min_confidence", &job.quality.min_confidence);
   refine.Read("min_views", &job.quality.min_views);
+  refine.Read("min_hand_span_m", &job.quality.min_hand_span_m);
+  refine.Read("max_hand_span_m", &job.quality.max_hand_span_m);
   refine.RejectUnknownKeys();
 
   Section evidence = top.Child("evidence");

@@ -22,6 +22,10 @@ struct QualityThresholds {
   double min_confidence = 0.3;
   // Fewest views with the hand visible for a frame to be labelled at all.
   int min_views = 2;
+  // Plausible hand span (largest distance between two of the 21 keypoints, metres);
+  // outside it the network's answer is rejected as out of range.
+  double min_hand_span_m = 0.05;
+  double max_hand_span_m = 0.35;
 };
 
 struct JobConfig {
