@@ -21,5 +21,8 @@ int RunHandlabel(int argc, char** argv);
 
 int RunVersion(int argc, char** argv);
 int RunModel(int argc, char** argv);
+// `model build` / `model render` (apps/model_build_command.cc).
+int RunModelBuild(int argc, char** argv);
+int RunModelRender(int argc, char** argv);
 
 }  // namespace handlabel
