@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/errors.h"
+#include "core/hand_model_io.h"
 #include "pipeline/build_config.h"
 #include "pipeline/capsule_hand.h"
 
@@ -22,10 +23,18 @@ ResolvedHandModel FromValue(const std::string& value, const std::string& origin,
     throw InputError(origin, "hand model", "an existing model file or \"capsule\"",
                      value);
   }
-  // Model files load through core/hand_model_io.h (branch "loaders"), merged later.
-  throw InputError(origin, "hand model",
-                   "\"capsule\" (loading model files arrives with core/hand_model_io)",
-                   value);
+  HandModelLoadOptions load;
+  load.side = side;  // for files that do not record their side
+  out.model = LoadHandModel(value, load);
+  if (out.model.side != side) {
+    const char* names[2] = {"right", "left"};
+    throw InputError(
+        origin, "hand model",
+        std::string("a ") + names[side == HandSide::kLeft] + " hand (as --side asks)",
+        value + " is a " + names[out.model.side == HandSide::kLeft] + " hand");
+  }
+  out.source = value;
+  return out;
 }
 
 }  // namespace
