@@ -23,7 +23,7 @@ std::string ReadBytes(const std::string& path) {
 // A coarse build, quick enough for a test.
 std::vector<std::string> CoarseBuild(const std::string& side, const std::string& out) {
   return {"model",       "build", "--side",          side, "--out",          out,
-          "--grid-step", "0.003", "--shape-samples", "40", "--pose-samples", "200"};
+          "--grid-step", "0.004", "--shape-samples", "40", "--pose-samples", "200"};
 }
 
 TEST(ModelBuildCommand, WritesALoadableModelAndTheSameBytesTwice) {
