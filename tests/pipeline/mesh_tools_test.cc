@@ -66,6 +66,39 @@ TEST(MeshDecimation, KeepsASphereClosedAndRound) {
   EXPECT_NEAR(SignedVolume(v, f), exact, 0.03 * exact);
 }
 
+// Mean over faces of each face's smallest angle (degrees).
+double MeanMinAngleDeg(const TriangleMesh& mesh) {
+  double sum = 0.0;
+  for (const Eigen::Vector3i& f : mesh.faces) {
+    double smallest = 180.0;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d u =
+          (mesh.vertices[f[(k + 1) % 3]] - mesh.vertices[f[k]]).normalized();
+      const Eigen::Vector3d w =
+          (mesh.vertices[f[(k + 2) % 3]] - mesh.vertices[f[k]]).normalized();
+      smallest = std::min(smallest, std::acos(u.dot(w)) * 180.0 / M_PI);
+    }
+    sum += smallest;
+  }
+  return sum / static_cast<double>(mesh.faces.size());
+}
+
+TEST(MeshDecimation, EdgeFlipsRaiseTheMinimumAnglesAndKeepTheMeshClosed) {
+  const TriangleMesh fine = Sphere(0.02, 0.0015);
+  DecimationOptions options;
+  options.target_vertices = 300;
+  const TriangleMesh plain = DecimateMesh(fine, options);
+  options.improve_by_flips = true;
+  const TriangleMesh flipped = DecimateMesh(fine, options);
+  EXPECT_EQ(flipped.vertices, plain.vertices);  // flips move no vertex
+  EXPECT_GT(MeanMinAngleDeg(flipped), MeanMinAngleDeg(plain) + 0.5);
+  Points3d v;
+  Faces f;
+  ToArrays(flipped, &v, &f);
+  EXPECT_TRUE(AnalyzeMeshTopology(static_cast<int>(v.rows()), f).IsClosedManifold());
+  EXPECT_EQ(CountSelfIntersections(v, f), 0);
+}
+
 TEST(MeshChecks, DetectsOpenFlippedAndIntersectingMeshes) {
   // A tetrahedron, outward.
   Points3d v(4, 3);
