@@ -401,6 +401,7 @@ class Reader {
     nodes_.back().kind = kind;
     return static_cast<int>(nodes_.size()) - 1;
   }
+  // References into nodes_ are invalidated by NewNode: never hold one across it.
   Node& N(int id) { return nodes_[id]; }
   void Push(int id) { stack_.push_back(id); }
   int Pop() {
@@ -441,7 +442,7 @@ class Reader {
     N(id).text = std::move(s);
     return id;
   }
-  int MakeSequence(NodeKind kind, const std::vector<int>& items) {
+  int MakeSequence(NodeKind kind, std::vector<int> items) {  // a copy (see N())
     const int id = NewNode(kind);
     for (int item : items) Nest(id, item);
     N(id).items = items;
@@ -469,7 +470,7 @@ class Reader {
     if (N(id).kind == NodeKind::kBool) return N(id).boolean;
     Fail(std::string(what) + " as an integer", KindName(id));
   }
-  const std::vector<int>& TupleOf(int id, const char* what) {
+  std::vector<int> TupleOf(int id, const char* what) {  // a copy (see N())
     const NodeKind k = N(id).kind;
     if (k == NodeKind::kTuple || k == NodeKind::kList) return N(id).items;
     Fail(std::string(what) + " as a tuple", KindName(id));
@@ -639,7 +640,8 @@ class Reader {
 
   // ---- REDUCE / NEWOBJ / BUILD ---------------------------------------------------
   int NewInstance(int cls_id) {
-    const Node& cls = N(cls_id);
+    // Copies, not references: NewNode may move every node.
+    const Node cls = N(cls_id);
     if (cls.kind != NodeKind::kGlobal || !IsInstanceClass(cls.global)) {
       Fail(
           "a class the reader can build (chumpy Ch/Select, scipy csc/csr_matrix, "
@@ -654,7 +656,7 @@ class Reader {
   }
 
   int Reduce(int callable, int args_id) {
-    const Node& f = N(callable);
+    const Node f = N(callable);  // a copy: NewNode below may move every node
     if (f.kind != NodeKind::kGlobal) Fail("a global to call", KindName(callable));
     const std::vector<int> args = TupleOf(args_id, "call arguments");
     switch (f.global) {
@@ -868,6 +870,13 @@ class Reader {
     return s[0] == '-' ? -static_cast<int64_t>(v) : static_cast<int64_t>(v);
   }
 
+  int HexDigit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    Fail("a hex digit", std::string("'") + c + "'");
+  }
+
   // Python repr of a str: '...' or "..." with backslash escapes.
   std::string UnquoteString(const std::string& s) {
     if (s.size() < 2 || (s[0] != '\'' && s[0] != '"') || s.back() != s[0]) {
@@ -902,7 +911,7 @@ class Reader {
           break;
         case 'x': {
           if (i + 2 >= s.size()) Fail("\\x and two hex digits", "end");
-          out.push_back(static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16)));
+          out.push_back(static_cast<char>(16 * HexDigit(s[i + 1]) + HexDigit(s[i + 2])));
           i += 2;
           break;
         }
@@ -937,7 +946,7 @@ class Reader {
         for (size_t k = 0; k < digits; ++k) {
           const char h = s[i + 2 + k];
           if (!std::isxdigit(static_cast<unsigned char>(h))) Fail("hex digits", "other");
-          cp = cp * 16 + static_cast<uint32_t>(std::stoi(std::string(1, h), nullptr, 16));
+          cp = cp * 16 + static_cast<uint32_t>(HexDigit(h));
         }
         if (cp > 0x10FFFF) Fail("a Unicode code point", "a larger number");
         AppendUtf8(cp, &out);
@@ -1187,7 +1196,8 @@ class Reader {
           if (N(name).kind != NodeKind::kText || N(module).kind != NodeKind::kText) {
             Fail("module and name strings", "other values");
           }
-          Push(MakeGlobal(N(module).text, N(name).text));
+          const std::string module_name = N(module).text, global_name = N(name).text;
+          Push(MakeGlobal(module_name, global_name));
           break;
         }
         case 'R': {
