@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""Writes the seed corpus of the pickle reader's fuzz target into corpus/pickle_reader/:
+"""Writes the seed corpus of the pickle reader's fuzz target into corpus/pickle_reader/
+and an object-array .npz for the npz target into corpus/npz_reader/ (whose other seeds
+are copies of tests/data/npy files):
 tiny pickles of every shape the reader understands (a MANO-structured Python 2 pickle
 with chumpy / scipy objects, numpy._core re-saves at protocols 4 and 5, a torch.save
 data.pkl, assorted values at protocols 0-5). Small inputs keep the fuzzer fast.
@@ -61,6 +63,11 @@ def main():
         save("small_p%d.pkl" % p, pickle.dumps(small, protocol=p))
     with zipfile.ZipFile(os.path.join(ROOT, "tests", "data", "npy", "state_dict.pt")) as z:
         save("torch_data.pkl", z.read("state_dict/data.pkl"))
+    import scipy.sparse
+    sys.modules.pop("scipy.sparse.csc")  # the real class, as np.savez users have it
+    np.savez(os.path.join(HERE, "corpus", "npz_reader", "object_array.npz"),
+             J=np.array(scipy.sparse._csc.csc_matrix(np.eye(2)), dtype=object),
+             v=np.arange(3.0))
 
 
 if __name__ == "__main__":

@@ -229,20 +229,21 @@ TEST(PickleReader, RandomByteFlipsNeverCrash) {
   }
 }
 
-// The fuzz target's seed corpus (fuzz/corpus/pickle_reader), each input whole and with
-// random mutations, as the fuzzer would start; runs without clang.
+// The fuzz target's corpus (fuzz/corpus/pickle_reader: named seeds plus inputs the
+// fuzzer kept), each input whole and with random edits; runs without clang.
 TEST(PickleReader, FuzzCorpusSmoke) {
   const std::string dir =
       std::string(HANDLABEL_SOURCE_DIR) + "/fuzz/corpus/pickle_reader";
   int inputs = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     const std::string bytes = ReadBytes(entry.path().string());
-    EXPECT_EQ(PickleError(bytes), "") << entry.path();
+    const std::string error = PickleError(bytes);
+    if (entry.path().extension() == ".pkl") EXPECT_EQ(error, "") << entry.path();
     ++inputs;
-    for (int trial = 0; trial < 200; ++trial) {
+    for (int trial = 0; trial < 20 && !bytes.empty(); ++trial) {
       std::string bad = bytes;
       const int edits = 1 + static_cast<int>(testing::Uniform(0, 4));
-      for (int k = 0; k < edits; ++k) {
+      for (int k = 0; k < edits && !bad.empty(); ++k) {
         const size_t at = static_cast<size_t>(testing::Uniform(0, bad.size() - 1));
         switch (static_cast<int>(testing::Uniform(0, 3))) {
           case 0:
