@@ -21,5 +21,9 @@ int RunHandlabel(int argc, char** argv);
 
 int RunVersion(int argc, char** argv);
 int RunModel(int argc, char** argv);
+int RunLabel(int argc, char** argv);
+int RunMerge(int argc, char** argv);
+int RunCameras(int argc, char** argv);
+int RunSynth(int argc, char** argv);
 
 }  // namespace handlabel
