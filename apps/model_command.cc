@@ -152,6 +152,9 @@ const std::vector<ModelSubcommand>& ModelSubcommands() {
       {"info", "print a model file's statistics", RunModelInfo},
       {"convert", "convert a MANO / smplx model file to the handlabel format",
        RunModelConvert},
+      {"build", "build the open hand model (ours, MANO-compatible)", RunModelBuild},
+      {"render", "render a preview sheet (PNG) of a model in several poses",
+       RunModelRender},
   };
   return table;
 }
