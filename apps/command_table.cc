@@ -27,6 +27,7 @@ const std::vector<Command>& AllCommands() {
       {"version", "print version, git hash and dependency versions", RunVersion},
       {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",
        RunCameras},
+      {"calib", "calibrate a camera rig from board images or with COLMAP", RunCalib},
   };
   return commands;
 }

@@ -21,5 +21,6 @@ int RunHandlabel(int argc, char** argv);
 
 int RunVersion(int argc, char** argv);
 int RunCameras(int argc, char** argv);
+int RunCalib(int argc, char** argv);
 
 }  // namespace handlabel
