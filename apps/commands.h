@@ -20,7 +20,11 @@ const std::vector<Command>& AllCommands();
 int RunHandlabel(int argc, char** argv);
 
 int RunVersion(int argc, char** argv);
+int RunModel(int argc, char** argv);
+int RunLabel(int argc, char** argv);
+int RunMerge(int argc, char** argv);
 int RunCameras(int argc, char** argv);
 int RunCalib(int argc, char** argv);
+int RunSynth(int argc, char** argv);
 
 }  // namespace handlabel

@@ -1,0 +1,91 @@
+#pragma once
+// Pulls the hand towards given 3D points: the 21 keypoints and/or chosen vertices (a
+// network's prediction, or triangulated keypoints), r = sqrt(w_i) (X_i - target_i) /
+// sigma with per-point weights w_i >= 0 (0 = unknown point). Used to start fitting
+// from the network's mesh and for the IK-style initialisation.
+// Residuals: 3 per keypoint (21, SNAP order) then 3 per listed vertex.
+
+#include <ceres/autodiff_cost_function.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/hand_evaluator.h"
+#include "core/hand_lbs.h"
+
+namespace handlabel {
+
+struct Points3dTargets {
+  Points3d keypoints;                // 21 x 3 or empty
+  Eigen::VectorXd keypoint_weights;  // 21 or empty (= all 1)
+  std::vector<int> vertex_ids;       // vertices to pull (may be empty)
+  Points3d vertices;                 // vertex_ids.size() x 3
+};
+
+template <int kPoseDim = kNumPoseParams, int kNumBetas = 10>
+class Points3dCost {
+ public:
+  // `evaluator` must outlive the functor.
+  Points3dCost(const HandEvaluator& evaluator, const Points3dTargets& targets,
+               double sigma)
+      : evaluator_(evaluator), targets_(targets), inv_sigma_(1.0 / sigma) {
+    HL_CHECK(evaluator.pose_dim() == kPoseDim && evaluator.num_betas() == kNumBetas,
+             "functor sizes differ from the evaluator's");
+    HL_CHECK(
+        targets.keypoints.rows() == 0 || targets.keypoints.rows() == kNumHandKeypoints,
+        "keypoint targets must be 21 x 3");
+    HL_CHECK(
+        targets.vertices.rows() == static_cast<Eigen::Index>(targets.vertex_ids.size()),
+        "one target per vertex id");
+    if (targets_.keypoints.rows() > 0 && targets_.keypoint_weights.size() == 0) {
+      targets_.keypoint_weights = Eigen::VectorXd::Ones(kNumHandKeypoints);
+    }
+  }
+  int num_residuals() const {
+    return 3 * static_cast<int>(targets_.keypoints.rows() + targets_.vertices.rows());
+  }
+
+  template <typename T>
+  bool operator()(const T* orient, const T* pose, const T* betas, const T* transl,
+                  T* residuals) const {
+    HandPoseState<T> state;
+    evaluator_.Pose(orient, pose, betas, transl, &state);
+    int row = 0;
+    if (targets_.keypoints.rows() > 0) {
+      T keypoints[3 * kNumHandKeypoints];
+      evaluator_.KeypointsFromState(state, keypoints);
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        const double s =
+            std::sqrt(std::max(0.0, targets_.keypoint_weights[k])) * inv_sigma_;
+        for (int c = 0; c < 3; ++c) {
+          residuals[row++] = (keypoints[3 * k + c] - targets_.keypoints(k, c)) * s;
+        }
+      }
+    }
+    if (!targets_.vertex_ids.empty()) {
+      std::vector<T> vertices(3 * targets_.vertex_ids.size());
+      evaluator_.VerticesFromState(state, targets_.vertex_ids, vertices.data());
+      for (size_t i = 0; i < targets_.vertex_ids.size(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+          residuals[row++] = (vertices[3 * i + c] - targets_.vertices(i, c)) * inv_sigma_;
+        }
+      }
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const HandEvaluator& evaluator,
+                                     const Points3dTargets& targets, double sigma) {
+    auto* functor = new Points3dCost(evaluator, targets, sigma);
+    return new ceres::AutoDiffCostFunction<Points3dCost, ceres::DYNAMIC, 3, kPoseDim,
+                                           kNumBetas, 3>(functor,
+                                                         functor->num_residuals());
+  }
+
+ private:
+  const HandEvaluator& evaluator_;
+  Points3dTargets targets_;
+  double inv_sigma_;
+};
+
+}  // namespace handlabel

@@ -1,0 +1,29 @@
+#pragma once
+// Outline samples of a silhouette mask and their matching to projected vertices, for
+// the mask -> mesh half of the silhouette term (silhouette_cost.h).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/distance_transform.h"
+
+namespace handlabel {
+
+struct MaskOutline {
+  std::vector<Eigen::Vector2d> points;   // on the pixel edge between inside and outside
+  std::vector<Eigen::Vector2d> normals;  // unit, pointing out of the mask
+};
+
+// Mask pixels with a 4-neighbour outside the mask (pixels on the image border are not
+// outline: the hand continues beyond the image), evenly subsampled in scan order to at
+// most `max_samples`; each point is moved half a pixel along its outward normal (the
+// gradient of the signed distance to the outline).
+MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples);
+
+// For every outline point, the index (into `projected`) of the nearest projected point;
+// entries with valid[i] == 0 are skipped. -1 if none is valid.
+std::vector<int> MatchOutlineToPoints(const MaskOutline& outline,
+                                      const std::vector<Eigen::Vector2d>& projected,
+                                      const std::vector<char>& valid);
+
+}  // namespace handlabel

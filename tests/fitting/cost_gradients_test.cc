@@ -1,0 +1,236 @@
+// Every cost functor's derivatives against central finite differences, and the
+// analytic keypoint Jacobian against autodiff.
+
+#include <ceres/manifold_test_utils.h>
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "core/hand_anatomy.h"
+#include "fitting/axis_angle_manifold.h"
+#include "fitting/joint_limit_cost.h"
+#include "fitting/keypoint_reprojection_cost.h"
+#include "fitting/points3d_cost.h"
+#include "fitting/prior_costs.h"
+#include "fitting/silhouette_cost.h"
+#include "tests/core/stick_hand.h"
+#include "tests/fitting/fitting_scene.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+struct Params {
+  double orient[3], pose[45], betas[10], transl[3];
+  std::vector<const double*> Blocks() const { return {orient, pose, betas, transl}; }
+};
+
+Params FromHandParams(const HandParams& p) {
+  Params out;
+  for (int i = 0; i < 3; ++i) {
+    out.orient[i] = p.global_orient[i];
+    out.transl[i] = p.transl[i];
+  }
+  for (int i = 0; i < 45; ++i) out.pose[i] = p.hand_pose[i];
+  for (int i = 0; i < 10; ++i) out.betas[i] = p.betas[i];
+  return out;
+}
+
+// Central differences (step 1e-6) against the cost function's Jacobians, block by
+// block; tolerance `precision` relative to the largest entry of the column (plus the
+// same absolute amount).
+void ExpectGradientsMatch(const ceres::CostFunction& cost,
+                          const std::vector<const double*>& blocks, double precision) {
+  const int n = cost.num_residuals();
+  const std::vector<int32_t>& sizes = cost.parameter_block_sizes();
+  ASSERT_EQ(sizes.size(), blocks.size());
+  std::vector<std::vector<double>> values(blocks.size());
+  std::vector<const double*> pointers(blocks.size());
+  std::vector<std::vector<double>> jac(blocks.size());
+  std::vector<double*> jac_ptr(blocks.size());
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    values[b].assign(blocks[b], blocks[b] + sizes[b]);
+    pointers[b] = values[b].data();
+    jac[b].resize(static_cast<size_t>(n) * sizes[b]);
+    jac_ptr[b] = jac[b].data();
+  }
+  std::vector<double> r0(n), plus(n), minus(n);
+  ASSERT_TRUE(cost.Evaluate(pointers.data(), r0.data(), jac_ptr.data()));
+  int bad = 0;
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    for (int c = 0; c < sizes[b]; ++c) {
+      const double h = 1e-6;
+      const double x = values[b][c];
+      values[b][c] = x + h;
+      ASSERT_TRUE(cost.Evaluate(pointers.data(), plus.data(), nullptr));
+      values[b][c] = x - h;
+      ASSERT_TRUE(cost.Evaluate(pointers.data(), minus.data(), nullptr));
+      values[b][c] = x;
+      double column_scale = 1.0;
+      for (int r = 0; r < n; ++r) {
+        column_scale = std::max(column_scale, std::abs(jac[b][r * sizes[b] + c]));
+      }
+      for (int r = 0; r < n; ++r) {
+        const double numeric = (plus[r] - minus[r]) / (2 * h);
+        const double analytic = jac[b][r * sizes[b] + c];
+        if (std::abs(numeric - analytic) > precision * column_scale && bad++ < 10) {
+          ADD_FAILURE() << "block " << b << " param " << c << " residual " << r
+                        << ": jacobian " << analytic << " vs finite difference "
+                        << numeric;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(bad, 0);
+}
+
+class CostGradientsTest : public ::testing::Test {
+ protected:
+  CostGradientsTest()
+      : model_(testing::MakeStickHand(HandSide::kRight)),
+        evaluator_(model_),
+        frame_(testing::RandomSceneFrame(model_, testing::TestRng())) {
+    // Evaluate slightly away from the truth so residuals are non-zero.
+    HandParams p = frame_.params;
+    for (int i = 0; i < 45; ++i) p.hand_pose[i] += testing::Gaussian(0.05);
+    p.transl += testing::RandomVector3(-0.003, 0.003);
+    params_ = FromHandParams(p);
+  }
+  HandModel model_;
+  HandEvaluator evaluator_;
+  testing::SceneFrame frame_;
+  Params params_;
+};
+
+TEST_F(CostGradientsTest, KeypointReprojectionAutodiff) {
+  for (RobustLossType type :
+       {RobustLossType::kTrivial, RobustLossType::kHuber, RobustLossType::kCauchy}) {
+    std::unique_ptr<ceres::CostFunction> cost(MultiViewKeypointCost<>::Create(
+        evaluator_, frame_.views, RobustLoss{type, 1.5}, 1.0));
+    ExpectGradientsMatch(*cost, params_.Blocks(), 1e-6);
+  }
+}
+
+TEST_F(CostGradientsTest, KeypointReprojectionAnalyticMatchesAutodiff) {
+  std::vector<KeypointView> views = frame_.views;
+  views[1].confidence[3] = 0.0;  // a missing detection
+  views[2].confidence[4] = 0.3;
+  for (RobustLossType type :
+       {RobustLossType::kTrivial, RobustLossType::kHuber, RobustLossType::kCauchy}) {
+    const RobustLoss loss{type, 1.5};
+    std::unique_ptr<ceres::CostFunction> autodiff(
+        MultiViewKeypointCost<>::Create(evaluator_, views, loss, 1.0));
+    std::unique_ptr<ceres::CostFunction> analytic(
+        MultiViewKeypointCostFunction::Create(evaluator_, views, loss, 1.0));
+    const int n = autodiff->num_residuals();
+    ASSERT_EQ(n, analytic->num_residuals());
+    const int sizes[4] = {3, 45, 10, 3};
+    std::vector<Eigen::MatrixXd> ja(4), jb(4);
+    std::vector<double*> pa(4), pb(4);
+    for (int b = 0; b < 4; ++b) {
+      ja[b].resize(sizes[b], n);  // column-major of size x n == row-major n x size
+      jb[b].resize(sizes[b], n);
+      pa[b] = ja[b].data();
+      pb[b] = jb[b].data();
+    }
+    Eigen::VectorXd ra(n), rb(n);
+    ASSERT_TRUE(autodiff->Evaluate(params_.Blocks().data(), ra.data(), pa.data()));
+    ASSERT_TRUE(analytic->Evaluate(params_.Blocks().data(), rb.data(), pb.data()));
+    EXPECT_THAT(rb, testing::MatrixNear(ra, 1e-9));
+    for (int b = 0; b < 4; ++b) {
+      const double scale = std::max(1.0, ja[b].cwiseAbs().maxCoeff());
+      EXPECT_THAT(jb[b], testing::MatrixNear(ja[b], 1e-7 * scale)) << "block " << b;
+    }
+    // Residual-only evaluation agrees too.
+    Eigen::VectorXd rc(n);
+    ASSERT_TRUE(analytic->Evaluate(params_.Blocks().data(), rc.data(), nullptr));
+    EXPECT_THAT(rc, testing::MatrixNear(ra, 1e-9));
+  }
+}
+
+TEST_F(CostGradientsTest, JointLimits) {
+  // Push some angles beyond their limits (away from the hinge kinks).
+  const HandAnatomy anatomy = ComputeHandAnatomy(model_);
+  HandPoseVector angles = HandPoseVector::Zero();
+  for (int i = 0; i < 45; ++i) angles[i] = testing::Uniform(-0.6, 1.2);
+  const HandPoseVector pose = HandPoseFromAnatomicalAngles(anatomy, angles);
+  std::unique_ptr<ceres::CostFunction> cost(
+      JointLimitCost<>::Create(evaluator_, anatomy, DefaultHandLimits(), 3.0));
+  Eigen::VectorXd r(45);
+  const double* blocks[1] = {pose.data()};
+  ASSERT_TRUE(cost->Evaluate(blocks, r.data(), nullptr));
+  EXPECT_GT(r.cwiseAbs().maxCoeff(), 0.1);  // some limits are violated
+  ExpectGradientsMatch(*cost, {pose.data()}, 1e-6);
+}
+
+TEST_F(CostGradientsTest, Priors) {
+  Eigen::Matrix<double, 45, 1> mean, inv_sigma;
+  for (int i = 0; i < 45; ++i) {
+    mean[i] = testing::Gaussian(0.2);
+    inv_sigma[i] = testing::Uniform(0.5, 2.0);
+  }
+  std::unique_ptr<ceres::CostFunction> pose(
+      PosePriorCost<>::Create(evaluator_, mean, inv_sigma));
+  ExpectGradientsMatch(*pose, {params_.pose}, 1e-7);
+  std::unique_ptr<ceres::CostFunction> shape(ShapePriorCost<>::Create(0.7));
+  ExpectGradientsMatch(*shape, {params_.betas}, 1e-7);
+  const double target[3] = {0.1, 0.2, 0.3};
+  std::unique_ptr<ceres::CostFunction> prior(ParameterPriorCost<3>::Create(target, 0.01));
+  ExpectGradientsMatch(*prior, {params_.transl}, 1e-7);
+  std::unique_ptr<ceres::CostFunction> diff(ParameterDifferenceCost<3>::Create(0.01));
+  ExpectGradientsMatch(*diff, {params_.transl, target}, 1e-7);
+}
+
+TEST_F(CostGradientsTest, Points3d) {
+  Points3dTargets targets;
+  targets.keypoints = frame_.mesh.keypoints;
+  targets.keypoint_weights = Eigen::VectorXd::Ones(21);
+  targets.keypoint_weights[4] = 0.0;
+  targets.vertex_ids = {0, 5, 17, 20};
+  targets.vertices.resize(4, 3);
+  for (int i = 0; i < 4; ++i)
+    targets.vertices.row(i) = frame_.mesh.vertices.row(targets.vertex_ids[i]);
+  std::unique_ptr<ceres::CostFunction> cost(
+      Points3dCost<>::Create(evaluator_, targets, 0.002));
+  ExpectGradientsMatch(*cost, params_.Blocks(), 1e-6);
+}
+
+TEST_F(CostGradientsTest, Silhouette) {
+  // A linear stand-in for a distance image (bilinear interpolation reproduces it
+  // exactly, so no cell edges), with an outline of a few samples.
+  std::vector<SilhouetteView> views(2);
+  for (int v = 0; v < 2; ++v) {
+    views[v].camera = frame_.views[v].camera;
+    views[v].distance_to_mask.resize(480, 640);
+    for (int y = 0; y < 480; ++y) {
+      for (int x = 0; x < 640; ++x) {
+        views[v].distance_to_mask(y, x) =
+            0.02 * std::abs(x - 300.0) + 0.01 * std::abs(y - 200.0);
+      }
+    }
+    for (int s = 0; s < 5; ++s) {
+      views[v].outline_px.emplace_back(300 + 10 * s, 250 - 7 * s);
+      views[v].outline_normal.push_back(Eigen::Vector2d(1, s).normalized());
+      views[v].outline_vertex.push_back(3 * s + v);
+    }
+  }
+  const std::vector<int> ids = {0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20};
+  std::unique_ptr<ceres::CostFunction> cost(
+      MultiViewSilhouetteCost<>::Create(evaluator_, ids, views, 2.0));
+  ExpectGradientsMatch(*cost, params_.Blocks(), 1e-5);
+}
+
+TEST(AxisAngleManifoldTest, Invariants) {
+  ceres::AutoDiffManifold<AxisAngleManifoldFunctor, 3, 3> manifold;
+  for (int trial = 0; trial < 10; ++trial) {
+    using Vector = Eigen::VectorXd;
+    using namespace ceres;  // NOLINT: the macro names ceres matchers unqualified
+    Vector x = testing::RandomVector3(-1.5, 1.5);
+    Vector delta = testing::RandomVector3(-0.5, 0.5);
+    Vector y = testing::RandomVector3(-1.5, 1.5);
+    EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(manifold, x, delta, y, 1e-9);
+  }
+}
+
+}  // namespace
+}  // namespace handlabel

@@ -1,0 +1,101 @@
+#pragma once
+// Synthetic multi-view scenes for fitting tests and benches: a DexYCB-like rig (8
+// cameras, 640x480, f ~ 615 px, mild OpenCV distortion, 0.55-0.8 m from the hand), a
+// hand in a natural random pose (core/hand_pose_sampler.h) with random shape, root
+// rotation and position, and its exact 2D keypoints in every view. Noise, outliers and
+// occluded views are added by the caller.
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "core/hand_anatomy.h"
+#include "core/hand_lbs.h"
+#include "core/hand_pose_sampler.h"
+#include "core/rig.h"
+#include "fitting/keypoint_view.h"
+
+namespace handlabel::testing {
+
+inline std::vector<RigCamera> DexYcbLikeRig() {
+  std::vector<RigCamera> cameras;
+  for (int i = 0; i < 8; ++i) {
+    const double azimuth = 2.0 * M_PI * i / 8.0 + 0.2;
+    const double elevation = (i % 2 == 0 ? 0.9 : 0.5);  // radians above the table
+    const double distance = 0.55 + 0.035 * i;
+    const Eigen::Vector3d eye(distance * std::cos(elevation) * std::cos(azimuth),
+                              -distance * std::sin(elevation),
+                              distance * std::cos(elevation) * std::sin(azimuth));
+    RigCamera cam;
+    cam.name = "cam" + std::to_string(i);
+    cam.camera = Camera(CameraModelId::kOpenCV, 640, 480,
+                        {615.0 + 3 * i, 613.0 + 2 * i, 320.0 + i, 240.0 - i,
+                         -0.04 + 0.01 * i, 0.02, 0.0005, -0.0004},
+                        "DexYcbLikeRig");
+    cam.cam_from_world = LookAt(eye, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, -1, 0));
+    cameras.push_back(cam);
+  }
+  return cameras;
+}
+
+struct SceneFrame {
+  HandParams params;
+  HandMesh mesh;
+  std::vector<KeypointView> views;  // exact projections, confidence 1
+};
+
+inline SceneFrame RandomSceneFrame(const HandModel& model, std::mt19937_64& rng,
+                                   double betas_sigma = 0.8) {
+  const HandAnatomy anatomy = ComputeHandAnatomy(model);
+  SceneFrame f;
+  f.params.hand_pose =
+      SampleHandPose(anatomy, DefaultHandLimits(), HandPoseSamplerOptions(), rng)
+          .hand_pose;
+  std::normal_distribution<double> g(0.0, 1.0);
+  f.params.betas = Eigen::VectorXd(10);
+  for (int s = 0; s < 10; ++s) f.params.betas[s] = betas_sigma * g(rng);
+  Eigen::Vector4d q(g(rng), g(rng), g(rng), g(rng));
+  const Eigen::AngleAxisd aa(Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized());
+  f.params.global_orient = aa.angle() * aa.axis();
+  // Place the hand's centre near the rig's centre.
+  const HandMesh at_origin = PoseHand(model, f.params);
+  const Eigen::Vector3d centre = at_origin.keypoints.colwise().mean().transpose();
+  f.params.transl = -centre + 0.04 * Eigen::Vector3d(g(rng), g(rng), g(rng));
+  f.mesh = PoseHand(model, f.params);
+  for (const RigCamera& cam : DexYcbLikeRig()) {
+    KeypointView view;
+    view.camera = cam;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      Eigen::Vector2d uv;
+      const bool ok = cam.ProjectWorld(f.mesh.keypoints.row(k).transpose(), &uv);
+      view.uv_px.row(k) = uv.transpose();
+      view.confidence[k] = ok ? 1.0 : 0.0;
+    }
+    f.views.push_back(view);
+  }
+  return f;
+}
+
+// sigma_px Gaussian noise on every keypoint, a fraction of keypoints replaced by
+// uniform outliers in the image, and the listed views occluded (confidence 0).
+inline void CorruptViews(std::vector<KeypointView>* views, double sigma_px,
+                         double outlier_fraction, const std::vector<int>& occluded,
+                         std::mt19937_64& rng) {
+  std::normal_distribution<double> g(0.0, sigma_px);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (KeypointView& view : *views) {
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (u(rng) < outlier_fraction) {
+        view.uv_px(k, 0) = 640.0 * u(rng);
+        view.uv_px(k, 1) = 480.0 * u(rng);
+      } else {
+        view.uv_px(k, 0) += g(rng);
+        view.uv_px(k, 1) += g(rng);
+      }
+    }
+  }
+  for (int v : occluded) (*views)[v].confidence.setZero();
+}
+
+}  // namespace handlabel::testing

@@ -1,0 +1,97 @@
+#include "fitting/hand_fitter.h"
+
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "core/metrics.h"
+#include "tests/core/stick_hand.h"
+#include "tests/fitting/fitting_scene.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+class HandFitterTest : public ::testing::Test {
+ protected:
+  HandModel model_ = testing::MakeStickHand(HandSide::kRight);
+};
+
+TEST_F(HandFitterTest, OptionsCheck) {
+  HandFitOptions o;
+  o.keypoint_sigma_px = 0.0;
+  EXPECT_THROW(o.Check(), InputError);
+  o = {};
+  o.silhouette_vertex_stride = 0;
+  EXPECT_THROW(o.Check(), InputError);
+  HandFitConfig c;
+  c.pose_pca_comps = 7;
+  EXPECT_THROW(c.Check(), InputError);
+  EXPECT_THROW(HandFitter(model_, c), InputError);
+}
+
+TEST_F(HandFitterTest, InitFromExact3dKeypoints) {
+  const HandFitter fitter(model_);
+  for (int trial = 0; trial < 3; ++trial) {
+    const testing::SceneFrame frame =
+        testing::RandomSceneFrame(model_, testing::TestRng());
+    const HandParams init =
+        fitter.InitFromKeypoints3d(frame.mesh.keypoints, Eigen::VectorXd::Ones(21));
+    const HandMesh mesh = PoseHand(model_, init);
+    EXPECT_LT(MeanPointError(mesh.keypoints, frame.mesh.keypoints), 0.003) << trial;
+  }
+}
+
+TEST_F(HandFitterTest, NoiseFreeKeypointsFromTriangulationBaseline) {
+  const HandFitter fitter(model_);
+  for (int trial = 0; trial < 3; ++trial) {
+    const testing::SceneFrame frame =
+        testing::RandomSceneFrame(model_, testing::TestRng());
+    FitInput input;
+    input.views = frame.views;
+    const HandParams init = fitter.InitFromViews(input.views);
+    const FitResult result = fitter.Fit(input, init);
+    EXPECT_LT(MeanPointError(result.keypoints, frame.mesh.keypoints), 0.0005) << trial;
+    ASSERT_EQ(result.view_rms_px.size(), 8u);
+    for (double rms : result.view_rms_px) EXPECT_LT(rms, 0.5);
+    EXPECT_GT(result.iterations, 0);
+    EXPECT_TRUE(result.term_costs.count("keypoints"));
+    EXPECT_TRUE(result.term_costs.count("joint_limits"));
+  }
+}
+
+TEST_F(HandFitterTest, RobustLossBeatsLeastSquaresWithOutliers) {
+  HandFitOptions robust_options;
+  HandFitOptions plain_options;
+  plain_options.keypoint_loss.type = RobustLossType::kTrivial;
+  const HandFitter robust(model_, {}, robust_options);
+  const HandFitter plain(model_, {}, plain_options);
+  double robust_error = 0.0, plain_error = 0.0;
+  for (int trial = 0; trial < 3; ++trial) {
+    testing::SceneFrame frame = testing::RandomSceneFrame(model_, testing::TestRng());
+    testing::CorruptViews(&frame.views, 2.0, 0.1, {3}, testing::TestRng());
+    FitInput input;
+    input.views = frame.views;
+    const HandParams init = robust.InitFromViews(input.views);
+    robust_error +=
+        MeanPointError(robust.Fit(input, init).keypoints, frame.mesh.keypoints);
+    plain_error += MeanPointError(plain.Fit(input, init).keypoints, frame.mesh.keypoints);
+  }
+  EXPECT_LT(robust_error / 3, 0.006);
+  EXPECT_LT(robust_error, plain_error);
+}
+
+TEST_F(HandFitterTest, ResultWithinJointLimits) {
+  const HandFitter fitter(model_);
+  const HandAnatomy anatomy = ComputeHandAnatomy(model_);
+  testing::SceneFrame frame = testing::RandomSceneFrame(model_, testing::TestRng());
+  testing::CorruptViews(&frame.views, 2.0, 0.1, {}, testing::TestRng());
+  FitInput input;
+  input.views = frame.views;
+  const FitResult result = fitter.Fit(input, fitter.InitFromViews(input.views));
+  HandPoseVector angles;
+  HandAnatomicalAngles(anatomy, result.params.hand_pose.data(), angles.data());
+  EXPECT_LT(MaxLimitViolationDeg(DefaultHandLimits(), angles), 5.0);
+}
+
+}  // namespace
+}  // namespace handlabel
