@@ -17,6 +17,7 @@
 #include "fitting/prior_costs.h"
 #include "fitting/silhouette_cost.h"
 #include "fitting/silhouette_outline.h"
+#include "fitting/silhouette_render.h"
 
 namespace handlabel {
 namespace {
@@ -156,6 +157,7 @@ void HandFitOptions::Check() const {
   }
   RequireNonNegative(silhouette_outline_samples, "silhouette_outline_samples");
   RequireNonNegative(silhouette_rounds, "silhouette_rounds");
+  RequirePositive(silhouette_contour_cosine, "silhouette_contour_cosine");
   RequireNonNegative(rigid_iterations, "rigid_iterations");
   RequireNonNegative(keypoint_iterations, "keypoint_iterations");
   RequireNonNegative(silhouette_iterations, "silhouette_iterations");
@@ -383,15 +385,22 @@ class FitRun {
     }
     for (int round = 0; !sil_views.empty() && round < options_.silhouette_rounds;
          ++round) {
-      std::vector<double> verts(3 * vertex_ids.size());
-      evaluator_.Vertices(b.orient, b.pose.data(), b.betas, b.transl, vertex_ids,
-                          verts.data());
+      // Outline samples are matched only to contour-generator vertices (normal nearly
+      // perpendicular to the viewing ray): matching interior vertices would pull them
+      // outwards and inflate the hand.
+      Points3d all(evaluator_.num_vertices(), 3);
+      evaluator_.AllVertices(b.orient, b.pose.data(), b.betas, b.transl, all.data());
+      const MeshVertices normals = ComputeVertexNormals(all, model_.faces);
       for (size_t v = 0; v < sil_views.size(); ++v) {
+        const Eigen::Vector3d centre = sil_views[v].camera.CenterInWorld();
         std::vector<Eigen::Vector2d> uv(vertex_ids.size());
         std::vector<char> valid(vertex_ids.size());
         for (size_t i = 0; i < vertex_ids.size(); ++i) {
-          valid[i] = sil_views[v].camera.ProjectWorld(
-              Eigen::Vector3d(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]), &uv[i]);
+          const Eigen::Vector3d x = all.row(vertex_ids[i]).transpose();
+          const Eigen::Vector3d n = normals.row(vertex_ids[i]).transpose();
+          const double along = std::abs(n.dot((x - centre).normalized()));
+          valid[i] = n.squaredNorm() > 0.5 && along < options_.silhouette_contour_cosine &&
+                     sil_views[v].camera.ProjectWorld(x, &uv[i]);
         }
         sil_views[v].outline_px = outlines[v].points;
         sil_views[v].outline_normal = outlines[v].normals;
@@ -422,6 +431,16 @@ class FitRun {
       result.view_rms_px.push_back(n > 0 ? std::sqrt(sum / n) : kNaN);
     }
     result.view_iou.assign(input.views.size(), kNaN);
+    for (size_t v = 0; v < input.masks.size(); ++v) {
+      if (input.masks[v].size() == 0) continue;
+      const RigCamera& camera = input.views[v].camera;
+      const MaskImage rendered = input.pixel_rays != nullptr
+                                     ? RenderHandMask(result.vertices, model_.faces,
+                                                      camera, (*input.pixel_rays)[v])
+                                     : RenderHandMask(result.vertices, model_.faces,
+                                                      camera, PixelRays(camera.camera));
+      result.view_iou[v] = MaskIoU(rendered, input.masks[v]);
+    }
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;

@@ -25,9 +25,10 @@
 #include "core/hand_evaluator.h"
 #include "core/hand_lbs.h"
 #include "core/hand_model.h"
+#include "core/rasterizer.h"
+#include "fitting/keypoint_view.h"
 #include "fitting/points3d_cost.h"
 #include "fitting/robust_loss.h"
-#include "fitting/keypoint_view.h"
 
 namespace handlabel {
 
@@ -73,6 +74,9 @@ struct HandFitOptions {
   int silhouette_vertex_stride = 2;
   int silhouette_outline_samples = 120;
   int silhouette_rounds = 3;
+  // Outline samples match only vertices whose normal makes |cos| below this with the
+  // viewing ray (contour generators).
+  double silhouette_contour_cosine = 0.6;
   // Ceres iterations per stage (silhouette: per round).
   int rigid_iterations = 20;
   int keypoint_iterations = 60;
@@ -97,6 +101,9 @@ struct FitInput {
   std::vector<MaskImage> masks;
   std::optional<Points3dTargets> targets3d;
   std::optional<HandParams> previous;
+  // Optional per-view pixel rays of the cameras (core/rasterizer.h), for the IoU of
+  // the result; computed per call when absent (costly: cache them per rig).
+  const std::vector<PixelRays>* pixel_rays = nullptr;
 };
 
 struct FitResult {

@@ -24,8 +24,8 @@
 
 #include "core/camera_models.h"
 #include "core/hand_evaluator.h"
-#include "fitting/robust_loss.h"
 #include "fitting/keypoint_view.h"
+#include "fitting/robust_loss.h"
 
 namespace handlabel {
 

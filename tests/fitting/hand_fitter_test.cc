@@ -4,8 +4,10 @@
 
 #include "core/errors.h"
 #include "core/metrics.h"
+#include "fitting/silhouette_render.h"
 #include "tests/core/stick_hand.h"
 #include "tests/fitting/fitting_scene.h"
+#include "tests/fitting/tube_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -91,6 +93,48 @@ TEST_F(HandFitterTest, ResultWithinJointLimits) {
   HandPoseVector angles;
   HandAnatomicalAngles(anatomy, result.params.hand_pose.data(), angles.data());
   EXPECT_LT(MaxLimitViolationDeg(DefaultHandLimits(), angles), 5.0);
+}
+
+}  // namespace
+}  // namespace handlabel
+
+namespace handlabel {
+namespace {
+
+// Masks of the ground-truth mesh in every view (the rasteriser of core).
+std::vector<MaskImage> RenderMasks(const HandModel& model,
+                                   const testing::SceneFrame& frame,
+                                   const std::vector<PixelRays>& rays) {
+  std::vector<MaskImage> masks;
+  for (size_t v = 0; v < frame.views.size(); ++v) {
+    masks.push_back(
+        RenderHandMask(frame.mesh.vertices, model.faces, frame.views[v].camera, rays[v]));
+  }
+  return masks;
+}
+
+TEST(HandFitterSilhouetteTest, NoiseFreeKeypointsAndMasks) {
+  const HandModel model = testing::MakeTubeHand();
+  HandFitOptions options;
+  options.silhouette_vertex_stride = 4;  // keeps the test fast
+  options.silhouette_rounds = 2;
+  const HandFitter fitter(model, {}, options);
+  std::vector<PixelRays> rays;
+  for (const RigCamera& cam : testing::DexYcbLikeRig()) rays.emplace_back(cam.camera);
+  for (int trial = 0; trial < 2; ++trial) {
+    const testing::SceneFrame frame =
+        testing::RandomSceneFrame(model, testing::TestRng());
+    FitInput input;
+    input.views = frame.views;
+    input.masks = RenderMasks(model, frame, rays);
+    input.pixel_rays = &rays;
+    const FitResult result = fitter.Fit(input, fitter.InitFromViews(input.views));
+    EXPECT_LT(MeanPointError(result.keypoints, frame.mesh.keypoints), 0.001) << trial;
+    EXPECT_LT(MeanPointError(result.vertices, frame.mesh.vertices), 0.0015) << trial;
+    ASSERT_EQ(result.view_iou.size(), 8u);
+    for (double iou : result.view_iou) EXPECT_GT(iou, 0.9);
+    EXPECT_TRUE(result.term_costs.count("silhouette"));
+  }
 }
 
 }  // namespace
