@@ -1,5 +1,7 @@
 #include "pipeline/frame_log.h"
 
+#include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -24,6 +26,11 @@ FrameRecord ParseRecord(const std::string& line, const std::string& source) {
     r.path = j.value("path", "");
     r.reason = j.value("reason", "");
     r.seconds = j.value("seconds", 0.0);
+    if (j.contains("metrics")) {
+      for (const auto& [name, value] : j.at("metrics").items()) {
+        r.metrics[name] = value.is_null() ? std::nan("") : value.get<double>();
+      }
+    }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(source, "record", "fields frame and status", e.what());
   }
@@ -59,6 +66,13 @@ std::vector<FrameRecord> FrameLog::Read(const std::string& path) {
 
 FrameLog::FrameLog(std::string path) : path_(std::move(path)) {
   for (FrameRecord& r : Read(path_)) latest_[r.frame] = std::move(r);
+  // Cut a partial last line left by a crash: appending after it would glue the next
+  // record onto it and turn it into a malformed complete line.
+  std::ifstream in(path_, std::ios::binary);
+  if (!in) return;
+  const std::string text((std::istreambuf_iterator<char>(in)), {});
+  const size_t keep = text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1;
+  if (keep < text.size()) std::filesystem::resize_file(path_, keep);
 }
 
 bool FrameLog::IsDone(const std::string& frame) const {
@@ -73,6 +87,7 @@ void FrameLog::Record(const FrameRecord& record) {
                       {"path", record.path},
                       {"seconds", record.seconds}};
   if (!record.reason.empty()) j["reason"] = record.reason;
+  if (!record.metrics.empty()) j["metrics"] = record.metrics;
   std::lock_guard<std::mutex> lock(mutex_);
   AppendLineDurably(path_, j.dump());
   latest_[record.frame] = record;

@@ -17,12 +17,16 @@ struct FrameRecord {
   std::string path;    // which stage produced the label ("network", "refined", "fit")
   std::string reason;  // why it failed (empty when ok)
   double seconds = 0;  // wall time spent on the frame
+  // Per-frame errors against ground truth, "<group>/<metric>" -> value (label_summary.h);
+  // empty when the capture has no ground truth.
+  std::map<std::string, double> metrics;
 };
 
 class FrameLog {
  public:
   // Loads `path` if it exists. Throws InputError naming the file and line for a
-  // malformed complete line (a partial last line is not an error).
+  // malformed complete line (a partial last line is not an error: it is cut off, so
+  // that the next append starts on a line of its own).
   explicit FrameLog(std::string path);
 
   // True if the frame finished with status ok.

@@ -75,7 +75,8 @@ class Section {
 };
 
 template <typename E>
-E ParseEnum(const std::string& text, const std::vector<std::pair<const char*, E>>& options,
+E ParseEnum(const std::string& text,
+            const std::vector<std::pair<const char*, E>>& options,
             const std::string& file, const std::string& field) {
   std::string names;
   for (const auto& [name, value] : options) {
@@ -94,9 +95,12 @@ std::string Resolve(const std::string& path, const fs::path& base) {
 
 std::string ToString(RefineMode mode) {
   switch (mode) {
-    case RefineMode::kOff: return "off";
-    case RefineMode::kAlways: return "always";
-    case RefineMode::kFallback: return "fallback";
+    case RefineMode::kOff:
+      return "off";
+    case RefineMode::kAlways:
+      return "always";
+    case RefineMode::kFallback:
+      return "fallback";
   }
   return "?";
 }
@@ -116,8 +120,10 @@ void JobConfig::Check() const {
     throw InputError(f, "cameras.file", "a rig file when cameras.source is file");
   }
   if (output_dir.empty()) throw InputError(f, "output.dir", "an output folder");
-  if (batch_size < 1) throw InputError(f, "network.batch_size", ">= 1", std::to_string(batch_size));
-  if (threads < 0) throw InputError(f, "network.threads", ">= 0", std::to_string(threads));
+  if (batch_size < 1)
+    throw InputError(f, "network.batch_size", ">= 1", std::to_string(batch_size));
+  if (threads < 0)
+    throw InputError(f, "network.threads", ">= 0", std::to_string(threads));
   if (network_weights.empty() && refine_mode != RefineMode::kAlways) {
     throw InputError(f, "refine.mode",
                      "'always' when network.weights is empty (without a network every "
@@ -137,8 +143,14 @@ void JobConfig::Check() const {
     throw InputError(f, "refine.min_confidence", "a value in [0, 1]");
   }
   if (quality.min_views < 1) throw InputError(f, "refine.min_views", ">= 1");
+  if (!(quality.min_hand_span_m > 0 &&
+        quality.max_hand_span_m > quality.min_hand_span_m)) {
+    throw InputError(f, "refine.min_hand_span_m / max_hand_span_m",
+                     "0 < min_hand_span_m < max_hand_span_m");
+  }
   for (const std::string& m : meshes) {
-    if (m != "ply" && m != "obj") throw InputError(f, "output.meshes", "ply and/or obj", "'" + m + "'");
+    if (m != "ply" && m != "obj")
+      throw InputError(f, "output.meshes", "ply and/or obj", "'" + m + "'");
   }
 }
 
@@ -180,28 +192,33 @@ JobConfig LoadJobConfig(const std::string& path) {
   Section refine = top.Child("refine");
   std::string mode = "fallback";
   refine.Read("mode", &mode);
-  job.refine_mode = ParseEnum<RefineMode>(
-      mode, {{"off", RefineMode::kOff}, {"always", RefineMode::kAlways},
-             {"fallback", RefineMode::kFallback}},
-      path, refine.Name("mode"));
+  job.refine_mode = ParseEnum<RefineMode>(mode,
+                                          {{"off", RefineMode::kOff},
+                                           {"always", RefineMode::kAlways},
+                                           {"fallback", RefineMode::kFallback}},
+                                          path, refine.Name("mode"));
   refine.Read("max_reprojection_px", &job.quality.max_reprojection_px);
   refine.Read("max_view_disagreement_mm", &job.quality.max_view_disagreement_mm);
   refine.Read("min_confidence", &job.quality.min_confidence);
   refine.Read("min_views", &job.quality.min_views);
+  refine.Read("min_hand_span_m", &job.quality.min_hand_span_m);
+  refine.Read("max_hand_span_m", &job.quality.max_hand_span_m);
   refine.RejectUnknownKeys();
 
   Section evidence = top.Child("evidence");
   std::string keypoints = "network", masks = "files";
   evidence.Read("keypoints_2d", &keypoints);
   evidence.Read("masks", &masks);
-  job.keypoints = ParseEnum<KeypointSource>(
-      keypoints, {{"network", KeypointSource::kNetwork}, {"files", KeypointSource::kFiles},
-                  {"both", KeypointSource::kBoth}},
-      path, evidence.Name("keypoints_2d"));
-  job.masks = ParseEnum<MaskSource>(
-      masks, {{"none", MaskSource::kNone}, {"files", MaskSource::kFiles},
-              {"network", MaskSource::kNetwork}},
-      path, evidence.Name("masks"));
+  job.keypoints = ParseEnum<KeypointSource>(keypoints,
+                                            {{"network", KeypointSource::kNetwork},
+                                             {"files", KeypointSource::kFiles},
+                                             {"both", KeypointSource::kBoth}},
+                                            path, evidence.Name("keypoints_2d"));
+  job.masks = ParseEnum<MaskSource>(masks,
+                                    {{"none", MaskSource::kNone},
+                                     {"files", MaskSource::kFiles},
+                                     {"network", MaskSource::kNetwork}},
+                                    path, evidence.Name("masks"));
   evidence.RejectUnknownKeys();
 
   Section output = top.Child("output");

@@ -22,12 +22,16 @@ struct QualityThresholds {
   double min_confidence = 0.3;
   // Fewest views with the hand visible for a frame to be labelled at all.
   int min_views = 2;
+  // Plausible hand span (largest distance between two of the 21 keypoints, metres);
+  // outside it the network's answer is rejected as out of range.
+  double min_hand_span_m = 0.05;
+  double max_hand_span_m = 0.35;
 };
 
 struct JobConfig {
   std::string source_file;  // the YAML file (for error messages)
   std::string name = "job";
-  uint64_t seed = 0;        // recorded in every label; drives any randomness
+  uint64_t seed = 0;  // recorded in every label; drives any randomness
 
   // input
   std::string input_format = "native";  // native | dexycb | ho3d | oakink

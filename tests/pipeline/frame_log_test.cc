@@ -50,6 +50,23 @@ TEST(FrameLog, PartialLastLineFromACrashIsIgnored) {
   EXPECT_FALSE(log.IsDone("b"));
 }
 
+TEST(FrameLog, AppendAfterAPartialLineStartsAFreshLine) {
+  const std::string path = TempDir() + "/log.jsonl";
+  {
+    FrameLog log(path);
+    log.Record({"a", "ok", "network", "", 0});
+  }
+  std::ofstream(path, std::ios::app) << "{\"frame\": \"b\", \"sta";  // killed mid-write
+  {
+    FrameLog log(path);
+    log.Record({"b", "ok", "fit", "", 0, {{"labels/mpjpe_mm", 2.5}}});
+  }
+  const auto records = FrameLog::Read(path);  // would throw on a glued line
+  ASSERT_EQ(records.size(), 2u);
+  EXPECT_EQ(records[1].frame, "b");
+  EXPECT_EQ(records[1].metrics.at("labels/mpjpe_mm"), 2.5);
+}
+
 TEST(FrameLog, MalformedCompleteLineNamesFileAndLine) {
   const std::string path = TempDir() + "/log.jsonl";
   std::ofstream(path) << "{\"frame\":\"a\",\"status\":\"ok\"}\n{\"frame\":\"b\"}\n";
@@ -68,7 +85,8 @@ TEST(AtomicFile, ReplacesContentAndLeavesNoTemporary) {
   WriteFileAtomically(path, "second");
   EXPECT_EQ(ReadAll(path), "second");
   int files = 0;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) files += e.is_regular_file();
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    files += e.is_regular_file();
   EXPECT_EQ(files, 1);
   std::ofstream(dir + "/sub/x.json.tmp.123") << "half";
   EXPECT_EQ(RemoveStaleTemporaries(dir), 1);

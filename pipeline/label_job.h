@@ -1,0 +1,72 @@
+#pragma once
+// The labeling runner: for the frames of one shard, read -> batched network
+// inference -> quality checks -> refine or fallback fit (label_policy.h) -> atomic
+// writes (label_record.h), with TBB over frames.
+//
+//  - Resume: a frame is finished once its files are renamed into place and its record
+//    appended to the shard log (frame_log.h). A re-run with resume skips finished
+//    frames, so `kill -9` at any moment loses no finished frame; leftovers of
+//    interrupted writes (*.tmp.<pid>) of the shard's frames are removed at start.
+//  - Failure isolation: a frame that throws at any stage is recorded as failed with
+//    the exception's message; the job goes on. A re-run tries failed frames again.
+//  - Shards: ShardSpec picks a deterministic contiguous part of the frames (shard.h).
+//    A run of the whole job (shard 0/1) also merges (manifest + summary).
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "pipeline/job_config.h"
+#include "pipeline/label_record.h"
+#include "pipeline/label_stages.h"
+#include "pipeline/label_summary.h"
+#include "pipeline/shard.h"
+
+namespace handlabel {
+
+// Draws the label onto every view of the frame (mesh and keypoints); implementations
+// write with WriteFileAtomically. Thread-safe.
+class OverlayWriter {
+ public:
+  virtual ~OverlayWriter() = default;
+  virtual void Write(const std::string& output_dir, const FrameInput& frame,
+                     const LabelRecord& label) const = 0;
+};
+
+// What a job runs with; built from the job by label_stage_factory.h, or by tests.
+struct LabelStageSet {
+  const FrameSource* source = nullptr;      // required
+  MeshPredictor* predictor = nullptr;       // nullptr: the job has no network
+  const HandFitter* fitter = nullptr;       // nullptr: refine off and no baseline
+  const OverlayWriter* overlays = nullptr;  // nullptr: no overlay pictures
+  std::string hand_model_name;              // recorded in provenance
+  HandSide side = HandSide::kRight;
+  Faces faces;  // for mesh files
+};
+
+struct LabelRunOptions {
+  ShardSpec shard;              // which part of the frames (default: all)
+  bool resume = false;          // skip frames finished by earlier runs
+  bool force = false;           // label every frame again (discards the shard's log)
+  bool interactive = false;     // progress bar instead of plain lines
+  std::ostream* log = nullptr;  // progress and summary; nullptr = quiet
+};
+
+// Hash of everything in the job that can change a label (inputs, cameras, hand model,
+// the weights' content, refine mode and thresholds, evidence, seed), not of where the
+// outputs go or how many threads run. SHA-256 hex.
+std::string JobHash(const JobConfig& job, const std::string& weights_sha256);
+
+// The job's frames from every frame of the capture, per job field input.frames:
+// "all", "a:b" (half-open range of positions in the sorted list) or "id,id,...".
+// Throws InputError naming `source` and input.frames for an unknown id or a bad range.
+std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames,
+                                      const std::string& spec, const std::string& source);
+
+// Runs the shard; returns its summary (also written to the shard's summary file).
+// Throws InputError when the output folder belongs to another job (unless force), or
+// holds finished frames of this shard and neither resume nor force is set.
+LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
+                         const LabelRunOptions& options);
+
+}  // namespace handlabel

@@ -1,0 +1,143 @@
+#include "pipeline/label_outputs.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "pipeline/atomic_file.h"
+#include "pipeline/label_record.h"
+
+namespace handlabel {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ShardStem(const std::string& output_dir, const ShardSpec& shard) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "shard-%05d-of-%05d", shard.index, shard.count);
+  return output_dir + "/shards/" + name;
+}
+
+// "name.ext.tmp.<pid>" -> "name.ext"; "" if not a temporary.
+std::string TemporaryTarget(const std::string& file_name) {
+  const size_t at = file_name.rfind(".tmp.");
+  return at == std::string::npos ? "" : file_name.substr(0, at);
+}
+
+}  // namespace
+
+std::string ShardLogPath(const std::string& output_dir, const ShardSpec& shard) {
+  return ShardStem(output_dir, shard) + ".jsonl";
+}
+std::string ShardSummaryPath(const std::string& output_dir, const ShardSpec& shard) {
+  return ShardStem(output_dir, shard) + ".summary.json";
+}
+std::string JobStampPath(const std::string& output_dir) {
+  return output_dir + "/job.json";
+}
+std::string ManifestPath(const std::string& output_dir) {
+  return output_dir + "/manifest.json";
+}
+std::string SummaryJsonPath(const std::string& output_dir) {
+  return output_dir + "/summary.json";
+}
+std::string SummaryMarkdownPath(const std::string& output_dir) {
+  return output_dir + "/summary.md";
+}
+std::string OverlayPath(const std::string& output_dir, const std::string& frame,
+                        const std::string& camera) {
+  return output_dir + "/overlays/" + FrameFileStem(frame, "frame id") + "/" +
+         FrameFileStem(camera, "camera name") + ".png";
+}
+
+std::map<std::string, FrameRecord> ReadShardLogs(const std::string& output_dir) {
+  std::map<std::string, FrameRecord> latest;
+  const fs::path dir = fs::path(output_dir) / "shards";
+  if (!fs::is_directory(dir)) return latest;
+  std::vector<fs::path> logs;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() == ".jsonl") logs.push_back(entry.path());
+  }
+  std::sort(logs.begin(), logs.end());  // deterministic when logs disagree
+  for (const fs::path& log : logs) {
+    for (FrameRecord& r : FrameLog::Read(log.string())) {
+      auto it = latest.find(r.frame);
+      if (it == latest.end() || r.status == "ok" || it->second.status != "ok") {
+        latest[r.frame] = std::move(r);
+      }
+    }
+  }
+  return latest;
+}
+
+LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string& job_name,
+                               const std::string& job_hash,
+                               const std::vector<std::string>& frames) {
+  std::map<std::string, FrameRecord> records = ReadShardLogs(output_dir);
+  nlohmann::json entries = nlohmann::json::array();
+  for (const std::string& frame : frames) {
+    auto it = records.find(frame);
+    nlohmann::json entry = {{"frame", frame}};
+    const std::string label = "labels/" + FrameFileStem(frame, "frame id") + ".json";
+    if (it != records.end() && it->second.status == "ok" &&
+        !fs::exists(output_dir + "/" + label)) {
+      records.erase(it);  // logged but the file is gone: label it again
+      it = records.end();
+    }
+    if (it == records.end()) {
+      entry["status"] = "missing";
+    } else if (it->second.status == "ok") {
+      entry["status"] = "ok";
+      entry["path"] = it->second.path;
+      entry["label"] = label;
+    } else {
+      entry["status"] = "failed";
+      entry["reason"] = it->second.reason;
+    }
+    entries.push_back(entry);
+  }
+  LabelSummary summary = Summarize(frames, records);
+  const nlohmann::json manifest = {{"format", "handlabel-manifest"},
+                                   {"format_version", 1},
+                                   {"job", job_name},
+                                   {"job_hash", job_hash},
+                                   {"frames", entries},
+                                   {"counts",
+                                    {{"frames", summary.frames},
+                                     {"ok", summary.ok},
+                                     {"failed", summary.failed},
+                                     {"missing", summary.missing},
+                                     {"by_path", summary.by_path}}}};
+  WriteFileAtomically(ManifestPath(output_dir), manifest.dump(1) + "\n");
+  WriteFileAtomically(SummaryJsonPath(output_dir), summary.ToJson().dump(1) + "\n");
+  WriteFileAtomically(SummaryMarkdownPath(output_dir),
+                      "# Labeling job " + job_name + "\n\n" + summary.ToMarkdown());
+  return summary;
+}
+
+int RemoveStaleFrameTemporaries(const std::string& output_dir,
+                                const std::vector<std::string>& frames) {
+  std::set<std::string> stems;
+  for (const std::string& f : frames) stems.insert(FrameFileStem(f, "frame id"));
+  int removed = 0;
+  for (const char* sub : {"labels", "meshes", "overlays"}) {
+    const fs::path dir = fs::path(output_dir) / sub;
+    if (!fs::is_directory(dir)) continue;
+    for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+      if (!entry.is_regular_file()) continue;
+      const std::string target = TemporaryTarget(entry.path().filename().string());
+      if (target.empty()) continue;
+      // labels/<stem>.json, meshes/<stem>.<ext>, overlays/<stem>/<camera>.png
+      const std::string stem = std::string(sub) == "overlays"
+                                   ? entry.path().parent_path().filename().string()
+                                   : fs::path(target).stem().string();
+      if (stems.count(stem)) {
+        fs::remove(entry.path());
+        ++removed;
+      }
+    }
+  }
+  return removed;
+}
+
+}  // namespace handlabel

@@ -1,0 +1,48 @@
+#pragma once
+// The layout of a labeling job's output folder (output.dir) and the merge of shards:
+//   job.json                          job name and hash (a folder holds one job)
+//   labels/<frame>.json               one label per frame (label_record.h)
+//   meshes/<frame>.ply|.obj           optional meshes
+//   overlays/<frame>/<camera>.png     optional overlay pictures
+//   shards/shard-<i>-of-<N>.jsonl     resume log of shard i (frame_log.h)
+//   shards/shard-<i>-of-<N>.summary.json   what that shard's last run did
+//   manifest.json, summary.json, summary.md   written by merge (and by a 1-shard run)
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "pipeline/frame_log.h"
+#include "pipeline/label_summary.h"
+#include "pipeline/shard.h"
+
+namespace handlabel {
+
+std::string ShardLogPath(const std::string& output_dir, const ShardSpec& shard);
+std::string ShardSummaryPath(const std::string& output_dir, const ShardSpec& shard);
+std::string JobStampPath(const std::string& output_dir);
+std::string ManifestPath(const std::string& output_dir);
+std::string SummaryJsonPath(const std::string& output_dir);
+std::string SummaryMarkdownPath(const std::string& output_dir);
+std::string OverlayPath(const std::string& output_dir, const std::string& frame,
+                        const std::string& camera);
+
+// The latest record per frame over every shard log in the folder (logs of any shard
+// count, so a job may be re-sharded between runs). An ok record wins over a failed
+// one: labels are deterministic, so any ok label of the job is the label.
+std::map<std::string, FrameRecord> ReadShardLogs(const std::string& output_dir);
+
+// Joins the shards: every frame of `frames` with its latest record; an ok record whose
+// label file is missing counts as missing. Writes manifest.json (frames, status, path,
+// label file, reason: nothing run-dependent, so it is identical however the job was
+// sharded), summary.json and summary.md, each atomically, and returns the summary.
+LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string& job_name,
+                               const std::string& job_hash,
+                               const std::vector<std::string>& frames);
+
+// Removes leftovers of interrupted atomic writes that belong to `frames` (never other
+// shards' files, which may be in flight). Returns how many were removed.
+int RemoveStaleFrameTemporaries(const std::string& output_dir,
+                                const std::vector<std::string>& frames);
+
+}  // namespace handlabel

@@ -1,0 +1,30 @@
+#pragma once
+// Builds the stages of a labeling job from its config: the capture reader for
+// input.format, the network for network.weights, the fitter for refine.mode (and
+// output.baseline), the hand model and the overlay writer.
+
+#include <memory>
+
+#include "core/hand_model.h"
+#include "pipeline/job_config.h"
+#include "pipeline/label_job.h"
+
+namespace handlabel {
+
+struct BuiltLabelStages {
+  std::unique_ptr<FrameSource> source;
+  std::unique_ptr<MeshPredictor> predictor;
+  std::unique_ptr<HandFitter> fitter;
+  std::unique_ptr<OverlayWriter> overlays;
+  HandModel hand_model;
+  // Views of the above for RunLabelJob.
+  LabelStageSet Set() const;
+};
+
+// Throws InputError naming the job file and the field whose stage cannot be built.
+BuiltLabelStages BuildLabelStages(const JobConfig& job);
+
+// Only the frame source (what `handlabel merge` needs to list the job's frames).
+std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job);
+
+}  // namespace handlabel

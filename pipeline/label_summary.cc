@@ -1,0 +1,169 @@
+#include "pipeline/label_summary.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace handlabel {
+namespace {
+
+// Groups in report order, then metrics in report order.
+const std::vector<std::string> kGroupOrder = {"labels",       "network",     "refined",
+                                              "fallback_fit", "network_raw", "fit_only"};
+const std::vector<std::pair<std::string, std::string>> kMetricColumns = {
+    {"mpjpe_mm", "MPJPE mm"},
+    {"pa_mpjpe_mm", "PA-MPJPE mm"},
+    {"mpvpe_mm", "MPVPE mm"},
+    {"auc", "AUC 0-50mm"}};
+
+std::string Number(double value, int decimals) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.*f", decimals, value);
+  return text;
+}
+
+std::vector<std::string> GroupsInOrder(
+    const std::map<std::string, std::map<std::string, MetricMean>>& metrics) {
+  std::vector<std::string> groups;
+  for (const std::string& g : kGroupOrder) {
+    if (metrics.count(g)) groups.push_back(g);
+  }
+  for (const auto& [g, unused] : metrics) {
+    if (std::find(kGroupOrder.begin(), kGroupOrder.end(), g) == kGroupOrder.end()) {
+      groups.push_back(g);
+    }
+  }
+  return groups;
+}
+
+int GroupFrames(const std::map<std::string, MetricMean>& metrics) {
+  const auto it = metrics.find("mpjpe_mm");
+  return it == metrics.end() ? 0 : it->second.count;
+}
+
+}  // namespace
+
+LabelSummary Summarize(const std::vector<std::string>& frames,
+                       const std::map<std::string, FrameRecord>& records) {
+  LabelSummary s;
+  s.frames = static_cast<int>(frames.size());
+  for (const std::string& frame : frames) {
+    const auto it = records.find(frame);
+    if (it == records.end()) {
+      ++s.missing;
+      continue;
+    }
+    const FrameRecord& r = it->second;
+    s.frame_seconds += r.seconds;
+    if (r.status == "ok") {
+      ++s.ok;
+      ++s.by_path[r.path];
+    } else {
+      ++s.failed;
+      s.failures.emplace_back(frame, r.reason);
+    }
+    for (const auto& [key, value] : r.metrics) {
+      const size_t slash = key.find('/');
+      if (slash == std::string::npos) continue;
+      MetricMean& m = s.metrics[key.substr(0, slash)][key.substr(slash + 1)];
+      m.sum += value;
+      ++m.count;
+    }
+  }
+  return s;
+}
+
+nlohmann::json LabelSummary::ToJson() const {
+  nlohmann::json j = {{"frames", frames},
+                      {"ok", ok},
+                      {"failed", failed},
+                      {"missing", missing},
+                      {"skipped", skipped},
+                      {"by_path", by_path},
+                      {"frame_seconds", frame_seconds},
+                      {"wall_seconds", wall_seconds}};
+  nlohmann::json fails = nlohmann::json::array();
+  for (const auto& [frame, reason] : failures)
+    fails.push_back({{"frame", frame}, {"reason", reason}});
+  j["failures"] = fails;
+  nlohmann::json groups = nlohmann::json::object();
+  for (const auto& [group, metrics] : this->metrics) {
+    nlohmann::json g = {{"frames", GroupFrames(metrics)}};
+    for (const auto& [name, mean] : metrics) g[name] = mean.Mean();
+    groups[group] = g;
+  }
+  j["metrics"] = groups;
+  return j;
+}
+
+std::string LabelSummary::ToText() const {
+  std::ostringstream out;
+  out << frames << " frames: " << ok << " labelled";
+  for (const auto& [path, count] : by_path) out << " (" << path << " " << count << ")";
+  out << ", " << failed << " failed";
+  if (missing > 0) out << ", " << missing << " not yet run";
+  if (skipped > 0) out << ", " << skipped << " skipped (done before)";
+  out << "\n";
+  if (wall_seconds > 0) {
+    out << "time: " << Number(wall_seconds, 1) << " s wall, " << Number(frame_seconds, 1)
+        << " s summed over frames\n";
+  } else {
+    out << "time: " << Number(frame_seconds, 1) << " s summed over frames\n";
+  }
+  const size_t shown = std::min<size_t>(failures.size(), 10);
+  for (size_t i = 0; i < shown; ++i) {
+    out << "  failed " << failures[i].first << ": " << failures[i].second << "\n";
+  }
+  if (failures.size() > shown)
+    out << "  ... and " << failures.size() - shown << " more\n";
+  for (const std::string& group : GroupsInOrder(metrics)) {
+    const auto& m = metrics.at(group);
+    out << "  " << group << " (" << GroupFrames(m) << " frames):";
+    for (const auto& [key, title] : kMetricColumns) {
+      if (m.count(key))
+        out << " " << title << " " << Number(m.at(key).Mean(), key == "auc" ? 3 : 2);
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+std::string LabelSummary::ToMarkdown() const {
+  std::ostringstream out;
+  out << "| frames | labelled | failed | not run | frame time (s) "
+         "|\n|---|---|---|---|---|\n"
+      << "| " << frames << " | " << ok << " | " << failed << " | " << missing << " | "
+      << Number(frame_seconds, 1) << " |\n\n";
+  if (!by_path.empty()) {
+    out << "| path | frames |\n|---|---|\n";
+    for (const auto& [path, count] : by_path)
+      out << "| " << path << " | " << count << " |\n";
+    out << "\n";
+  }
+  if (!metrics.empty()) {
+    out << "| group | frames |";
+    for (const auto& [key, title] : kMetricColumns) out << " " << title << " |";
+    out << "\n|---|---|";
+    for (size_t i = 0; i < kMetricColumns.size(); ++i) out << "---|";
+    out << "\n";
+    for (const std::string& group : GroupsInOrder(metrics)) {
+      const auto& m = metrics.at(group);
+      out << "| " << group << " | " << GroupFrames(m) << " |";
+      for (const auto& [key, title] : kMetricColumns) {
+        out << " "
+            << (m.count(key) ? Number(m.at(key).Mean(), key == "auc" ? 3 : 2) : "-")
+            << " |";
+      }
+      out << "\n";
+    }
+    out << "\n";
+  }
+  if (!failures.empty()) {
+    out << "Failed frames:\n\n";
+    for (const auto& [frame, reason] : failures)
+      out << "- `" << frame << "`: " << reason << "\n";
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace handlabel

@@ -1,0 +1,169 @@
+#include "pipeline/quality_checks.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/triangulation.h"
+
+namespace handlabel {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string Format(double value) {
+  std::ostringstream out;
+  out.precision(3);
+  out << value;
+  return out.str();
+}
+
+int CountNonFinite(const MeshPrediction& p) {
+  int bad = 0;
+  bad += static_cast<int>((!p.vertices.array().isFinite()).count());
+  bad += static_cast<int>((!p.keypoints.array().isFinite()).count());
+  for (const Keypoints2d& view : p.keypoints_2d) {
+    bad += static_cast<int>((!view.uv_px.array().isFinite()).count());
+    bad += static_cast<int>((!view.confidence.array().isFinite()).count());
+  }
+  return bad;
+}
+
+double HandSpan(const Points3d& keypoints) {
+  double span = 0;
+  for (int i = 0; i < keypoints.rows(); ++i) {
+    for (int j = i + 1; j < keypoints.rows(); ++j) {
+      span = std::max(span, (keypoints.row(i) - keypoints.row(j)).norm());
+    }
+  }
+  return span;
+}
+
+}  // namespace
+
+bool QualityReport::Passed() const {
+  for (const QualityFlag& f : flags) {
+    if (!f.passed) return false;
+  }
+  return true;
+}
+
+std::string QualityReport::FailedNames() const {
+  std::string names;
+  for (const QualityFlag& f : flags) {
+    if (!f.passed) names += (names.empty() ? "" : ",") + f.name;
+  }
+  return names;
+}
+
+QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
+                              const QualityThresholds& t) {
+  QualityReport report;
+  const int num_views = static_cast<int>(rig.size());
+  const bool shapes_ok = prediction.keypoints.rows() == kNumHandKeypoints &&
+                         static_cast<int>(prediction.keypoints_2d.size()) == num_views;
+
+  QualityFlag finite{"finite", false, 0, 0, ""};
+  finite.value = CountNonFinite(prediction);
+  finite.passed = shapes_ok && finite.value == 0;
+  finite.detail = !shapes_ok ? "expected 21 keypoints and one 2D set per view"
+                             : Format(finite.value) + " non-finite values";
+  if (!finite.passed) {
+    report.flags.push_back(finite);
+    for (const char* name : {"range", "enough_views", "reprojection", "view_agreement"}) {
+      report.flags.push_back(
+          {name, false, kInf, 0, "not checked: prediction not finite"});
+    }
+    return report;
+  }
+  report.flags.push_back(finite);
+
+  // Which views count as evidence.
+  std::vector<bool> confident(num_views, false);
+  int confident_views = 0;
+  for (int v = 0; v < num_views; ++v) {
+    confident[v] = prediction.keypoints_2d[v].confidence.mean() >= t.min_confidence;
+    confident_views += confident[v];
+  }
+
+  QualityFlag range{"range", false, HandSpan(prediction.keypoints), t.max_hand_span_m,
+                    ""};
+  int behind = 0;
+  for (int v = 0; v < num_views; ++v) {
+    if (!confident[v]) continue;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      const Eigen::Vector3d p =
+          rig[v].cam_from_world * prediction.keypoints.row(k).transpose();
+      behind += p.z() <= 0;
+    }
+  }
+  range.passed =
+      range.value >= t.min_hand_span_m && range.value <= t.max_hand_span_m && behind == 0;
+  range.detail = "hand span " + Format(range.value) + " m (allowed " +
+                 Format(t.min_hand_span_m) + ".." + Format(t.max_hand_span_m) + "), " +
+                 std::to_string(behind) + " keypoint(s) behind a camera";
+  report.flags.push_back(range);
+
+  report.flags.push_back(
+      {"enough_views", confident_views >= t.min_views, double(confident_views),
+       double(t.min_views),
+       std::to_string(confident_views) + " of " + std::to_string(num_views) +
+           " views with mean confidence >= " + Format(t.min_confidence)});
+
+  QualityFlag reprojection{"reprojection", false, 0, t.max_reprojection_px, ""};
+  int worst_view = -1;
+  for (int v = 0; v < num_views; ++v) {
+    if (!confident[v]) continue;
+    double sum_sq = 0;
+    int count = 0;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (prediction.keypoints_2d[v].confidence(k) < t.min_confidence) continue;
+      Eigen::Vector2d uv;
+      const bool in_front =
+          rig[v].ProjectWorld(prediction.keypoints.row(k).transpose(), &uv);
+      const double err =
+          in_front ? (uv - prediction.keypoints_2d[v].uv_px.row(k).transpose()).norm()
+                   : kInf;
+      sum_sq += err * err;
+      ++count;
+    }
+    const double rms = count > 0 ? std::sqrt(sum_sq / count) : 0.0;
+    if (rms >= reprojection.value) {
+      reprojection.value = rms;
+      worst_view = v;
+    }
+  }
+  reprojection.passed =
+      confident_views > 0 && reprojection.value <= t.max_reprojection_px;
+  reprojection.detail = confident_views == 0
+                            ? "no confident view"
+                            : "worst view " + rig[worst_view].name + ": RMS " +
+                                  Format(reprojection.value) + " px";
+  report.flags.push_back(reprojection);
+
+  QualityFlag agreement{"view_agreement", false, kInf, t.max_view_disagreement_mm, ""};
+  double sum_mm = 0;
+  int triangulated = 0;
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    std::vector<ViewObservation> observations;
+    for (int v = 0; v < num_views; ++v) {
+      const double c = prediction.keypoints_2d[v].confidence(k);
+      if (!confident[v] || c < t.min_confidence) continue;
+      observations.push_back({v, prediction.keypoints_2d[v].uv_px.row(k).transpose(), c});
+    }
+    const auto point = TriangulateWeighted(rig, observations);
+    if (!point) continue;
+    sum_mm += 1000.0 * (*point - prediction.keypoints.row(k).transpose()).norm();
+    ++triangulated;
+  }
+  if (triangulated > 0) agreement.value = sum_mm / triangulated;
+  agreement.passed = triangulated > 0 && agreement.value <= t.max_view_disagreement_mm;
+  agreement.detail = triangulated == 0
+                         ? "no keypoint seen confidently in two views"
+                         : "mean distance " + Format(agreement.value) + " mm over " +
+                               std::to_string(triangulated) + " triangulated keypoints";
+  report.flags.push_back(agreement);
+  return report;
+}
+
+}  // namespace handlabel

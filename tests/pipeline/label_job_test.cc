@@ -1,0 +1,294 @@
+#include "pipeline/label_job.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/errors.h"
+#include "pipeline/frame_log.h"
+#include "pipeline/label_outputs.h"
+#include "tests/pipeline/label_test_stages.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using testing::TestCapture;
+using testing::TestFitter;
+using testing::TestPredictor;
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+JobConfig MakeJob(const std::string& out, RefineMode mode) {
+  JobConfig job;
+  job.source_file = "test.yaml";
+  job.name = "test";
+  job.seed = 5;
+  job.input_path = "memory";
+  job.output_dir = out;
+  job.refine_mode = mode;
+  job.threads = 2;
+  job.batch_size = 3;
+  job.network_weights = "weights.pt";
+  job.meshes = {"ply"};
+  return job;
+}
+
+struct Stages {
+  TestCapture capture{12};
+  TestPredictor predictor;
+  TestFitter fitter;
+  LabelStageSet Set(bool with_network = true) {
+    LabelStageSet set;
+    set.source = &capture;
+    set.predictor = with_network ? &predictor : nullptr;
+    set.fitter = &fitter;
+    set.hand_model_name = capture.model().name;
+    set.faces = capture.model().faces;
+    return set;
+  }
+};
+
+std::map<std::string, std::string> LabelPaths(const std::string& out) {
+  std::map<std::string, std::string> paths;
+  for (const FrameRecord& r : FrameLog::Read(ShardLogPath(out, {0, 1}))) {
+    if (r.status == "ok") paths[r.frame] = r.path;
+  }
+  return paths;
+}
+
+TEST(LabelJob, FallbackModeKeepsGoodNetworkAnswersAndFitsTheOthers) {
+  Stages s;
+  s.predictor.shifted = {"000002", "000007"};
+  const std::string out = testing::ScratchDir() + "/out";
+  const LabelSummary summary =
+      RunLabelJob(MakeJob(out, RefineMode::kFallback), s.Set(), {});
+  EXPECT_EQ(summary.ok, 12);
+  EXPECT_EQ(summary.failed, 0);
+  EXPECT_EQ(summary.by_path.at("network"), 10);
+  EXPECT_EQ(summary.by_path.at("fallback_fit"), 2);
+  const LabelRecord bad = ReadLabelFile(LabelFilePath(out, "000002"));
+  EXPECT_EQ(bad.path, LabelPath::kFallbackFit);
+  EXPECT_FALSE(bad.quality.Passed());
+  EXPECT_THAT(bad.fit.at("why").get<std::string>(), HasSubstr("view_agreement"));
+  const LabelRecord good = ReadLabelFile(LabelFilePath(out, "000003"));
+  EXPECT_EQ(good.path, LabelPath::kNetwork);
+  EXPECT_TRUE(good.quality.Passed());
+  EXPECT_EQ(good.provenance.network_model, "test-predictor");
+  EXPECT_EQ(good.provenance.job_hash,
+            JobHash(MakeJob(out, RefineMode::kFallback), s.predictor.WeightsSha256()));
+  EXPECT_TRUE(fs::exists(MeshFilePath(out, "000003", "ply")));
+  // The network's answer is the ground truth on good frames: zero error, full AUC.
+  EXPECT_NEAR(summary.metrics.at("network").at("mpjpe_mm").Mean(), 0.0, 1e-9);
+  EXPECT_NEAR(summary.metrics.at("network").at("auc").Mean(), 1.0, 1e-12);
+  EXPECT_EQ(summary.metrics.at("network_raw").at("mpjpe_mm").count, 12);
+  // A one-shard run merges itself.
+  EXPECT_TRUE(fs::exists(ManifestPath(out)));
+}
+
+TEST(LabelJob, RefineAlwaysRefinesEveryNetworkAnswer) {
+  Stages s;
+  const std::string out = testing::ScratchDir() + "/out";
+  const LabelSummary summary =
+      RunLabelJob(MakeJob(out, RefineMode::kAlways), s.Set(), {});
+  EXPECT_EQ(summary.by_path.at("refined"), 12);
+  EXPECT_EQ(s.fitter.fits.load(), 12);
+  const LabelRecord label = ReadLabelFile(LabelFilePath(out, "000000"));
+  EXPECT_TRUE(label.fit.at("refined_from_network").get<bool>());
+}
+
+TEST(LabelJob, RefineAlwaysWithoutNetworkFitsFromFileEvidence) {
+  Stages s;
+  const std::string out = testing::ScratchDir() + "/out";
+  JobConfig job = MakeJob(out, RefineMode::kAlways);
+  job.network_weights = "";
+  job.keypoints = KeypointSource::kFiles;
+  const LabelSummary summary = RunLabelJob(job, s.Set(false), {});
+  EXPECT_EQ(summary.by_path.at("fallback_fit"), 12);
+  EXPECT_LT(summary.metrics.at("labels").at("mpjpe_mm").Mean(), 1e-6);
+  const LabelRecord label = ReadLabelFile(LabelFilePath(out, "000004"));
+  EXPECT_EQ(label.provenance.network_model, "");
+  EXPECT_TRUE(label.quality.flags.empty());
+}
+
+TEST(LabelJob, RefineOffWritesTheNetworkAnswerWithItsFlags) {
+  Stages s;
+  s.predictor.shifted = {"000001"};
+  const std::string out = testing::ScratchDir() + "/out";
+  const LabelSummary summary = RunLabelJob(MakeJob(out, RefineMode::kOff), s.Set(), {});
+  EXPECT_EQ(summary.by_path.at("network"), 12);
+  EXPECT_EQ(s.fitter.fits.load(), 0);
+  EXPECT_FALSE(ReadLabelFile(LabelFilePath(out, "000001")).quality.Passed());
+}
+
+TEST(LabelJob, AFailingFrameIsRecordedWithItsReasonAndTheJobGoesOn) {
+  Stages s;
+  s.capture.unreadable = {"000001"};
+  s.predictor.throws = {"000004"};
+  s.predictor.shifted = {"000009"};
+  s.fitter.throws = {"000009"};
+  const std::string out = testing::ScratchDir() + "/out";
+  const LabelSummary summary =
+      RunLabelJob(MakeJob(out, RefineMode::kFallback), s.Set(), {});
+  EXPECT_EQ(summary.ok, 9);
+  EXPECT_EQ(summary.failed, 3);
+  std::map<std::string, std::string> reasons(summary.failures.begin(),
+                                             summary.failures.end());
+  EXPECT_THAT(reasons["000001"], HasSubstr("cannot read image"));
+  EXPECT_THAT(reasons["000004"], HasSubstr("network exploded"));
+  EXPECT_THAT(reasons["000009"], HasSubstr("solver diverged"));
+  EXPECT_FALSE(fs::exists(LabelFilePath(out, "000004")));
+  // The batch-mates of the throwing frame were predicted one by one and labelled.
+  EXPECT_TRUE(fs::exists(LabelFilePath(out, "000003")));
+  EXPECT_TRUE(fs::exists(LabelFilePath(out, "000005")));
+
+  // A resumed run retries only the failed frames.
+  s.capture.unreadable.clear();
+  s.predictor.throws.clear();
+  s.fitter.throws.clear();
+  s.capture.loads = 0;
+  LabelRunOptions resume;
+  resume.resume = true;
+  const LabelSummary again =
+      RunLabelJob(MakeJob(out, RefineMode::kFallback), s.Set(), resume);
+  EXPECT_EQ(s.capture.loads.load(), 3);
+  EXPECT_EQ(again.ok, 12);
+  EXPECT_EQ(again.skipped, 9);
+}
+
+TEST(LabelJob, ResumeRedoesExactlyTheUnfinishedFramesAndGivesIdenticalLabels) {
+  Stages s;
+  const std::string out = testing::ScratchDir() + "/out";
+  const JobConfig job = MakeJob(out, RefineMode::kFallback);
+  RunLabelJob(job, s.Set(), {});
+  std::map<std::string, std::string> before;
+  for (const std::string& f : s.capture.FrameIds())
+    before[f] = ReadAll(LabelFilePath(out, f));
+
+  // Simulate a crash: the log lost its last 4 records (one torn), two of those labels
+  // never reached disk and a temporary was left behind.
+  const std::string log_path = ShardLogPath(out, {0, 1});
+  std::string log = ReadAll(log_path);
+  for (int i = 0; i < 4; ++i) log.erase(log.rfind('\n', log.size() - 2) + 1);
+  log += "{\"frame\": \"0000";
+  std::ofstream(log_path, std::ios::binary | std::ios::trunc) << log;
+  std::vector<std::string> lost;
+  for (const auto& [frame, path] : LabelPaths(out)) lost.push_back(frame);
+  ASSERT_EQ(lost.size(), 8u);
+  std::vector<std::string> unfinished;
+  for (const std::string& f : s.capture.FrameIds()) {
+    if (!std::count(lost.begin(), lost.end(), f)) unfinished.push_back(f);
+  }
+  fs::remove(LabelFilePath(out, unfinished[0]));
+  fs::remove(LabelFilePath(out, unfinished[1]));
+  std::ofstream(LabelFilePath(out, unfinished[2]) + ".tmp.12345")
+      << "{\"format\": \"hand";
+
+  EXPECT_THROW(RunLabelJob(job, s.Set(), {}), InputError);  // neither resume nor force
+  s.capture.loads = 0;
+  LabelRunOptions resume;
+  resume.resume = true;
+  const LabelSummary summary = RunLabelJob(job, s.Set(), resume);
+  EXPECT_EQ(s.capture.loads.load(), 4);
+  EXPECT_EQ(summary.skipped, 8);
+  EXPECT_EQ(summary.ok, 12);
+  EXPECT_FALSE(fs::exists(LabelFilePath(out, unfinished[2]) + ".tmp.12345"));
+  for (const auto& [frame, text] : before)
+    EXPECT_EQ(ReadAll(LabelFilePath(out, frame)), text);
+
+  // --force labels everything again.
+  s.capture.loads = 0;
+  LabelRunOptions force;
+  force.force = true;
+  RunLabelJob(job, s.Set(), force);
+  EXPECT_EQ(s.capture.loads.load(), 12);
+}
+
+TEST(LabelJob, ShardsPartitionTheFramesAndTheirMergeEqualsOneProcess) {
+  Stages s;
+  s.predictor.shifted = {"000005"};
+  const std::string root = testing::ScratchDir();
+  RunLabelJob(MakeJob(root + "/single", RefineMode::kFallback), s.Set(), {});
+
+  s.capture.loads = 0;
+  const JobConfig sharded = MakeJob(root + "/sharded", RefineMode::kFallback);
+  for (int i = 2; i >= 0; --i) {
+    LabelRunOptions options;
+    options.shard = {i, 3};
+    const LabelSummary summary = RunLabelJob(sharded, s.Set(), options);
+    EXPECT_EQ(summary.frames, 4);
+  }
+  EXPECT_EQ(s.capture.loads.load(), 12);  // every frame exactly once
+  const std::vector<std::string> frames = s.capture.FrameIds();
+  const std::string hash = JobHash(sharded, s.predictor.WeightsSha256());
+  const LabelSummary merged = MergeLabelOutputs(root + "/sharded", "test", hash, frames);
+  EXPECT_EQ(merged.ok, 12);
+  EXPECT_EQ(ReadAll(ManifestPath(root + "/sharded")),
+            ReadAll(ManifestPath(root + "/single")));
+  for (const std::string& f : frames) {
+    EXPECT_EQ(ReadAll(LabelFilePath(root + "/sharded", f)),
+              ReadAll(LabelFilePath(root + "/single", f)))
+        << f;
+  }
+}
+
+TEST(LabelJob, MergeReportsFramesNoShardHasLabelledYet) {
+  Stages s;
+  const std::string out = testing::ScratchDir() + "/out";
+  const JobConfig job = MakeJob(out, RefineMode::kFallback);
+  LabelRunOptions options;
+  options.shard = {1, 4};
+  RunLabelJob(job, s.Set(), options);
+  const LabelSummary merged =
+      MergeLabelOutputs(out, "test", JobHash(job, "x"), s.capture.FrameIds());
+  EXPECT_EQ(merged.ok, 3);
+  EXPECT_EQ(merged.missing, 9);
+}
+
+TEST(LabelJob, RefusesAnOutputFolderOfAnotherJob) {
+  Stages s;
+  const std::string out = testing::ScratchDir() + "/out";
+  RunLabelJob(MakeJob(out, RefineMode::kFallback), s.Set(), {});
+  JobConfig other = MakeJob(out, RefineMode::kFallback);
+  other.seed = 6;
+  LabelRunOptions resume;
+  resume.resume = true;
+  try {
+    RunLabelJob(other, s.Set(), resume);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("job.json"));
+    EXPECT_THAT(e.what(), HasSubstr("different job"));
+  }
+}
+
+TEST(LabelJob, SelectFramesByRangeAndIds) {
+  const std::vector<std::string> all = {"a", "b", "c", "d"};
+  EXPECT_EQ(SelectFrames(all, "all", "j"), all);
+  EXPECT_EQ(SelectFrames(all, "1:3", "j"), (std::vector<std::string>{"b", "c"}));
+  EXPECT_EQ(SelectFrames(all, ":2", "j"), (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(SelectFrames(all, "d, b", "j"), (std::vector<std::string>{"b", "d"}));
+  EXPECT_THROW(SelectFrames(all, "2:9", "j"), InputError);
+  EXPECT_THROW(SelectFrames(all, "x", "j"), InputError);
+}
+
+TEST(LabelJob, JobHashIgnoresWhereOutputsGoButNotWhatChangesLabels) {
+  JobConfig a = MakeJob("/tmp/a", RefineMode::kFallback);
+  JobConfig b = MakeJob("/tmp/b", RefineMode::kFallback);
+  b.threads = 1;
+  b.batch_size = 8;
+  EXPECT_EQ(JobHash(a, "w"), JobHash(b, "w"));
+  EXPECT_NE(JobHash(a, "w"), JobHash(a, "v"));
+  b.quality.max_reprojection_px = 3;
+  EXPECT_NE(JobHash(a, "w"), JobHash(b, "w"));
+}
+
+}  // namespace
+}  // namespace handlabel

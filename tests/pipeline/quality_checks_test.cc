@@ -1,0 +1,121 @@
+#include "pipeline/quality_checks.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/pipeline/label_test_stages.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+using testing::MakeFourCameraRig;
+using testing::ProjectKeypoints;
+
+// The stick hand in a random pose near the origin, with exact 2D keypoints in all views.
+MeshPrediction ExactPrediction(const Rig& rig) {
+  const HandModel model = testing::MakeStickHand(HandSide::kRight);
+  HandParams params;
+  params.global_orient = testing::RandomVector3(-0.3, 0.3);
+  for (int i = 0; i < kNumPoseParams; ++i) params.hand_pose[i] = testing::Gaussian(0.1);
+  params.transl = Eigen::Vector3d(0.08, 0, 0) + testing::RandomVector3(-0.03, 0.03);
+  const HandMesh mesh = PoseHand(model, params);
+  MeshPrediction p;
+  p.keypoints = mesh.keypoints;
+  p.vertices = mesh.vertices;
+  for (const RigCamera& camera : rig.cameras()) {
+    p.keypoints_2d.push_back(ProjectKeypoints(camera, mesh.keypoints));
+  }
+  return p;
+}
+
+const QualityFlag& Flag(const QualityReport& report, const std::string& name) {
+  for (const QualityFlag& f : report.flags) {
+    if (f.name == name) return f;
+  }
+  throw std::runtime_error("no flag " + name);
+}
+
+TEST(QualityChecks, AnExactPredictionPassesEveryCheck) {
+  const Rig rig = MakeFourCameraRig();
+  const QualityReport report = CheckPrediction(rig, ExactPrediction(rig), {});
+  ASSERT_EQ(report.flags.size(), 5u);
+  EXPECT_TRUE(report.Passed()) << report.FailedNames();
+  EXPECT_NEAR(Flag(report, "reprojection").value, 0.0, 1e-6);
+  EXPECT_NEAR(Flag(report, "view_agreement").value, 0.0, 1e-6);
+  EXPECT_EQ(Flag(report, "enough_views").value, 4);
+  EXPECT_GT(Flag(report, "range").value, 0.1);  // the stick hand spans ~19 cm
+  EXPECT_LT(Flag(report, "range").value, 0.25);
+}
+
+TEST(QualityChecks, A3dOffsetFailsReprojectionAndViewAgreementWithTheRightSize) {
+  const Rig rig = MakeFourCameraRig();
+  MeshPrediction p = ExactPrediction(rig);
+  p.keypoints.rowwise() += Eigen::RowVector3d(0.02, 0, 0);  // 2D stays at the truth
+  const QualityReport report = CheckPrediction(rig, p, {});
+  EXPECT_EQ(report.FailedNames(), "reprojection,view_agreement");
+  EXPECT_NEAR(Flag(report, "view_agreement").value, 20.0, 1e-6);  // exactly the offset
+  // 2 cm at ~0.6 m with f = 600 px moves a point by up to ~20 px.
+  EXPECT_GT(Flag(report, "reprojection").value, 12.0);
+}
+
+TEST(QualityChecks, ThresholdsComeFromTheJob) {
+  const Rig rig = MakeFourCameraRig();
+  MeshPrediction p = ExactPrediction(rig);
+  p.keypoints.rowwise() += Eigen::RowVector3d(0.005, 0, 0);
+  QualityThresholds loose;
+  EXPECT_TRUE(CheckPrediction(rig, p, loose).Passed());
+  QualityThresholds strict;
+  strict.max_view_disagreement_mm = 4.0;
+  strict.max_reprojection_px = 1.0;
+  EXPECT_EQ(CheckPrediction(rig, p, strict).FailedNames(), "reprojection,view_agreement");
+}
+
+TEST(QualityChecks, OneBadViewFailsReprojectionAndNamesThatView) {
+  const Rig rig = MakeFourCameraRig();
+  MeshPrediction p = ExactPrediction(rig);
+  p.keypoints_2d[2].uv_px.col(0).array() += 30.0;
+  const QualityReport report = CheckPrediction(rig, p, {});
+  EXPECT_FALSE(Flag(report, "reprojection").passed);
+  EXPECT_NEAR(Flag(report, "reprojection").value, 30.0, 1e-6);
+  EXPECT_THAT(Flag(report, "reprojection").detail, ::testing::HasSubstr("cam2"));
+}
+
+TEST(QualityChecks, LowConfidenceViewsDoNotCountAsEvidence) {
+  const Rig rig = MakeFourCameraRig();
+  MeshPrediction p = ExactPrediction(rig);
+  for (int v = 0; v < 3; ++v) p.keypoints_2d[v].confidence.setConstant(0.1);
+  p.keypoints_2d[0].uv_px.array() += 50.0;  // ignored: not confident
+  const QualityReport report = CheckPrediction(rig, p, {});
+  EXPECT_EQ(Flag(report, "enough_views").value, 1);
+  EXPECT_FALSE(Flag(report, "enough_views").passed);
+  EXPECT_TRUE(Flag(report, "reprojection").passed);
+  EXPECT_FALSE(Flag(report, "view_agreement").passed);  // one view cannot triangulate
+}
+
+TEST(QualityChecks, NanFailsFiniteAndEverythingElse) {
+  const Rig rig = MakeFourCameraRig();
+  MeshPrediction p = ExactPrediction(rig);
+  p.vertices(3, 1) = std::nan("");
+  const QualityReport report = CheckPrediction(rig, p, {});
+  EXPECT_EQ(Flag(report, "finite").value, 1);
+  EXPECT_EQ(report.FailedNames(),
+            "finite,range,enough_views,reprojection,view_agreement");
+}
+
+TEST(QualityChecks, ImplausibleSizeOrAHandBehindACameraFailsRange) {
+  const Rig rig = MakeFourCameraRig();
+  MeshPrediction tiny = ExactPrediction(rig);
+  const Eigen::RowVector3d center = tiny.keypoints.colwise().mean();
+  tiny.keypoints = ((tiny.keypoints.rowwise() - center) * 0.1).rowwise() + center;
+  EXPECT_FALSE(Flag(CheckPrediction(rig, tiny, {}), "range").passed);
+
+  MeshPrediction behind = ExactPrediction(rig);
+  behind.keypoints.rowwise() += 1.5 * rig[0].CenterInWorld().transpose();
+  EXPECT_FALSE(Flag(CheckPrediction(rig, behind, {}), "range").passed);
+}
+
+}  // namespace
+}  // namespace handlabel
