@@ -1,4 +1,4 @@
-#include "fitting/hand_fitter.h"
+#include "fitting/ceres_hand_fitter.h"
 
 #include <ceres/ceres.h>
 
@@ -191,8 +191,8 @@ Eigen::Matrix<double, 45, 1> PoseMean(const HandModel& model) {
 
 }  // namespace
 
-HandFitter::HandFitter(const HandModel& model, const HandFitConfig& config,
-                       const HandFitOptions& options)
+CeresHandFitter::CeresHandFitter(const HandModel& model, const HandFitConfig& config,
+                                 const HandFitOptions& options)
     : model_(model),
       config_(config),
       options_(options),
@@ -285,7 +285,7 @@ class FitRun {
     }
   }
 
-  FitResult Fit(const FitInput& input, const HandParams& init) const {
+  HandFitResult Fit(const HandFitInput& input, const HandParams& init) const {
     const auto start = std::chrono::steady_clock::now();
     Blocks b = ToBlocks(init);
     Blocks previous;
@@ -295,7 +295,7 @@ class FitRun {
     const bool use_temporal = config_.use_temporal && input.previous.has_value();
     if (!input.masks.empty() && input.masks.size() != input.views.size()) {
       throw InputError(
-          "FitInput", "masks",
+          "HandFitInput", "masks",
           std::to_string(input.views.size()) + " masks (one per view) or none",
           std::to_string(input.masks.size()));
     }
@@ -303,7 +303,7 @@ class FitRun {
     for (const MaskImage& m : input.masks) use_sil |= m.size() > 0;
     use_sil &= config_.use_silhouettes && options_.silhouette_rounds > 0;
 
-    FitResult result;
+    HandFitResult result;
     auto add_evidence = [&](StageProblem* problem) {
       if (use_kp) {
         problem->AddFull("keypoints", MultiViewKeypointCostFunction::Create(
@@ -371,7 +371,7 @@ class FitRun {
         view.camera = input.views[v].camera;
         if (input.masks[v].rows() != view.camera.camera.height() ||
             input.masks[v].cols() != view.camera.camera.width()) {
-          throw InputError("FitInput", "masks[" + std::to_string(v) + "]",
+          throw InputError("HandFitInput", "masks[" + std::to_string(v) + "]",
                            "the camera's image size",
                            std::to_string(input.masks[v].cols()) + "x" +
                                std::to_string(input.masks[v].rows()));
@@ -399,7 +399,8 @@ class FitRun {
           const Eigen::Vector3d x = all.row(vertex_ids[i]).transpose();
           const Eigen::Vector3d n = normals.row(vertex_ids[i]).transpose();
           const double along = std::abs(n.dot((x - centre).normalized()));
-          valid[i] = n.squaredNorm() > 0.5 && along < options_.silhouette_contour_cosine &&
+          valid[i] = n.squaredNorm() > 0.5 &&
+                     along < options_.silhouette_contour_cosine &&
                      sil_views[v].camera.ProjectWorld(x, &uv[i]);
         }
         sil_views[v].outline_px = outlines[v].points;
@@ -504,8 +505,8 @@ class FitRun {
 
 }  // namespace
 
-HandParams HandFitter::InitFromKeypoints3d(const Points3d& keypoints,
-                                           const Eigen::VectorXd& weights) const {
+HandParams CeresHandFitter::InitFromKeypoints3d(const Points3d& keypoints,
+                                                const Eigen::VectorXd& weights) const {
   const Eigen::Vector3d fallback(0, 0, options_.fallback_depth_m);
   if (evaluator_.pose_dim() == 12) {
     return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
@@ -515,7 +516,7 @@ HandParams HandFitter::InitFromKeypoints3d(const Points3d& keypoints,
       .InitFromKeypoints3d(keypoints, weights, fallback);
 }
 
-HandParams HandFitter::InitFromViews(const std::vector<KeypointView>& views) const {
+HandParams CeresHandFitter::InitFromViews(const std::vector<KeypointView>& views) const {
   Rig rig;
   for (size_t v = 0; v < views.size(); ++v) {
     RigCamera camera = views[v].camera;
@@ -551,7 +552,8 @@ HandParams HandFitter::InitFromViews(const std::vector<KeypointView>& views) con
       .InitFromKeypoints3d(keypoints, weights, fallback);
 }
 
-FitResult HandFitter::Fit(const FitInput& input, const HandParams& init) const {
+HandFitResult CeresHandFitter::Fit(const HandFitInput& input,
+                                   const HandParams& init) const {
   if (evaluator_.pose_dim() == 12) {
     return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
         .Fit(input, init);

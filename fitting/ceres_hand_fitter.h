@@ -43,8 +43,8 @@ struct HandFitConfig {
   bool use_joint_limits = true;  // anatomical hinge limits
   bool use_pose_prior = true;
   bool use_shape_prior = true;
-  bool use_points3d = true;  // only if FitInput::targets3d is set
-  bool use_temporal = true;  // only if FitInput::previous is set
+  bool use_points3d = true;  // only if HandFitInput::targets3d is set
+  bool use_temporal = true;  // only if HandFitInput::previous is set
   void Check() const;
 };
 
@@ -65,7 +65,7 @@ struct HandFitOptions {
   double shape_prior_sigma = 1.0;
   // 3D targets: metres per residual unit.
   double points3d_sigma_m = 0.002;
-  // Temporal pull towards FitInput::previous (pose: radians, transl: metres).
+  // Temporal pull towards HandFitInput::previous (pose: radians, transl: metres).
   double temporal_pose_sigma_rad = 0.2;
   double temporal_transl_sigma_m = 0.02;
   // Silhouettes: pixels per residual unit; vertices used (every n-th); outline
@@ -94,7 +94,7 @@ struct HandFitOptions {
   void Check() const;
 };
 
-struct FitInput {
+struct HandFitInput {
   std::vector<KeypointView> views;  // 2D keypoints per view (may be empty)
   // Per view: silhouette mask (rows = image height), or empty = none for that view.
   // Empty vector = no silhouettes. Cameras come from `views`.
@@ -106,7 +106,7 @@ struct FitInput {
   const std::vector<PixelRays>* pixel_rays = nullptr;
 };
 
-struct FitResult {
+struct HandFitResult {
   HandParams params;
   Points3d vertices;   // V x 3, world frame
   Points3d keypoints;  // 21 x 3, SNAP order
@@ -124,11 +124,11 @@ struct FitResult {
   std::string message;     // Ceres' message of the last stage
 };
 
-class HandFitter {
+class CeresHandFitter {
  public:
   // Throws InputError if the options, config or model do not fit together.
-  HandFitter(const HandModel& model, const HandFitConfig& config = {},
-             const HandFitOptions& options = {});
+  CeresHandFitter(const HandModel& model, const HandFitConfig& config = {},
+                  const HandFitOptions& options = {});
 
   const HandEvaluator& evaluator() const { return evaluator_; }
   const HandFitConfig& config() const { return config_; }
@@ -144,7 +144,7 @@ class HandFitter {
   HandParams InitFromViews(const std::vector<KeypointView>& views) const;
 
   // Staged solve from `init`.
-  FitResult Fit(const FitInput& input, const HandParams& init) const;
+  HandFitResult Fit(const HandFitInput& input, const HandParams& init) const;
 
  private:
   HandModel model_;
