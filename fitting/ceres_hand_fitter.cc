@@ -1,4 +1,4 @@
-#include "fitting/hand_fitter.h"
+#include "fitting/ceres_hand_fitter.h"
 
 #include <ceres/ceres.h>
 
@@ -17,6 +17,7 @@
 #include "fitting/prior_costs.h"
 #include "fitting/silhouette_cost.h"
 #include "fitting/silhouette_outline.h"
+#include "fitting/silhouette_render.h"
 
 namespace handlabel {
 namespace {
@@ -156,6 +157,7 @@ void HandFitOptions::Check() const {
   }
   RequireNonNegative(silhouette_outline_samples, "silhouette_outline_samples");
   RequireNonNegative(silhouette_rounds, "silhouette_rounds");
+  RequirePositive(silhouette_contour_cosine, "silhouette_contour_cosine");
   RequireNonNegative(rigid_iterations, "rigid_iterations");
   RequireNonNegative(keypoint_iterations, "keypoint_iterations");
   RequireNonNegative(silhouette_iterations, "silhouette_iterations");
@@ -189,8 +191,8 @@ Eigen::Matrix<double, 45, 1> PoseMean(const HandModel& model) {
 
 }  // namespace
 
-HandFitter::HandFitter(const HandModel& model, const HandFitConfig& config,
-                       const HandFitOptions& options)
+CeresHandFitter::CeresHandFitter(const HandModel& model, const HandFitConfig& config,
+                                 const HandFitOptions& options)
     : model_(model),
       config_(config),
       options_(options),
@@ -283,7 +285,7 @@ class FitRun {
     }
   }
 
-  FitResult Fit(const FitInput& input, const HandParams& init) const {
+  HandFitResult Fit(const HandFitInput& input, const HandParams& init) const {
     const auto start = std::chrono::steady_clock::now();
     Blocks b = ToBlocks(init);
     Blocks previous;
@@ -293,7 +295,7 @@ class FitRun {
     const bool use_temporal = config_.use_temporal && input.previous.has_value();
     if (!input.masks.empty() && input.masks.size() != input.views.size()) {
       throw InputError(
-          "FitInput", "masks",
+          "HandFitInput", "masks",
           std::to_string(input.views.size()) + " masks (one per view) or none",
           std::to_string(input.masks.size()));
     }
@@ -301,7 +303,7 @@ class FitRun {
     for (const MaskImage& m : input.masks) use_sil |= m.size() > 0;
     use_sil &= config_.use_silhouettes && options_.silhouette_rounds > 0;
 
-    FitResult result;
+    HandFitResult result;
     auto add_evidence = [&](StageProblem* problem) {
       if (use_kp) {
         problem->AddFull("keypoints", MultiViewKeypointCostFunction::Create(
@@ -369,7 +371,7 @@ class FitRun {
         view.camera = input.views[v].camera;
         if (input.masks[v].rows() != view.camera.camera.height() ||
             input.masks[v].cols() != view.camera.camera.width()) {
-          throw InputError("FitInput", "masks[" + std::to_string(v) + "]",
+          throw InputError("HandFitInput", "masks[" + std::to_string(v) + "]",
                            "the camera's image size",
                            std::to_string(input.masks[v].cols()) + "x" +
                                std::to_string(input.masks[v].rows()));
@@ -383,15 +385,23 @@ class FitRun {
     }
     for (int round = 0; !sil_views.empty() && round < options_.silhouette_rounds;
          ++round) {
-      std::vector<double> verts(3 * vertex_ids.size());
-      evaluator_.Vertices(b.orient, b.pose.data(), b.betas, b.transl, vertex_ids,
-                          verts.data());
+      // Outline samples are matched only to contour-generator vertices (normal nearly
+      // perpendicular to the viewing ray): matching interior vertices would pull them
+      // outwards and inflate the hand.
+      Points3d all(evaluator_.num_vertices(), 3);
+      evaluator_.AllVertices(b.orient, b.pose.data(), b.betas, b.transl, all.data());
+      const MeshVertices normals = ComputeVertexNormals(all, model_.faces);
       for (size_t v = 0; v < sil_views.size(); ++v) {
+        const Eigen::Vector3d centre = sil_views[v].camera.CenterInWorld();
         std::vector<Eigen::Vector2d> uv(vertex_ids.size());
         std::vector<char> valid(vertex_ids.size());
         for (size_t i = 0; i < vertex_ids.size(); ++i) {
-          valid[i] = sil_views[v].camera.ProjectWorld(
-              Eigen::Vector3d(verts[3 * i], verts[3 * i + 1], verts[3 * i + 2]), &uv[i]);
+          const Eigen::Vector3d x = all.row(vertex_ids[i]).transpose();
+          const Eigen::Vector3d n = normals.row(vertex_ids[i]).transpose();
+          const double along = std::abs(n.dot((x - centre).normalized()));
+          valid[i] = n.squaredNorm() > 0.5 &&
+                     along < options_.silhouette_contour_cosine &&
+                     sil_views[v].camera.ProjectWorld(x, &uv[i]);
         }
         sil_views[v].outline_px = outlines[v].points;
         sil_views[v].outline_normal = outlines[v].normals;
@@ -422,6 +432,16 @@ class FitRun {
       result.view_rms_px.push_back(n > 0 ? std::sqrt(sum / n) : kNaN);
     }
     result.view_iou.assign(input.views.size(), kNaN);
+    for (size_t v = 0; v < input.masks.size(); ++v) {
+      if (input.masks[v].size() == 0) continue;
+      const RigCamera& camera = input.views[v].camera;
+      const MaskImage rendered = input.pixel_rays != nullptr
+                                     ? RenderHandMask(result.vertices, model_.faces,
+                                                      camera, (*input.pixel_rays)[v])
+                                     : RenderHandMask(result.vertices, model_.faces,
+                                                      camera, PixelRays(camera.camera));
+      result.view_iou[v] = MaskIoU(rendered, input.masks[v]);
+    }
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
@@ -485,8 +505,8 @@ class FitRun {
 
 }  // namespace
 
-HandParams HandFitter::InitFromKeypoints3d(const Points3d& keypoints,
-                                           const Eigen::VectorXd& weights) const {
+HandParams CeresHandFitter::InitFromKeypoints3d(const Points3d& keypoints,
+                                                const Eigen::VectorXd& weights) const {
   const Eigen::Vector3d fallback(0, 0, options_.fallback_depth_m);
   if (evaluator_.pose_dim() == 12) {
     return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
@@ -496,7 +516,7 @@ HandParams HandFitter::InitFromKeypoints3d(const Points3d& keypoints,
       .InitFromKeypoints3d(keypoints, weights, fallback);
 }
 
-HandParams HandFitter::InitFromViews(const std::vector<KeypointView>& views) const {
+HandParams CeresHandFitter::InitFromViews(const std::vector<KeypointView>& views) const {
   Rig rig;
   for (size_t v = 0; v < views.size(); ++v) {
     RigCamera camera = views[v].camera;
@@ -532,7 +552,8 @@ HandParams HandFitter::InitFromViews(const std::vector<KeypointView>& views) con
       .InitFromKeypoints3d(keypoints, weights, fallback);
 }
 
-FitResult HandFitter::Fit(const FitInput& input, const HandParams& init) const {
+HandFitResult CeresHandFitter::Fit(const HandFitInput& input,
+                                   const HandParams& init) const {
   if (evaluator_.pose_dim() == 12) {
     return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
         .Fit(input, init);

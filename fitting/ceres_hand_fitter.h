@@ -25,9 +25,10 @@
 #include "core/hand_evaluator.h"
 #include "core/hand_lbs.h"
 #include "core/hand_model.h"
+#include "core/rasterizer.h"
+#include "fitting/keypoint_view.h"
 #include "fitting/points3d_cost.h"
 #include "fitting/robust_loss.h"
-#include "fitting/keypoint_view.h"
 
 namespace handlabel {
 
@@ -42,8 +43,8 @@ struct HandFitConfig {
   bool use_joint_limits = true;  // anatomical hinge limits
   bool use_pose_prior = true;
   bool use_shape_prior = true;
-  bool use_points3d = true;  // only if FitInput::targets3d is set
-  bool use_temporal = true;  // only if FitInput::previous is set
+  bool use_points3d = true;  // only if HandFitInput::targets3d is set
+  bool use_temporal = true;  // only if HandFitInput::previous is set
   void Check() const;
 };
 
@@ -64,7 +65,7 @@ struct HandFitOptions {
   double shape_prior_sigma = 1.0;
   // 3D targets: metres per residual unit.
   double points3d_sigma_m = 0.002;
-  // Temporal pull towards FitInput::previous (pose: radians, transl: metres).
+  // Temporal pull towards HandFitInput::previous (pose: radians, transl: metres).
   double temporal_pose_sigma_rad = 0.2;
   double temporal_transl_sigma_m = 0.02;
   // Silhouettes: pixels per residual unit; vertices used (every n-th); outline
@@ -73,6 +74,9 @@ struct HandFitOptions {
   int silhouette_vertex_stride = 2;
   int silhouette_outline_samples = 120;
   int silhouette_rounds = 3;
+  // Outline samples match only vertices whose normal makes |cos| below this with the
+  // viewing ray (contour generators).
+  double silhouette_contour_cosine = 0.6;
   // Ceres iterations per stage (silhouette: per round).
   int rigid_iterations = 20;
   int keypoint_iterations = 60;
@@ -90,16 +94,19 @@ struct HandFitOptions {
   void Check() const;
 };
 
-struct FitInput {
+struct HandFitInput {
   std::vector<KeypointView> views;  // 2D keypoints per view (may be empty)
   // Per view: silhouette mask (rows = image height), or empty = none for that view.
   // Empty vector = no silhouettes. Cameras come from `views`.
   std::vector<MaskImage> masks;
   std::optional<Points3dTargets> targets3d;
   std::optional<HandParams> previous;
+  // Optional per-view pixel rays of the cameras (core/rasterizer.h), for the IoU of
+  // the result; computed per call when absent (costly: cache them per rig).
+  const std::vector<PixelRays>* pixel_rays = nullptr;
 };
 
-struct FitResult {
+struct HandFitResult {
   HandParams params;
   Points3d vertices;   // V x 3, world frame
   Points3d keypoints;  // 21 x 3, SNAP order
@@ -117,11 +124,11 @@ struct FitResult {
   std::string message;     // Ceres' message of the last stage
 };
 
-class HandFitter {
+class CeresHandFitter {
  public:
   // Throws InputError if the options, config or model do not fit together.
-  HandFitter(const HandModel& model, const HandFitConfig& config = {},
-             const HandFitOptions& options = {});
+  CeresHandFitter(const HandModel& model, const HandFitConfig& config = {},
+                  const HandFitOptions& options = {});
 
   const HandEvaluator& evaluator() const { return evaluator_; }
   const HandFitConfig& config() const { return config_; }
@@ -137,7 +144,7 @@ class HandFitter {
   HandParams InitFromViews(const std::vector<KeypointView>& views) const;
 
   // Staged solve from `init`.
-  FitResult Fit(const FitInput& input, const HandParams& init) const;
+  HandFitResult Fit(const HandFitInput& input, const HandParams& init) const;
 
  private:
   HandModel model_;
