@@ -25,8 +25,12 @@ void PrintUsage(std::ostream& out) {
 const std::vector<Command>& AllCommands() {
   static const std::vector<Command> commands = {
       {"version", "print version, git hash and dependency versions", RunVersion},
+      {"model", "inspect and convert hand model files (MANO, smplx npz, own)", RunModel},
       {"label", "label a capture as a job (YAML), resumable, shardable", RunLabel},
       {"merge", "join the shards of a labeling job (manifest + summary)", RunMerge},
+      {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",
+       RunCameras},
+      {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
   };
   return commands;
 }

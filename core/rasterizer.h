@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/camera.h"
@@ -43,9 +44,9 @@ struct RenderMesh {
   MeshColors colors;      // per-vertex albedo in [0, 1]; empty = `color` everywhere
   Eigen::Vector3f color = Eigen::Vector3f(0.8f, 0.8f, 0.8f);
   // Optional texture: albedo = texture(uv) * color, uv in [0, 1] (v down), bilinear,
-  // wrapping. Not owned; must outlive shading.
+  // wrapping. Shared and immutable, so meshes copy cheaply.
   MeshUvs uvs;
-  const ImageU8* texture = nullptr;
+  std::shared_ptr<const ImageU8> texture;
 };
 
 // Area-weighted vertex normals (unit length; zero for unused vertices).

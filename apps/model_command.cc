@@ -1,0 +1,194 @@
+// `handlabel model <subcommand>`: inspect and convert hand model files.
+// Subcommands sit in one table (ModelSubcommands below): to add one, write a
+// RunModelFoo(argc, argv) with its own CLI11 app and add a row.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli_util.h"
+#include "apps/commands.h"
+#include "core/errors.h"
+#include "core/hand_lbs.h"
+#include "core/hand_model_io.h"
+
+namespace handlabel {
+namespace {
+
+// Options shared by subcommands that load a model file.
+struct ModelFileFlags {
+  std::string side;  // "", "left" or "right"
+  std::vector<int> tips;
+
+  void Register(CLI::App& app) {
+    app.add_option("--side", side,
+                   "side for files that do not record it (MANO pickles, smplx npz); "
+                   "default: from the file name (MANO_LEFT / MANO_RIGHT)")
+        ->check(CLI::IsMember({"left", "right"}));
+    app.add_option("--tips", tips,
+                   "fingertip vertex ids thumb,index,middle,ring,pinky for files without "
+                   "them; default for 778-vertex MANO: 745,317,444,556,673 (manopth)")
+        ->delimiter(',')
+        ->expected(5);
+  }
+
+  HandModelLoadOptions Options() const {
+    HandModelLoadOptions options;
+    if (!side.empty()) options.side = side == "left" ? HandSide::kLeft : HandSide::kRight;
+    if (!tips.empty()) {
+      std::array<int, 5> t;
+      std::copy(tips.begin(), tips.end(), t.begin());
+      options.tip_vertex_ids = t;
+    }
+    return options;
+  }
+};
+
+constexpr const char* kSnapNames[kNumHandKeypoints] = {
+    "wrist",      "thumb_cmc", "thumb_mcp", "thumb_ip",   "thumb_tip",  "index_mcp",
+    "index_pip",  "index_dip", "index_tip", "middle_mcp", "middle_pip", "middle_dip",
+    "middle_tip", "ring_mcp",  "ring_pip",  "ring_dip",   "ring_tip",   "pinky_mcp",
+    "pinky_pip",  "pinky_dip", "pinky_tip"};
+
+void PrintInfo(const std::string& path, const LoadedHandModel& loaded,
+               std::ostream& out) {
+  const HandModel& m = loaded.model;
+  HandParams rest;
+  rest.betas = Eigen::VectorXd::Zero(m.num_betas());
+  const HandMesh mesh = PoseHand(m, rest);
+  const Eigen::Vector3d extent =
+      (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff())
+          .transpose();
+  const double wrist_to_middle_tip =
+      (mesh.keypoints.row(12) - mesh.keypoints.row(0)).norm();
+
+  out << std::fixed << std::setprecision(2);
+  out << "file:          " << path << "\n"
+      << "format:        " << HandModelFormatName(loaded.format) << "\n"
+      << "name:          " << m.name << "\n"
+      << "side:          " << (m.side == HandSide::kLeft ? "left" : "right") << "\n"
+      << "vertices:      " << m.num_vertices() << "\n"
+      << "faces:         " << m.num_faces() << "\n"
+      << "joints:        " << kNumHandJoints << " (+5 fingertips = 21 keypoints)\n"
+      << "betas:         " << m.num_betas() << "\n"
+      << "pose PCA:      ";
+  if (m.pose_pca_basis.size() == 0) {
+    out << "none\n";
+  } else {
+    out << m.pose_pca_basis.rows() << " components"
+        << (m.pose_mean.size() ? ", with hand mean" : ", no hand mean") << "\n";
+  }
+  out << "J_regressor:   " << m.joint_regressor.nonZeros() << " non-zeros\n"
+      << "size at rest:  wrist to middle fingertip " << 100 * wrist_to_middle_tip
+      << " cm; bounding box " << 100 * extent.x() << " x " << 100 * extent.y() << " x "
+      << 100 * extent.z() << " cm\n"
+      << "fingertips:    vertices";
+  for (int t : m.tip_vertex_ids) out << " " << t;
+  out << " (thumb, index, middle, ring, pinky)\n"
+      << "keypoints (SNAP/OpenPose order <- native joint, or tip vertex):\n";
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const int native = kSnapFromNative[k];
+    out << "  " << std::setw(2) << k << " " << std::left << std::setw(11) << kSnapNames[k]
+        << std::right << " <- ";
+    if (native < kNumHandJoints) {
+      out << "joint " << native << "\n";
+    } else {
+      out << "tip vertex " << m.tip_vertex_ids[native - kNumHandJoints] << "\n";
+    }
+  }
+}
+
+int RunModelInfo(int argc, char** argv) {
+  CLI::App app(
+      "Print a hand model's statistics: format, side, vertex / face / beta counts, pose "
+      "PCA, fingertip vertices, the 21-keypoint map and its size at rest.",
+      "model info");
+  std::string path;
+  ModelFileFlags flags;
+  app.add_option("file", path, "model file (MANO .pkl, smplx .npz or handlabel .npz)")
+      ->required();
+  flags.Register(app);
+  if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
+  return RunReportingErrors("model info", [&] {
+    PrintInfo(path, LoadHandModelFile(path, flags.Options()), std::cout);
+    return 0;
+  });
+}
+
+int RunModelConvert(int argc, char** argv) {
+  CLI::App app(
+      "Convert any supported hand model file (MANO pickle, re-saved pickle, smplx npz) "
+      "into the handlabel model file (.npz; numpy and smplx read it too).",
+      "model convert");
+  std::string in, out;
+  ModelFileFlags flags;
+  app.add_option("input", in, "model file to read")->required();
+  app.add_option("output", out, "handlabel model file to write (.npz)")->required();
+  flags.Register(app);
+  if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
+  return RunReportingErrors("model convert", [&] {
+    const LoadedHandModel loaded = LoadHandModelFile(in, flags.Options());
+    SaveHandModel(loaded.model, out);
+    std::cout << "wrote " << out << " (" << loaded.model.name << ", "
+              << (loaded.model.side == HandSide::kLeft ? "left" : "right") << ", "
+              << loaded.model.num_vertices() << " vertices, from "
+              << HandModelFormatName(loaded.format) << ")\n";
+    return 0;
+  });
+}
+
+struct ModelSubcommand {
+  const char* name;
+  const char* summary;
+  int (*run)(int argc, char** argv);
+};
+
+const std::vector<ModelSubcommand>& ModelSubcommands() {
+  static const std::vector<ModelSubcommand> table = {
+      {"info", "print a model file's statistics", RunModelInfo},
+      {"convert", "convert a MANO / smplx model file to the handlabel format",
+       RunModelConvert},
+      {"build", "build the open hand model (ours, MANO-compatible)", RunModelBuild},
+      {"render", "render a preview sheet (PNG) of a model in several poses",
+       RunModelRender},
+  };
+  return table;
+}
+
+void PrintModelUsage(std::ostream& out) {
+  out << "Usage: handlabel model <subcommand> [options]\n"
+         "       handlabel model <subcommand> --help\n\n"
+         "Subcommands:\n";
+  for (const ModelSubcommand& s : ModelSubcommands()) {
+    std::string name = s.name;
+    name.resize(std::max<size_t>(name.size(), 10), ' ');
+    out << "  " << name << "  " << s.summary << "\n";
+  }
+  out << "\nSee docs/hand-model-files.md.\n";
+}
+
+}  // namespace
+
+int RunModel(int argc, char** argv) {
+  if (argc < 2) {
+    PrintModelUsage(std::cerr);
+    return 2;
+  }
+  const std::string name = argv[1];
+  if (name == "--help" || name == "-h" || name == "help") {
+    PrintModelUsage(std::cout);
+    return 0;
+  }
+  for (const ModelSubcommand& s : ModelSubcommands()) {
+    if (name == s.name) return s.run(argc - 1, argv + 1);
+  }
+  std::cerr << "handlabel model: unknown subcommand '" << name << "'\n";
+  PrintModelUsage(std::cerr);
+  return 2;
+}
+
+}  // namespace handlabel

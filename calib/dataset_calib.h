@@ -1,0 +1,28 @@
+#pragma once
+// Rigs from dataset calibration files (see docs/cameras.md for the layouts):
+//   dexycb  PATH = calibration/extrinsics_<id>/extrinsics.yml, or a sequence's
+//           meta.yml (its `extrinsics` id is looked up under <root>/calibration);
+//           intrinsics from calibration/intrinsics/<serial>_640x480.yml.
+//           World = DexYCB's common frame (camera_from_common = inverse of the file's
+//           camera -> common 3x4); cameras named by serial.
+//   ho3d    PATH = calibration/<SEQ>/calibration folder: cam_orders.txt,
+//           trans_<i>.txt (4x4 camera -> common), cam_<i>_intrinsics.txt.
+//   oakink  PATH = a folder of OakInk general_info pickles (or one pickle): one
+//           camera per <cam> suffix from cam_intr (3x3) and cam_extr (4x4 world ->
+//           camera), taken from the first frame of each camera.
+
+#include <string>
+#include <vector>
+
+#include "calib/rig_json.h"
+#include "core/rig.h"
+
+namespace handlabel {
+
+std::vector<std::string> DatasetRigFormats();
+
+// Throws InputError naming the file and field for anything missing or malformed.
+Rig ReadDatasetRig(const std::string& format, const std::string& path,
+                   RigFileInfo* info = nullptr);
+
+}  // namespace handlabel

@@ -1,0 +1,1549 @@
+#include "core/pickle_reader.h"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <unordered_map>
+
+#include "core/errors.h"
+#include "core/npy.h"
+
+namespace handlabel {
+namespace {
+
+// The callables and classes the reader understands. Anything else is refused.
+enum class Global {
+  kNdarray,
+  kReconstruct,
+  kDTypeClass,
+  kScalar,
+  kFromBuffer,
+  kSet,
+  kFrozenSet,
+  kBytesClass,
+  kBytearray,
+  kObjectClass,
+  kCodecsEncode,
+  kCopyregReconstructor,
+  kOrderedDict,
+  kCh,
+  kSelect,
+  kCscMatrix,
+  kCsrMatrix,
+  kRebuildTensorV2,
+  kRebuildParameter,
+  kStorage,
+};
+
+struct KnownGlobal {
+  const char* module;
+  const char* name;
+  Global global;
+  DType storage_dtype;
+};
+
+constexpr KnownGlobal kKnownGlobals[] = {
+    {"numpy", "ndarray", Global::kNdarray, DType::kUInt8},
+    {"numpy", "dtype", Global::kDTypeClass, DType::kUInt8},
+    {"numpy.core.multiarray", "_reconstruct", Global::kReconstruct, DType::kUInt8},
+    {"numpy._core.multiarray", "_reconstruct", Global::kReconstruct, DType::kUInt8},
+    {"numpy.core.multiarray", "scalar", Global::kScalar, DType::kUInt8},
+    {"numpy._core.multiarray", "scalar", Global::kScalar, DType::kUInt8},
+    {"numpy.core.numeric", "_frombuffer", Global::kFromBuffer, DType::kUInt8},
+    {"numpy._core.numeric", "_frombuffer", Global::kFromBuffer, DType::kUInt8},
+    {"__builtin__", "set", Global::kSet, DType::kUInt8},
+    {"builtins", "set", Global::kSet, DType::kUInt8},
+    {"__builtin__", "frozenset", Global::kFrozenSet, DType::kUInt8},
+    {"builtins", "frozenset", Global::kFrozenSet, DType::kUInt8},
+    {"__builtin__", "bytes", Global::kBytesClass, DType::kUInt8},
+    {"builtins", "bytes", Global::kBytesClass, DType::kUInt8},
+    {"__builtin__", "bytearray", Global::kBytearray, DType::kUInt8},
+    {"builtins", "bytearray", Global::kBytearray, DType::kUInt8},
+    {"__builtin__", "object", Global::kObjectClass, DType::kUInt8},
+    {"builtins", "object", Global::kObjectClass, DType::kUInt8},
+    {"_codecs", "encode", Global::kCodecsEncode, DType::kUInt8},
+    {"copy_reg", "_reconstructor", Global::kCopyregReconstructor, DType::kUInt8},
+    {"copyreg", "_reconstructor", Global::kCopyregReconstructor, DType::kUInt8},
+    {"collections", "OrderedDict", Global::kOrderedDict, DType::kUInt8},
+    {"chumpy.ch", "Ch", Global::kCh, DType::kUInt8},
+    {"chumpy.reordering", "Select", Global::kSelect, DType::kUInt8},
+    {"scipy.sparse.csc", "csc_matrix", Global::kCscMatrix, DType::kUInt8},
+    {"scipy.sparse._csc", "csc_matrix", Global::kCscMatrix, DType::kUInt8},
+    {"scipy.sparse", "csc_matrix", Global::kCscMatrix, DType::kUInt8},
+    {"scipy.sparse.csr", "csr_matrix", Global::kCsrMatrix, DType::kUInt8},
+    {"scipy.sparse._csr", "csr_matrix", Global::kCsrMatrix, DType::kUInt8},
+    {"scipy.sparse", "csr_matrix", Global::kCsrMatrix, DType::kUInt8},
+    {"torch._utils", "_rebuild_tensor_v2", Global::kRebuildTensorV2, DType::kUInt8},
+    {"torch._utils", "_rebuild_parameter", Global::kRebuildParameter, DType::kUInt8},
+    {"torch", "FloatStorage", Global::kStorage, DType::kFloat32},
+    {"torch", "DoubleStorage", Global::kStorage, DType::kFloat64},
+    {"torch", "HalfStorage", Global::kStorage, DType::kFloat16},
+    {"torch", "LongStorage", Global::kStorage, DType::kInt64},
+    {"torch", "IntStorage", Global::kStorage, DType::kInt32},
+    {"torch", "ShortStorage", Global::kStorage, DType::kInt16},
+    {"torch", "CharStorage", Global::kStorage, DType::kInt8},
+    {"torch", "ByteStorage", Global::kStorage, DType::kUInt8},
+    {"torch", "BoolStorage", Global::kStorage, DType::kBool},
+};
+
+// Classes whose instances the reader can build (NEWOBJ / REDUCE / INST / OBJ) and
+// fill from BUILD state.
+bool IsInstanceClass(Global g) {
+  return g == Global::kCh || g == Global::kSelect || g == Global::kCscMatrix ||
+         g == Global::kCsrMatrix || g == Global::kOrderedDict;
+}
+
+// Values while reading. Ids index Reader::nodes_; containers refer to children by id,
+// so shared and even cyclic references cost nothing and never recurse here.
+enum class NodeKind {
+  kNone,
+  kBool,
+  kInt,
+  kFloat,
+  kText,
+  kBytes,
+  kPy2Str,  // Python 2 str: raw bytes, Latin-1 when read as text
+  kList,
+  kTuple,
+  kSet,
+  kDict,
+  kGlobal,
+  kObject,        // instance of an understood class: attributes in `entries`
+  kPendingArray,  // numpy _reconstruct result awaiting its BUILD state
+  kArray,
+  kDType,
+  kStorage,
+  kTensor,
+  kUnsupported,
+};
+
+struct Node {
+  NodeKind kind = NodeKind::kNone;
+  int depth = 0;  // container nesting below and including this node
+  bool boolean = false;
+  int64_t integer = 0;
+  double real = 0;
+  std::string text;  // text (UTF-8), bytes, Python 2 str, unsupported reason
+  std::vector<int> items;
+  std::vector<std::pair<int, int>> entries;
+  Global global = Global::kObjectClass;
+  std::string global_name;  // "module.name" of a global or an instance's class
+  std::shared_ptr<NdArray> array;
+  // dtype (kDType, kStorage): element type; supported = false for object/structured.
+  DType dtype = DType::kFloat64;
+  int64_t itemsize = 8;
+  bool big_endian = false;
+  bool dtype_supported = true;
+  std::shared_ptr<TensorRef> tensor;  // kStorage, kTensor
+};
+
+const char* OpcodeName(uint8_t op) {
+  switch (op) {
+    case '(':
+      return "MARK";
+    case '.':
+      return "STOP";
+    case '0':
+      return "POP";
+    case '1':
+      return "POP_MARK";
+    case '2':
+      return "DUP";
+    case 'F':
+      return "FLOAT";
+    case 'I':
+      return "INT";
+    case 'J':
+      return "BININT";
+    case 'K':
+      return "BININT1";
+    case 'L':
+      return "LONG";
+    case 'M':
+      return "BININT2";
+    case 'N':
+      return "NONE";
+    case 'P':
+      return "PERSID";
+    case 'Q':
+      return "BINPERSID";
+    case 'R':
+      return "REDUCE";
+    case 'S':
+      return "STRING";
+    case 'T':
+      return "BINSTRING";
+    case 'U':
+      return "SHORT_BINSTRING";
+    case 'V':
+      return "UNICODE";
+    case 'X':
+      return "BINUNICODE";
+    case 'a':
+      return "APPEND";
+    case 'b':
+      return "BUILD";
+    case 'c':
+      return "GLOBAL";
+    case 'd':
+      return "DICT";
+    case '}':
+      return "EMPTY_DICT";
+    case 'e':
+      return "APPENDS";
+    case 'g':
+      return "GET";
+    case 'h':
+      return "BINGET";
+    case 'i':
+      return "INST";
+    case 'j':
+      return "LONG_BINGET";
+    case 'l':
+      return "LIST";
+    case ']':
+      return "EMPTY_LIST";
+    case 'o':
+      return "OBJ";
+    case 'p':
+      return "PUT";
+    case 'q':
+      return "BINPUT";
+    case 'r':
+      return "LONG_BINPUT";
+    case 's':
+      return "SETITEM";
+    case 't':
+      return "TUPLE";
+    case ')':
+      return "EMPTY_TUPLE";
+    case 'u':
+      return "SETITEMS";
+    case 'G':
+      return "BINFLOAT";
+    case 0x80:
+      return "PROTO";
+    case 0x81:
+      return "NEWOBJ";
+    case 0x82:
+      return "EXT1";
+    case 0x83:
+      return "EXT2";
+    case 0x84:
+      return "EXT4";
+    case 0x85:
+      return "TUPLE1";
+    case 0x86:
+      return "TUPLE2";
+    case 0x87:
+      return "TUPLE3";
+    case 0x88:
+      return "NEWTRUE";
+    case 0x89:
+      return "NEWFALSE";
+    case 0x8a:
+      return "LONG1";
+    case 0x8b:
+      return "LONG4";
+    case 'B':
+      return "BINBYTES";
+    case 'C':
+      return "SHORT_BINBYTES";
+    case 0x8c:
+      return "SHORT_BINUNICODE";
+    case 0x8d:
+      return "BINUNICODE8";
+    case 0x8e:
+      return "BINBYTES8";
+    case 0x8f:
+      return "EMPTY_SET";
+    case 0x90:
+      return "ADDITEMS";
+    case 0x91:
+      return "FROZENSET";
+    case 0x92:
+      return "NEWOBJ_EX";
+    case 0x93:
+      return "STACK_GLOBAL";
+    case 0x94:
+      return "MEMOIZE";
+    case 0x95:
+      return "FRAME";
+    case 0x96:
+      return "BYTEARRAY8";
+    case 0x97:
+      return "NEXT_BUFFER";
+    case 0x98:
+      return "READONLY_BUFFER";
+  }
+  return nullptr;
+}
+
+void AppendUtf8(uint32_t c, std::string* out) {
+  if (c < 0x80) {
+    out->push_back(static_cast<char>(c));
+  } else if (c < 0x800) {
+    out->push_back(static_cast<char>(0xC0 | (c >> 6)));
+    out->push_back(static_cast<char>(0x80 | (c & 0x3F)));
+  } else if (c < 0x10000) {
+    out->push_back(static_cast<char>(0xE0 | (c >> 12)));
+    out->push_back(static_cast<char>(0x80 | ((c >> 6) & 0x3F)));
+    out->push_back(static_cast<char>(0x80 | (c & 0x3F)));
+  } else {
+    out->push_back(static_cast<char>(0xF0 | ((c >> 18) & 0x07)));
+    out->push_back(static_cast<char>(0x80 | ((c >> 12) & 0x3F)));
+    out->push_back(static_cast<char>(0x80 | ((c >> 6) & 0x3F)));
+    out->push_back(static_cast<char>(0x80 | (c & 0x3F)));
+  }
+}
+
+std::string Latin1ToUtf8(const std::string& s) {
+  std::string out;
+  for (unsigned char c : s) AppendUtf8(c, &out);
+  return out;
+}
+
+// UTF-8 text whose code points are all below 256 -> those bytes (Python's
+// str.encode('latin1')); false if a code point does not fit.
+bool Utf8ToLatin1(const std::string& s, std::string* out) {
+  out->clear();
+  for (size_t i = 0; i < s.size(); ++i) {
+    const unsigned char c = s[i];
+    if (c < 0x80) {
+      out->push_back(static_cast<char>(c));
+    } else if ((c & 0xE0) == 0xC0 && i + 1 < s.size()) {
+      const uint32_t cp =
+          ((c & 0x1F) << 6) | (static_cast<unsigned char>(s[i + 1]) & 0x3F);
+      if (cp > 0xFF) return false;
+      out->push_back(static_cast<char>(cp));
+      ++i;
+    } else {
+      return false;
+    }
+  }
+  return true;
+}
+
+class Reader {
+ public:
+  Reader(const std::string& bytes, const std::string& source, const PickleLimits& limits)
+      : in_(bytes), source_(source), limits_(limits) {}
+
+  PickleValue Run() {
+    const int root = Execute();
+    return Convert(root, 0);
+  }
+
+ private:
+  // ---- errors --------------------------------------------------------------------
+  [[noreturn]] void Fail(const std::string& expected, const std::string& got) const {
+    throw InputError(
+        source_, "pickle", expected,
+        got + " (opcode " + OpName() + " at offset " + std::to_string(op_offset_) + ")");
+  }
+  std::string OpName() const {
+    const char* name = OpcodeName(op_);
+    if (name) return name;
+    char hex[8];
+    std::snprintf(hex, sizeof(hex), "0x%02x", op_);
+    return hex;
+  }
+  [[noreturn]] void FailConvert(const std::string& where, const std::string& expected,
+                                const std::string& got) const {
+    throw InputError(source_, where, expected, got);
+  }
+
+  // ---- input ---------------------------------------------------------------------
+  size_t Remaining() const { return in_.size() - pos_; }
+  void Need(uint64_t n) const {
+    if (n > Remaining()) {
+      Fail(std::to_string(n) + " more bytes",
+           "only " + std::to_string(Remaining()) + " left (truncated pickle)");
+    }
+  }
+  uint64_t ReadLE(int bytes) {
+    Need(bytes);
+    uint64_t v = 0;
+    for (int k = bytes - 1; k >= 0; --k)
+      v = (v << 8) | static_cast<uint8_t>(in_[pos_ + k]);
+    pos_ += bytes;
+    return v;
+  }
+  std::string ReadBytes(uint64_t n) {
+    Need(n);
+    ChargeBytes(n);
+    std::string s = in_.substr(pos_, static_cast<size_t>(n));
+    pos_ += static_cast<size_t>(n);
+    return s;
+  }
+  std::string ReadLine() {
+    const size_t end = in_.find('\n', pos_);
+    if (end == std::string::npos) Fail("a newline-terminated argument", "end of data");
+    std::string s = in_.substr(pos_, end - pos_);
+    pos_ = end + 1;
+    return s;
+  }
+  void ChargeBytes(uint64_t n) {
+    total_bytes_ += static_cast<int64_t>(n);
+    if (total_bytes_ > limits_.max_total_bytes) {
+      Fail("at most " + std::to_string(limits_.max_total_bytes) + " bytes of data",
+           "more");
+    }
+  }
+
+  // ---- nodes and stack -----------------------------------------------------------
+  int NewNode(NodeKind kind) {
+    if (static_cast<int64_t>(nodes_.size()) >= limits_.max_values) {
+      Fail("at most " + std::to_string(limits_.max_values) + " values", "more");
+    }
+    nodes_.emplace_back();
+    nodes_.back().kind = kind;
+    return static_cast<int>(nodes_.size()) - 1;
+  }
+  Node& N(int id) { return nodes_[id]; }
+  void Push(int id) { stack_.push_back(id); }
+  int Pop() {
+    if (stack_.size() <= MarkBase()) Fail("a value on the stack", "an empty stack");
+    const int id = stack_.back();
+    stack_.pop_back();
+    return id;
+  }
+  int Top() {
+    if (stack_.size() <= MarkBase()) Fail("a value on the stack", "an empty stack");
+    return stack_.back();
+  }
+  size_t MarkBase() const { return marks_.empty() ? 0 : marks_.back(); }
+  std::vector<int> PopMark() {
+    if (marks_.empty()) Fail("a MARK before this opcode", "none");
+    const size_t base = marks_.back();
+    marks_.pop_back();
+    std::vector<int> items(stack_.begin() + base, stack_.end());
+    stack_.resize(base);
+    return items;
+  }
+  // Records that `child` now sits inside `parent`, enforcing the nesting limit.
+  void Nest(int parent, int child) {
+    const int depth = N(child).depth + 1;
+    if (depth > N(parent).depth) N(parent).depth = depth;
+    if (N(parent).depth > limits_.max_depth) {
+      Fail("nesting at most " + std::to_string(limits_.max_depth) + " levels deep",
+           "deeper nesting");
+    }
+  }
+  int MakeInt(int64_t v) {
+    const int id = NewNode(NodeKind::kInt);
+    N(id).integer = v;
+    return id;
+  }
+  int MakeString(NodeKind kind, std::string s) {
+    const int id = NewNode(kind);
+    N(id).text = std::move(s);
+    return id;
+  }
+  int MakeSequence(NodeKind kind, const std::vector<int>& items) {
+    const int id = NewNode(kind);
+    for (int item : items) Nest(id, item);
+    N(id).items = items;
+    return id;
+  }
+
+  // ---- accessors used by the understood callables --------------------------------
+  bool IsText(int id) {
+    const NodeKind k = N(id).kind;
+    return k == NodeKind::kText || k == NodeKind::kPy2Str;
+  }
+  std::string TextOf(int id, const char* what) {
+    if (N(id).kind == NodeKind::kText) return N(id).text;
+    if (N(id).kind == NodeKind::kPy2Str) return Latin1ToUtf8(N(id).text);
+    Fail(std::string(what) + " as a string", KindName(id));
+  }
+  // Raw bytes: Python 3 bytes, Python 2 str.
+  const std::string& BytesOf(int id, const char* what) {
+    const NodeKind k = N(id).kind;
+    if (k == NodeKind::kBytes || k == NodeKind::kPy2Str) return N(id).text;
+    Fail(std::string(what) + " as bytes", KindName(id));
+  }
+  int64_t IntOf(int id, const char* what) {
+    if (N(id).kind == NodeKind::kInt) return N(id).integer;
+    if (N(id).kind == NodeKind::kBool) return N(id).boolean;
+    Fail(std::string(what) + " as an integer", KindName(id));
+  }
+  const std::vector<int>& TupleOf(int id, const char* what) {
+    const NodeKind k = N(id).kind;
+    if (k == NodeKind::kTuple || k == NodeKind::kList) return N(id).items;
+    Fail(std::string(what) + " as a tuple", KindName(id));
+  }
+  std::vector<int64_t> IntsOf(int id, const char* what) {
+    std::vector<int64_t> v;
+    for (int item : TupleOf(id, what)) v.push_back(IntOf(item, what));
+    return v;
+  }
+  std::string KindName(int id) const {
+    const Node& n = nodes_[id];
+    switch (n.kind) {
+      case NodeKind::kNone:
+        return "None";
+      case NodeKind::kBool:
+        return "a bool";
+      case NodeKind::kInt:
+        return "an int";
+      case NodeKind::kFloat:
+        return "a float";
+      case NodeKind::kText:
+        return "a str";
+      case NodeKind::kBytes:
+        return "bytes";
+      case NodeKind::kPy2Str:
+        return "a Python 2 str";
+      case NodeKind::kList:
+        return "a list";
+      case NodeKind::kTuple:
+        return "a tuple";
+      case NodeKind::kSet:
+        return "a set";
+      case NodeKind::kDict:
+        return "a dict";
+      case NodeKind::kGlobal:
+        return "global " + n.global_name;
+      case NodeKind::kObject:
+        return "a " + n.global_name + " object";
+      case NodeKind::kPendingArray:
+        return "an ndarray without state";
+      case NodeKind::kArray:
+        return "an ndarray";
+      case NodeKind::kDType:
+        return "a numpy dtype";
+      case NodeKind::kStorage:
+        return "a torch storage";
+      case NodeKind::kTensor:
+        return "a torch tensor";
+      case NodeKind::kUnsupported:
+        return "unsupported " + n.global_name;
+    }
+    return "?";
+  }
+
+  // ---- globals -------------------------------------------------------------------
+  int MakeGlobal(const std::string& module, const std::string& name) {
+    for (const KnownGlobal& k : kKnownGlobals) {
+      if (module == k.module && name == k.name) {
+        const int id = NewNode(NodeKind::kGlobal);
+        N(id).global = k.global;
+        N(id).global_name = module + "." + name;
+        N(id).dtype = k.storage_dtype;
+        return id;
+      }
+    }
+    Fail(
+        "only the numpy, chumpy, scipy.sparse, collections and torch globals that "
+        "model files use",
+        "global '" + module + "." + name + "'");
+  }
+
+  // A dtype from numpy.dtype(descr, align, copy); byte order comes with BUILD.
+  int MakeDType(const std::vector<int>& args) {
+    if (args.empty() || !IsText(args[0]))
+      Fail("numpy.dtype(str, ...)", "other arguments");
+    const std::string descr = TextOf(args[0], "dtype");
+    const int id = NewNode(NodeKind::kDType);
+    Node& d = N(id);
+    d.text = descr;
+    d.dtype_supported = ParseDTypeDescr(descr, &d.dtype, &d.itemsize, &d.big_endian);
+    // numpy pickles "=" order as "<" on little-endian hosts; BUILD corrects it.
+    return id;
+  }
+
+  void BuildDType(int id, int state) {
+    const std::vector<int>& s = TupleOf(state, "dtype state");
+    if (s.size() < 2) Fail("a dtype state tuple", "a short tuple");
+    const std::string order = TextOf(s[1], "dtype byte order");
+    Node& d = N(id);
+    if (order == ">") d.big_endian = true;
+    if (order == "<") d.big_endian = false;
+    if (s.size() >= 4 && N(s[3]).kind != NodeKind::kNone) {
+      d.dtype_supported = false;  // structured dtype (names)
+    }
+    // Flexible dtypes carry their element size in the state (index 5).
+    if (d.dtype_supported && !IsNumeric(d.dtype) && s.size() >= 6) {
+      const int64_t elsize = IntOf(s[5], "dtype elsize");
+      if (elsize > 0) d.itemsize = elsize;
+    }
+  }
+
+  // Builds an NdArray from raw bytes in the given dtype; big-endian / Fortran data is
+  // converted to native C order.
+  std::shared_ptr<NdArray> ArrayFromBytes(const std::vector<int64_t>& shape, int dtype_id,
+                                          bool fortran, const std::string& raw) {
+    const Node& d = N(dtype_id);
+    auto a = std::make_shared<NdArray>();
+    a->dtype = d.dtype;
+    a->itemsize = d.itemsize;
+    a->shape = shape;
+    int64_t n_bytes = 0;
+    try {
+      n_bytes = CheckedByteCount(shape, d.itemsize, limits_.max_total_bytes, "ndarray");
+    } catch (const Error& e) {
+      Fail("an array within the size limit", e.what());
+    }
+    if (static_cast<uint64_t>(n_bytes) != raw.size()) {
+      Fail(std::to_string(n_bytes) + " data bytes for shape " + a->ShapeString() +
+               " of " + DTypeName(d.dtype),
+           std::to_string(raw.size()) + " bytes");
+    }
+    ChargeBytes(raw.size());
+    a->data.assign(raw.begin(), raw.end());
+    ToNativeCOrder(d.big_endian, fortran, a.get());
+    return a;
+  }
+
+  void BuildArray(int id, int state) {
+    std::vector<int> s = TupleOf(state, "ndarray state");
+    if (s.size() == 5) s.erase(s.begin());  // (version, shape, dtype, fortran, data)
+    if (s.size() != 4) Fail("an ndarray state of 4 or 5 items", KindName(state));
+    if (N(s[1]).kind != NodeKind::kDType) Fail("a numpy dtype", KindName(s[1]));
+    const std::vector<int64_t> shape = IntsOf(s[0], "ndarray shape");
+    const bool fortran = IntOf(s[2], "ndarray fortran flag") != 0;
+    const Node& d = N(s[1]);
+    const NodeKind raw_kind = N(s[3]).kind;
+    if (!d.text.empty() && d.text[0] == 'O' &&
+        (raw_kind == NodeKind::kList || raw_kind == NodeKind::kTuple)) {
+      // Object array (np.save of a sparse matrix, ...): its elements are pickled
+      // objects, kept as a list; a 0-d one converts to its single element.
+      const std::vector<int> items = N(s[3]).items;
+      N(id).kind = NodeKind::kList;
+      N(id).global_name = "numpy object array";
+      N(id).integer = static_cast<int64_t>(shape.size());
+      N(id).items = items;
+      for (int item : items) Nest(id, item);
+      return;
+    }
+    if (!d.dtype_supported) {
+      N(id).kind = NodeKind::kUnsupported;
+      N(id).global_name = "numpy.ndarray";
+      N(id).text = "dtype '" + d.text + "'";
+      return;
+    }
+    if (raw_kind != NodeKind::kBytes && raw_kind != NodeKind::kPy2Str &&
+        raw_kind != NodeKind::kText) {
+      Fail("the array's raw bytes", KindName(s[3]));
+    }
+    std::string raw = N(s[3]).text;
+    // Python 3 pickles of Python 2 buffers arrive as str when loaded with latin1.
+    if (raw_kind == NodeKind::kText && !Utf8ToLatin1(N(s[3]).text, &raw)) {
+      Fail("array bytes", "non-Latin-1 text");
+    }
+    N(id).array = ArrayFromBytes(shape, s[1], fortran, raw);
+    N(id).kind = NodeKind::kArray;
+  }
+
+  // ---- REDUCE / NEWOBJ / BUILD ---------------------------------------------------
+  int NewInstance(int cls_id) {
+    const Node& cls = N(cls_id);
+    if (cls.kind != NodeKind::kGlobal || !IsInstanceClass(cls.global)) {
+      Fail(
+          "a class the reader can build (chumpy Ch/Select, scipy csc/csr_matrix, "
+          "OrderedDict)",
+          KindName(cls_id));
+    }
+    if (cls.global == Global::kOrderedDict) return NewNode(NodeKind::kDict);
+    const int id = NewNode(NodeKind::kObject);
+    N(id).global = cls.global;
+    N(id).global_name = cls.global_name;
+    return id;
+  }
+
+  int Reduce(int callable, int args_id) {
+    const Node& f = N(callable);
+    if (f.kind != NodeKind::kGlobal) Fail("a global to call", KindName(callable));
+    const std::vector<int> args = TupleOf(args_id, "call arguments");
+    switch (f.global) {
+      case Global::kReconstruct: {
+        if (args.empty() || N(args[0]).kind != NodeKind::kGlobal ||
+            N(args[0]).global != Global::kNdarray) {
+          Fail("_reconstruct(numpy.ndarray, ...)", "another class");
+        }
+        const int id = NewNode(NodeKind::kPendingArray);
+        N(id).global_name = "numpy.ndarray";
+        return id;
+      }
+      case Global::kDTypeClass:
+        return MakeDType(args);
+      case Global::kScalar: {
+        if (args.size() != 2 || N(args[0]).kind != NodeKind::kDType) {
+          Fail("scalar(dtype, bytes)", "other arguments");
+        }
+        if (!N(args[0]).dtype_supported || !IsNumeric(N(args[0]).dtype)) {
+          const int id = NewNode(NodeKind::kUnsupported);
+          N(id).global_name = "numpy scalar";
+          N(id).text = "dtype '" + N(args[0]).text + "'";
+          return id;
+        }
+        std::string raw;
+        if (N(args[1]).kind != NodeKind::kText) {
+          raw = BytesOf(args[1], "scalar data");
+        } else if (!Utf8ToLatin1(N(args[1]).text, &raw)) {
+          Fail("scalar bytes", "non-Latin-1 text");
+        }
+        const auto a = ArrayFromBytes({}, args[0], false, raw);
+        const double v = a->ToDoubles()[0];
+        if (a->dtype == DType::kFloat16 || a->dtype == DType::kFloat32 ||
+            a->dtype == DType::kFloat64) {
+          const int id = NewNode(NodeKind::kFloat);
+          N(id).real = v;
+          return id;
+        }
+        if (a->dtype == DType::kBool) {
+          const int id = NewNode(NodeKind::kBool);
+          N(id).boolean = v != 0;
+          return id;
+        }
+        return MakeInt(a->ToInt64s()[0]);
+      }
+      case Global::kFromBuffer: {
+        // _frombuffer(buffer, dtype, shape, order)
+        if (args.size() != 4 || N(args[1]).kind != NodeKind::kDType) {
+          Fail("_frombuffer(buffer, dtype, shape, order)", "other arguments");
+        }
+        const int id = NewNode(NodeKind::kArray);
+        if (!N(args[1]).dtype_supported) {
+          N(id).kind = NodeKind::kUnsupported;
+          N(id).global_name = "numpy.ndarray";
+          N(id).text = "dtype '" + N(args[1]).text + "'";
+          return id;
+        }
+        const bool fortran = TextOf(args[3], "order") == "F";
+        N(id).array = ArrayFromBytes(IntsOf(args[2], "shape"), args[1], fortran,
+                                     BytesOf(args[0], "buffer"));
+        return id;
+      }
+      case Global::kSet:
+      case Global::kFrozenSet: {
+        if (args.empty()) return NewNode(NodeKind::kSet);
+        if (args.size() != 1) Fail("set(iterable)", "other arguments");
+        return MakeSequence(NodeKind::kSet, TupleOf(args[0], "set items"));
+      }
+      case Global::kBytesClass:
+      case Global::kBytearray: {
+        if (args.empty()) return MakeString(NodeKind::kBytes, "");
+        if (N(args[0]).kind == NodeKind::kBytes || N(args[0]).kind == NodeKind::kPy2Str) {
+          return MakeString(NodeKind::kBytes, N(args[0]).text);
+        }
+        std::string raw;  // Python 3 protocol 2: bytearray(str, 'latin-1')
+        if (N(args[0]).kind == NodeKind::kText && Utf8ToLatin1(N(args[0]).text, &raw)) {
+          return MakeString(NodeKind::kBytes, raw);
+        }
+        Fail("bytes() or bytearray(bytes)", "other arguments");
+      }
+      case Global::kCodecsEncode: {
+        if (args.size() != 2 || N(args[0]).kind != NodeKind::kText) {
+          Fail("_codecs.encode(str, 'latin1')", "other arguments");
+        }
+        const std::string codec = TextOf(args[1], "codec");
+        if (codec != "latin1" && codec != "latin-1" && codec != "iso-8859-1") {
+          Fail("the latin1 codec", "'" + codec + "'");
+        }
+        std::string raw;
+        if (!Utf8ToLatin1(N(args[0]).text, &raw)) Fail("Latin-1 text", "other text");
+        return MakeString(NodeKind::kBytes, raw);
+      }
+      case Global::kCopyregReconstructor: {
+        if (args.size() != 3 || N(args[1]).kind != NodeKind::kGlobal ||
+            N(args[1]).global != Global::kObjectClass) {
+          Fail("copy_reg._reconstructor(cls, object, None)", "other arguments");
+        }
+        return NewInstance(args[0]);
+      }
+      case Global::kOrderedDict:
+        if (!args.empty()) Fail("OrderedDict()", "arguments");
+        return NewNode(NodeKind::kDict);
+      case Global::kCh:
+      case Global::kSelect:
+      case Global::kCscMatrix:
+      case Global::kCsrMatrix:
+        return NewInstance(callable);
+      case Global::kRebuildTensorV2: {
+        // (storage, storage_offset, size, stride, requires_grad, hooks[, metadata])
+        if (args.size() < 4 || N(args[0]).kind != NodeKind::kStorage) {
+          Fail("_rebuild_tensor_v2(storage, offset, size, stride, ...)",
+               "other arguments");
+        }
+        auto t = std::make_shared<TensorRef>(*N(args[0]).tensor);
+        t->storage_offset = IntOf(args[1], "storage offset");
+        t->shape = IntsOf(args[2], "tensor size");
+        t->stride = IntsOf(args[3], "tensor stride");
+        if (t->shape.size() != t->stride.size()) {
+          Fail("as many strides as dimensions", "a mismatch");
+        }
+        const int id = NewNode(NodeKind::kTensor);
+        N(id).tensor = t;
+        return id;
+      }
+      case Global::kRebuildParameter: {
+        if (args.empty() || N(args[0]).kind != NodeKind::kTensor) {
+          Fail("_rebuild_parameter(tensor, ...)", "other arguments");
+        }
+        return args[0];
+      }
+      case Global::kNdarray:
+      case Global::kObjectClass:
+      case Global::kStorage:
+        break;
+    }
+    Fail("a callable global", "call of " + f.global_name);
+  }
+
+  void Build(int obj, int state) {
+    Node& o = N(obj);
+    switch (o.kind) {
+      case NodeKind::kPendingArray:
+        BuildArray(obj, state);
+        return;
+      case NodeKind::kDType:
+        BuildDType(obj, state);
+        return;
+      case NodeKind::kObject:
+      case NodeKind::kDict: {
+        // State is a dict, or (dict, slots dict) from classes with __slots__.
+        std::vector<int> dicts;
+        if (N(state).kind == NodeKind::kDict) {
+          dicts.push_back(state);
+        } else if (N(state).kind == NodeKind::kTuple && N(state).items.size() == 2) {
+          for (int part : N(state).items) {
+            if (N(part).kind == NodeKind::kDict) dicts.push_back(part);
+          }
+        } else {
+          Fail("an attribute dict as object state", KindName(state));
+        }
+        if (o.kind == NodeKind::kDict) return;  // OrderedDict attributes (_metadata)
+        for (int d : dicts) {
+          for (const auto& kv : N(d).entries) {
+            N(obj).entries.push_back(kv);
+            Nest(obj, kv.second);
+          }
+        }
+        return;
+      }
+      default:
+        Fail("an object that takes BUILD state", KindName(obj));
+    }
+  }
+
+  int PersistentLoad(int pid) {
+    // torch.save: ('storage', <Type>Storage, key, location, numel)
+    const std::vector<int>& t = TupleOf(pid, "persistent id");
+    if (t.size() != 5 || !IsText(t[0]) ||
+        TextOf(t[0], "persistent id tag") != "storage" ||
+        N(t[1]).kind != NodeKind::kGlobal || N(t[1]).global != Global::kStorage) {
+      Fail(
+          "a torch storage persistent id ('storage', torch.<Type>Storage, key, "
+          "location, numel)",
+          "another persistent id");
+    }
+    auto ref = std::make_shared<TensorRef>();
+    ref->dtype = N(t[1]).dtype;
+    ref->storage_key = TextOf(t[2], "storage key");
+    ref->device = TextOf(t[3], "storage location");
+    ref->storage_numel = IntOf(t[4], "storage numel");
+    if (ref->storage_numel < 0) Fail("a non-negative storage size", "a negative one");
+    const int id = NewNode(NodeKind::kStorage);
+    N(id).tensor = ref;
+    return id;
+  }
+
+  // ---- protocol 0 text arguments -------------------------------------------------
+  int64_t ParseDecimal(std::string s, const char* what) {
+    if (!s.empty() && s.back() == 'L') s.pop_back();
+    if (s.empty()) Fail(std::string(what) + " digits", "nothing");
+    size_t i = s[0] == '-' || s[0] == '+' ? 1 : 0;
+    if (i == s.size()) Fail(std::string(what) + " digits", "'" + s + "'");
+    uint64_t v = 0;
+    for (; i < s.size(); ++i) {
+      if (!std::isdigit(static_cast<unsigned char>(s[i]))) {
+        Fail(std::string(what) + " digits", "'" + s.substr(0, 40) + "'");
+      }
+      if (v > (uint64_t{1} << 62)) Fail("an integer that fits 64 bits", "a larger one");
+      v = v * 10 + (s[i] - '0');
+    }
+    return s[0] == '-' ? -static_cast<int64_t>(v) : static_cast<int64_t>(v);
+  }
+
+  // Python repr of a str: '...' or "..." with backslash escapes.
+  std::string UnquoteString(const std::string& s) {
+    if (s.size() < 2 || (s[0] != '\'' && s[0] != '"') || s.back() != s[0]) {
+      Fail("a quoted string", "'" + s.substr(0, 40) + "'");
+    }
+    std::string out;
+    for (size_t i = 1; i + 1 < s.size(); ++i) {
+      if (s[i] != '\\') {
+        out.push_back(s[i]);
+        continue;
+      }
+      if (++i >= s.size() - 1) Fail("a complete escape", "a trailing backslash");
+      const char c = s[i];
+      switch (c) {
+        case 'n':
+          out.push_back('\n');
+          break;
+        case 't':
+          out.push_back('\t');
+          break;
+        case 'r':
+          out.push_back('\r');
+          break;
+        case '\\':
+          out.push_back('\\');
+          break;
+        case '\'':
+          out.push_back('\'');
+          break;
+        case '"':
+          out.push_back('"');
+          break;
+        case 'x': {
+          if (i + 2 >= s.size()) Fail("\\x and two hex digits", "end");
+          out.push_back(static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16)));
+          i += 2;
+          break;
+        }
+        default:
+          if (c >= '0' && c <= '7') {
+            int v = 0, k = 0;
+            while (k < 3 && i < s.size() - 1 && s[i] >= '0' && s[i] <= '7') {
+              v = v * 8 + (s[i++] - '0');
+              ++k;
+            }
+            --i;
+            out.push_back(static_cast<char>(v & 0xFF));
+          } else {
+            out.push_back('\\');
+            out.push_back(c);
+          }
+      }
+    }
+    return out;
+  }
+
+  // raw-unicode-escape: \uXXXX and \UXXXXXXXX escapes, other bytes are Latin-1.
+  std::string DecodeRawUnicode(const std::string& s) {
+    std::string out;
+    for (size_t i = 0; i < s.size(); ++i) {
+      const size_t digits = s[i] == '\\' && i + 1 < s.size() ? (s[i + 1] == 'u'   ? 4
+                                                                : s[i + 1] == 'U' ? 8
+                                                                                  : 0)
+                                                             : 0;
+      if (digits && i + 2 + digits <= s.size()) {
+        uint32_t cp = 0;
+        for (size_t k = 0; k < digits; ++k) {
+          const char h = s[i + 2 + k];
+          if (!std::isxdigit(static_cast<unsigned char>(h))) Fail("hex digits", "other");
+          cp = cp * 16 + static_cast<uint32_t>(std::stoi(std::string(1, h), nullptr, 16));
+        }
+        if (cp > 0x10FFFF) Fail("a Unicode code point", "a larger number");
+        AppendUtf8(cp, &out);
+        i += 1 + digits;
+      } else {
+        AppendUtf8(static_cast<unsigned char>(s[i]), &out);
+      }
+    }
+    return out;
+  }
+
+  // ---- the opcode loop -----------------------------------------------------------
+  int Execute() {
+    while (true) {
+      op_offset_ = pos_;
+      if (pos_ >= in_.size()) {
+        op_ = 0;
+        Fail("a STOP opcode", "end of data (truncated pickle)");
+      }
+      op_ = static_cast<uint8_t>(in_[pos_++]);
+      switch (op_) {
+        case 0x80: {  // PROTO
+          const uint64_t proto = ReadLE(1);
+          if (proto > 5) Fail("pickle protocol 0-5", "protocol " + std::to_string(proto));
+          break;
+        }
+        case 0x95:
+          ReadLE(8);
+          break;     // FRAME: only a read-ahead hint
+        case '.': {  // STOP
+          const int root = Pop();
+          return root;
+        }
+        case '(':
+          marks_.push_back(stack_.size());
+          break;
+        case '0':
+          Pop();
+          break;
+        case '1':
+          PopMark();
+          break;
+        case '2':
+          Push(Top());
+          break;
+        case 'N':
+          Push(NewNode(NodeKind::kNone));
+          break;
+        case 0x88:
+        case 0x89: {
+          const int id = NewNode(NodeKind::kBool);
+          N(id).boolean = op_ == 0x88;
+          Push(id);
+          break;
+        }
+        case 'I': {
+          const std::string line = ReadLine();
+          if (line == "00" || line == "01") {
+            const int id = NewNode(NodeKind::kBool);
+            N(id).boolean = line == "01";
+            Push(id);
+          } else {
+            Push(MakeInt(ParseDecimal(line, "INT")));
+          }
+          break;
+        }
+        case 'L':
+          Push(MakeInt(ParseDecimal(ReadLine(), "LONG")));
+          break;
+        case 'J':
+          Push(MakeInt(static_cast<int32_t>(ReadLE(4))));
+          break;
+        case 'K':
+          Push(MakeInt(static_cast<int64_t>(ReadLE(1))));
+          break;
+        case 'M':
+          Push(MakeInt(static_cast<int64_t>(ReadLE(2))));
+          break;
+        case 0x8a:
+        case 0x8b: {  // LONG1 / LONG4: little-endian two's complement
+          const uint64_t n = ReadLE(op_ == 0x8a ? 1 : 4);
+          if (n > 8) Fail("an integer of at most 8 bytes", std::to_string(n) + " bytes");
+          Need(n);
+          uint64_t v = 0;
+          for (uint64_t k = n; k-- > 0;)
+            v = (v << 8) | static_cast<uint8_t>(in_[pos_ + k]);
+          if (n > 0 && n < 8 && (static_cast<uint8_t>(in_[pos_ + n - 1]) & 0x80)) {
+            v |= ~uint64_t{0} << (8 * n);  // sign-extend
+          }
+          pos_ += n;
+          Push(MakeInt(static_cast<int64_t>(v)));
+          break;
+        }
+        case 'F': {
+          const std::string line = ReadLine();
+          char* end = nullptr;
+          const double v = std::strtod(line.c_str(), &end);
+          if (line.empty() || *end != '\0')
+            Fail("a float", "'" + line.substr(0, 40) + "'");
+          const int id = NewNode(NodeKind::kFloat);
+          N(id).real = v;
+          Push(id);
+          break;
+        }
+        case 'G': {
+          uint64_t bits = 0;
+          Need(8);
+          for (int k = 0; k < 8; ++k)
+            bits = (bits << 8) | static_cast<uint8_t>(in_[pos_ + k]);
+          pos_ += 8;
+          double v;
+          std::memcpy(&v, &bits, 8);
+          const int id = NewNode(NodeKind::kFloat);
+          N(id).real = v;
+          Push(id);
+          break;
+        }
+        case 'S':
+          Push(MakeString(NodeKind::kPy2Str, UnquoteString(ReadLine())));
+          break;
+        case 'T':
+          Push(MakeString(NodeKind::kPy2Str, ReadBytes(ReadLE(4))));
+          break;
+        case 'U':
+          Push(MakeString(NodeKind::kPy2Str, ReadBytes(ReadLE(1))));
+          break;
+        case 'V':
+          Push(MakeString(NodeKind::kText, DecodeRawUnicode(ReadLine())));
+          break;
+        case 'X':
+          Push(MakeString(NodeKind::kText, ReadBytes(ReadLE(4))));
+          break;
+        case 0x8c:
+          Push(MakeString(NodeKind::kText, ReadBytes(ReadLE(1))));
+          break;
+        case 0x8d:
+          Push(MakeString(NodeKind::kText, ReadBytes(ReadLE(8))));
+          break;
+        case 'B':
+          Push(MakeString(NodeKind::kBytes, ReadBytes(ReadLE(4))));
+          break;
+        case 'C':
+          Push(MakeString(NodeKind::kBytes, ReadBytes(ReadLE(1))));
+          break;
+        case 0x8e:
+        case 0x96:
+          Push(MakeString(NodeKind::kBytes, ReadBytes(ReadLE(8))));
+          break;
+        case 0x98:
+          Top();
+          break;  // READONLY_BUFFER: no effect on our values
+        case ')':
+          Push(NewNode(NodeKind::kTuple));
+          break;
+        case ']':
+          Push(NewNode(NodeKind::kList));
+          break;
+        case '}':
+          Push(NewNode(NodeKind::kDict));
+          break;
+        case 0x8f:
+          Push(NewNode(NodeKind::kSet));
+          break;
+        case 't':
+          Push(MakeSequence(NodeKind::kTuple, PopMark()));
+          break;
+        case 'l':
+          Push(MakeSequence(NodeKind::kList, PopMark()));
+          break;
+        case 0x91:
+          Push(MakeSequence(NodeKind::kSet, PopMark()));
+          break;
+        case 0x85:
+        case 0x86:
+        case 0x87: {
+          const int n = op_ - 0x84;
+          std::vector<int> items(n);
+          for (int k = n - 1; k >= 0; --k) items[k] = Pop();
+          Push(MakeSequence(NodeKind::kTuple, items));
+          break;
+        }
+        case 'd': {
+          const std::vector<int> items = PopMark();
+          if (items.size() % 2) Fail("key-value pairs", "an odd number of items");
+          const int id = NewNode(NodeKind::kDict);
+          for (size_t k = 0; k < items.size(); k += 2)
+            SetItem(id, items[k], items[k + 1]);
+          Push(id);
+          break;
+        }
+        case 'a': {
+          const int item = Pop();
+          Append(Top(), item);
+          break;
+        }
+        case 'e':
+        case 0x90: {
+          const std::vector<int> items = PopMark();
+          const int target = Top();
+          for (int item : items) Append(target, item);
+          break;
+        }
+        case 's': {
+          const int value = Pop();
+          const int key = Pop();
+          SetItem(Top(), key, value);
+          break;
+        }
+        case 'u': {
+          const std::vector<int> items = PopMark();
+          if (items.size() % 2) Fail("key-value pairs", "an odd number of items");
+          const int target = Top();
+          for (size_t k = 0; k < items.size(); k += 2)
+            SetItem(target, items[k], items[k + 1]);
+          break;
+        }
+        case 'g':
+          Push(MemoGet(static_cast<uint64_t>(ParseDecimal(ReadLine(), "GET"))));
+          break;
+        case 'h':
+          Push(MemoGet(ReadLE(1)));
+          break;
+        case 'j':
+          Push(MemoGet(ReadLE(4)));
+          break;
+        case 'p':
+          memo_[static_cast<uint64_t>(ParseDecimal(ReadLine(), "PUT"))] = Top();
+          break;
+        case 'q':
+          memo_[ReadLE(1)] = Top();
+          break;
+        case 'r':
+          memo_[ReadLE(4)] = Top();
+          break;
+        case 0x94:
+          memo_[memo_.size()] = Top();
+          break;
+        case 'c': {
+          const std::string module = ReadLine();
+          const std::string name = ReadLine();
+          Push(MakeGlobal(module, name));
+          break;
+        }
+        case 0x93: {  // STACK_GLOBAL
+          const int name = Pop();
+          const int module = Pop();
+          if (N(name).kind != NodeKind::kText || N(module).kind != NodeKind::kText) {
+            Fail("module and name strings", "other values");
+          }
+          Push(MakeGlobal(N(module).text, N(name).text));
+          break;
+        }
+        case 'R': {
+          const int args = Pop();
+          const int callable = Pop();
+          Push(Reduce(callable, args));
+          break;
+        }
+        case 0x81: {  // NEWOBJ
+          const int args = Pop();
+          const int cls = Pop();
+          TupleOf(args, "NEWOBJ arguments");
+          Push(NewInstance(cls));
+          break;
+        }
+        case 0x92: {  // NEWOBJ_EX
+          Pop();      // kwargs
+          Pop();      // args
+          Push(NewInstance(Pop()));
+          break;
+        }
+        case 'i': {  // INST module\nname\n with MARKed args
+          const std::string module = ReadLine();
+          const std::string name = ReadLine();
+          PopMark();
+          Push(NewInstance(MakeGlobal(module, name)));
+          break;
+        }
+        case 'o': {  // OBJ: MARK cls args...
+          const std::vector<int> items = PopMark();
+          if (items.empty()) Fail("a class after MARK", "nothing");
+          Push(NewInstance(items[0]));
+          break;
+        }
+        case 'b': {
+          const int state = Pop();
+          Build(Top(), state);
+          break;
+        }
+        case 'Q':
+          Push(PersistentLoad(Pop()));
+          break;
+        case 'P':
+          Fail("torch storage persistent ids (BINPERSID)", "a text persistent id");
+        case 0x82:
+        case 0x83:
+        case 0x84:
+          Fail("no extension registry codes", "an EXT opcode");
+        case 0x97:
+          Fail("in-band data", "an out-of-band buffer");
+        default:
+          Fail("a pickle opcode", "unknown opcode");
+      }
+      if (marks_.size() > static_cast<size_t>(limits_.max_values)) {
+        Fail("fewer MARKs", "too many");
+      }
+    }
+  }
+
+  int MemoGet(uint64_t key) {
+    const auto it = memo_.find(key);
+    if (it == memo_.end()) Fail("a stored memo entry", "memo key " + std::to_string(key));
+    return it->second;
+  }
+
+  void Append(int target, int item) {
+    const NodeKind k = N(target).kind;
+    if (k != NodeKind::kList && k != NodeKind::kSet) {
+      Fail("a list or set to append to", KindName(target));
+    }
+    Nest(target, item);
+    N(target).items.push_back(item);
+  }
+
+  void SetItem(int target, int key, int value) {
+    if (N(target).kind != NodeKind::kDict)
+      Fail("a dict to set items on", KindName(target));
+    Nest(target, key);
+    Nest(target, value);
+    N(target).entries.emplace_back(key, value);
+  }
+
+  // ---- conversion to plain values ------------------------------------------------
+  void Budget(int depth) {
+    if (depth > limits_.max_depth) {
+      FailConvert("pickle",
+                  "nesting at most " + std::to_string(limits_.max_depth) +
+                      " levels deep (or a reference cycle)",
+                  "deeper");
+    }
+    if (++converted_ > limits_.max_values) {
+      FailConvert("pickle", "at most " + std::to_string(limits_.max_values) + " values",
+                  "more (shared references expand)");
+    }
+  }
+
+  std::string AttrName(int key) {
+    return IsText(key) ? TextOf(key, "attribute name") : std::string();
+  }
+  int Attr(int obj, const char* name) {
+    for (const auto& [k, v] : N(obj).entries) {
+      if (AttrName(k) == name) return v;
+    }
+    FailConvert(N(obj).global_name, std::string("attribute '") + name + "'", "missing");
+  }
+
+  std::shared_ptr<const NdArray> ArrayOf(int id, int depth, const std::string& what) {
+    const PickleValue v = Convert(id, depth);
+    if (v.kind == PickleValue::Kind::kArray) return v.array;
+    if (v.is_number()) {
+      const double x = v.number();
+      return std::make_shared<NdArray>(NdArray::FromDoubles({}, &x));
+    }
+    FailConvert(what, "an array", v.Describe());
+  }
+
+  std::shared_ptr<const NdArray> Select(int obj, int depth) {
+    const std::string& cls = N(obj).global_name;
+    const auto a = ArrayOf(Attr(obj, "a"), depth + 1, cls + ".a");
+    const auto idx_array = ArrayOf(Attr(obj, "idxs"), depth + 1, cls + ".idxs");
+    std::vector<int64_t> idxs;
+    try {
+      idxs = idx_array->ToInt64s();
+    } catch (const Error& e) {
+      FailConvert(cls + ".idxs", "integer indices", e.what());
+    }
+    std::vector<int64_t> shape = {static_cast<int64_t>(idxs.size())};
+    for (const auto& [k, v] : N(obj).entries) {
+      if (AttrName(k) == "preferred_shape" && N(v).kind != NodeKind::kNone) {
+        shape = IntsOf(v, "preferred_shape");
+      }
+    }
+    int64_t count = 1;
+    for (int64_t d : shape) {
+      if (d < 0 || (d > 0 && count > (int64_t{1} << 40) / d)) {
+        FailConvert(cls + ".preferred_shape", "a valid shape", "out of range");
+      }
+      count *= d;
+    }
+    if (count != static_cast<int64_t>(idxs.size())) {
+      FailConvert(cls + ".preferred_shape",
+                  std::to_string(idxs.size()) + " elements like idxs",
+                  std::to_string(count));
+    }
+    auto out = std::make_shared<NdArray>();
+    out->dtype = a->dtype;
+    out->itemsize = a->itemsize;
+    out->shape = shape;
+    out->data.resize(idxs.size() * a->itemsize);
+    const int64_t n = a->size();
+    for (size_t i = 0; i < idxs.size(); ++i) {
+      if (idxs[i] < 0 || idxs[i] >= n) {
+        FailConvert(cls + ".idxs", "indices below " + std::to_string(n),
+                    std::to_string(idxs[i]));
+      }
+      std::memcpy(out->data.data() + i * a->itemsize,
+                  a->data.data() + idxs[i] * a->itemsize, a->itemsize);
+    }
+    return out;
+  }
+
+  std::shared_ptr<const SparseArrays> Sparse(int obj, int depth) {
+    const std::string& cls = N(obj).global_name;
+    auto s = std::make_shared<SparseArrays>();
+    s->format = N(obj).global == Global::kCscMatrix ? "csc" : "csr";
+    s->data = *ArrayOf(Attr(obj, "data"), depth + 1, cls + ".data");
+    s->indices = *ArrayOf(Attr(obj, "indices"), depth + 1, cls + ".indices");
+    s->indptr = *ArrayOf(Attr(obj, "indptr"), depth + 1, cls + ".indptr");
+    int shape_id = -1;
+    for (const auto& [k, v] : N(obj).entries) {
+      const std::string name = AttrName(k);
+      if (name == "_shape" || name == "shape") shape_id = v;
+    }
+    if (shape_id < 0) FailConvert(cls, "attribute '_shape'", "missing");
+    const std::vector<int64_t> shape = IntsOf(shape_id, "sparse shape");
+    if (shape.size() != 2 || shape[0] < 0 || shape[1] < 0) {
+      FailConvert(cls + "._shape", "two non-negative dimensions", "other");
+    }
+    s->rows = shape[0];
+    s->cols = shape[1];
+    const int64_t outer = s->format == "csc" ? s->cols : s->rows;
+    const int64_t inner = s->format == "csc" ? s->rows : s->cols;
+    std::vector<int64_t> indptr, indices;
+    try {
+      indptr = s->indptr.ToInt64s();
+      indices = s->indices.ToInt64s();
+    } catch (const Error& e) {
+      FailConvert(cls, "integer index arrays", e.what());
+    }
+    const int64_t nnz = s->data.size();
+    if (static_cast<int64_t>(indptr.size()) != outer + 1 || indptr.front() != 0 ||
+        indptr.back() != nnz || static_cast<int64_t>(indices.size()) != nnz) {
+      FailConvert(cls,
+                  "indptr of " + std::to_string(outer + 1) +
+                      " entries from 0 to nnz and one index per value",
+                  "inconsistent arrays");
+    }
+    for (size_t k = 1; k < indptr.size(); ++k) {
+      if (indptr[k] < indptr[k - 1])
+        FailConvert(cls + ".indptr", "non-decreasing", "not");
+    }
+    for (int64_t i : indices) {
+      if (i < 0 || i >= inner) {
+        FailConvert(cls + ".indices", "values below " + std::to_string(inner),
+                    std::to_string(i));
+      }
+    }
+    return s;
+  }
+
+  PickleValue Convert(int id, int depth) {
+    Budget(depth);
+    const Node& n = N(id);
+    PickleValue v;
+    using K = PickleValue::Kind;
+    switch (n.kind) {
+      case NodeKind::kNone:
+        v.kind = K::kNone;
+        v.type_name = "NoneType";
+        break;
+      case NodeKind::kBool:
+        v.kind = K::kBool;
+        v.boolean = n.boolean;
+        v.type_name = "bool";
+        break;
+      case NodeKind::kInt:
+        v.kind = K::kInt;
+        v.integer = n.integer;
+        v.type_name = "int";
+        break;
+      case NodeKind::kFloat:
+        v.kind = K::kFloat;
+        v.real = n.real;
+        v.type_name = "float";
+        break;
+      case NodeKind::kText:
+        v.kind = K::kText;
+        v.text = n.text;
+        v.type_name = "str";
+        break;
+      case NodeKind::kPy2Str:
+        v.kind = K::kText;
+        v.text = Latin1ToUtf8(n.text);
+        v.type_name = "str";
+        break;
+      case NodeKind::kBytes:
+        v.kind = K::kBytes;
+        v.text = n.text;
+        v.type_name = "bytes";
+        break;
+      case NodeKind::kList:
+      case NodeKind::kTuple:
+      case NodeKind::kSet: {
+        if (n.global_name == "numpy object array" && n.integer == 0 &&
+            n.items.size() == 1) {
+          return Convert(n.items[0], depth + 1);
+        }
+        v.kind = K::kList;
+        v.type_name = n.kind == NodeKind::kList    ? "list"
+                      : n.kind == NodeKind::kTuple ? "tuple"
+                                                   : "set";
+        const std::vector<int> items = n.items;  // nodes_ is stable, but be explicit
+        for (int item : items) v.items.push_back(Convert(item, depth + 1));
+        break;
+      }
+      case NodeKind::kDict: {
+        v.kind = K::kDict;
+        v.type_name = "dict";
+        const auto entries = n.entries;
+        for (const auto& [key, value] : entries) {
+          v.entries.emplace_back(Convert(key, depth + 1), Convert(value, depth + 1));
+        }
+        break;
+      }
+      case NodeKind::kArray:
+        v.kind = K::kArray;
+        v.array = n.array;
+        v.type_name = "numpy.ndarray";
+        break;
+      case NodeKind::kObject: {
+        v.type_name = n.global_name;
+        if (n.global == Global::kCh) {
+          v.kind = K::kArray;
+          v.array = ArrayOf(Attr(id, "x"), depth + 1, n.global_name + ".x");
+        } else if (n.global == Global::kSelect) {
+          v.kind = K::kArray;
+          v.array = Select(id, depth);
+        } else {
+          v.kind = K::kSparse;
+          v.sparse = Sparse(id, depth);
+        }
+        break;
+      }
+      case NodeKind::kTensor:
+        v.kind = K::kTensor;
+        v.tensor = n.tensor;
+        v.type_name = "torch.Tensor";
+        break;
+      case NodeKind::kPendingArray:
+        v.kind = K::kUnsupported;
+        v.type_name = "numpy.ndarray";
+        v.text = "no state";
+        break;
+      case NodeKind::kUnsupported:
+        v.kind = K::kUnsupported;
+        v.type_name = n.global_name;
+        v.text = n.text;
+        break;
+      case NodeKind::kGlobal:
+      case NodeKind::kDType:
+      case NodeKind::kStorage:
+        v.kind = K::kUnsupported;
+        v.type_name = KindName(id);
+        v.text = "not plain data";
+        break;
+    }
+    return v;
+  }
+
+  const std::string& in_;
+  const std::string& source_;
+  const PickleLimits& limits_;
+  size_t pos_ = 0;
+  size_t op_offset_ = 0;
+  uint8_t op_ = 0;
+  std::vector<Node> nodes_;
+  std::vector<int> stack_;
+  std::vector<size_t> marks_;
+  std::unordered_map<uint64_t, int> memo_;
+  int64_t total_bytes_ = 0;
+  int64_t converted_ = 0;
+};
+
+}  // namespace
+
+bool PickleLimits::Check(std::string* error) const {
+  if (max_values < 1 || max_depth < 1 || max_total_bytes < 0) {
+    *error = "PickleLimits: max_values and max_depth must be positive";
+    return false;
+  }
+  return true;
+}
+
+PickleValue ReadPickle(const std::string& bytes, const std::string& source,
+                       const PickleLimits& limits) {
+  std::string error;
+  if (!limits.Check(&error)) throw InputError(source, "PickleLimits", error);
+  return Reader(bytes, source, limits).Run();
+}
+
+PickleValue ReadPickleFile(const std::string& path, const PickleLimits& limits) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "a readable pickle file", "cannot open");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return ReadPickle(buffer.str(), path, limits);
+}
+
+}  // namespace handlabel

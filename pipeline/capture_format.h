@@ -1,0 +1,113 @@
+#pragma once
+// The native capture layout (docs/capture-format.md), version 1: what `handlabel synth`
+// writes and what dataset readers convert to. A capture is a folder with a manifest
+// `capture.json` naming the rig file, the cameras, the frames and, per kind of file, a
+// path pattern with {camera} and {frame} placeholders (relative to the folder):
+//
+//   capture.json                          manifest (this file's CaptureManifest)
+//   rig.json                              cameras, own JSON (calib/rig_json.h)
+//   colmap/{cameras,images,points3D}.txt  the same rig as a COLMAP text model
+//   images/{camera}/{frame}.png           RGB
+//   masks/{camera}/{frame}.png            hand mask, 0/255 (visible hand pixels)
+//   object_masks/{camera}/{frame}.png     0 = none, k = object k of the frame
+//   depth/{camera}/{frame}.png            16-bit, depth_unit_m per step, 0 = none
+//   keypoints/{frame}.json                ground-truth 2D keypoints per view
+//   detections/{frame}.json               simulated 2D detections per view
+//   detections/masks/{camera}/{frame}.png noisy hand masks
+//   ground_truth/{frame}.json             hand parameters, 3D keypoints, vertices
+// Kinds a capture does not have are absent from "files". This header holds the
+// manifest and the per-frame records with their JSON forms; the writer is
+// synth_capture.h, the reader capture_reader.h.
+
+#include <Eigen/Core>
+#include <array>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/hand_lbs.h"
+#include "core/hand_model.h"
+#include "core/rigid3.h"
+
+namespace handlabel {
+
+inline constexpr int kCaptureFormatVersion = 1;
+inline constexpr char kCaptureManifestFile[] = "capture.json";
+
+// File kinds (keys of CaptureManifest::files).
+inline constexpr char kFileImage[] = "image";
+inline constexpr char kFileMask[] = "mask";
+inline constexpr char kFileObjectMask[] = "object_mask";
+inline constexpr char kFileDepth[] = "depth";
+inline constexpr char kFileKeypoints[] = "keypoints";
+inline constexpr char kFileDetections[] = "detections";
+inline constexpr char kFileDetectionMask[] = "detection_mask";
+inline constexpr char kFileGroundTruth[] = "ground_truth";
+
+struct CaptureManifest {
+  int version = kCaptureFormatVersion;
+  std::string rig_file = "rig.json";         // relative to the capture folder
+  std::string colmap_dir;                    // "" = no COLMAP copy of the rig
+  std::vector<std::string> cameras;          // names in rig order
+  std::vector<std::string> frames;           // frame ids, e.g. "000000"
+  std::map<std::string, std::string> files;  // kind -> pattern
+  double depth_unit_m = 1e-4;                // metres per step of 16-bit depth PNGs
+  std::string world;                         // what the world frame is (free text)
+  std::string hand_side = "right";           // "right" or "left"
+  nlohmann::json generator = nlohmann::json::object();  // tool, seed, settings
+};
+
+nlohmann::json ManifestToJson(const CaptureManifest& manifest);
+// Throws InputError naming `source` and the field.
+CaptureManifest ManifestFromJson(const nlohmann::json& json, const std::string& source);
+
+// Replaces {camera} and {frame} in `pattern`.
+std::string ExpandPattern(const std::string& pattern, const std::string& camera,
+                          const std::string& frame);
+// "000042" for 42.
+std::string FrameId(int index);
+
+// 2D keypoints of one view, SNAP order. Ground truth has visibility (0 out of frame,
+// 1 occluded, 2 visible; synth_view.h) and confidence 1; detections have confidence
+// (0 = missing) and visibility -1. Missing positions are NaN (null in JSON).
+struct ViewKeypoints {
+  std::string camera;
+  Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor> keypoints =
+      Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor>::Zero();
+  std::array<int, kNumHandKeypoints> visibility{};
+  std::array<double, kNumHandKeypoints> confidence{};
+  std::string status;    // ground truth: "visible", "occluded", "out_of_frame"
+  int hand_pixels = -1;  // ground truth: visible hand pixels; -1 = unknown
+};
+
+// {"frame": id, "views": [...]}; `ground_truth` selects the fields written.
+nlohmann::json ViewKeypointsToJson(const std::string& frame,
+                                   const std::vector<ViewKeypoints>& views,
+                                   bool ground_truth);
+std::vector<ViewKeypoints> ViewKeypointsFromJson(const nlohmann::json& json,
+                                                 const std::string& source);
+
+struct ObjectGroundTruth {
+  std::string kind;  // sphere, box, cylinder
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();
+  Rigid3 world_from_object;
+};
+
+// Ground truth of one frame, all in the rig's world frame.
+struct HandGroundTruth {
+  std::string hand_model;  // model name
+  std::string side = "right";
+  std::string pose_kind;
+  HandParams params;
+  Points3d keypoints;  // 21 x 3, SNAP order
+  Points3d joints;     // 16 x 3, native order
+  Points3d vertices;   // V x 3
+  std::vector<ObjectGroundTruth> objects;
+};
+
+nlohmann::json GroundTruthToJson(const std::string& frame, const HandGroundTruth& gt);
+HandGroundTruth GroundTruthFromJson(const nlohmann::json& json,
+                                    const std::string& source);
+
+}  // namespace handlabel

@@ -1,0 +1,23 @@
+#pragma once
+// A contact sheet of one capture frame: every view in a grid, each with the hand mask
+// tinted over the image and the ground-truth 2D keypoints and skeleton drawn (visible
+// keypoints filled, occluded ones hollow, out-of-frame ones left out), so a person can
+// check a capture at a glance.
+
+#include "core/image.h"
+#include "pipeline/capture_reader.h"
+
+namespace handlabel {
+
+struct ContactSheetOptions {
+  int columns = 4;           // views per row (>= 1)
+  int tile_width = 320;      // each view is scaled to this width (>= 16)
+  bool mask_overlay = true;  // tint the hand mask
+  bool keypoints = true;     // draw keypoints and skeleton
+  bool detections = false;   // also draw simulated detections (crosses), if present
+};
+
+ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
+                         const ContactSheetOptions& options = {});
+
+}  // namespace handlabel

@@ -1,0 +1,88 @@
+#pragma once
+// Random scenes for synthetic captures: a posed hand (natural poses within anatomical
+// limits, random shape), its skin tone, the lighting, and objects held near or in the
+// hand, placed in a rig's world frame where most cameras see the hand.
+//
+// Pose kinds: the sampler's archetypes (open, fist, pinch, point, random within
+// limits; core/hand_pose_sampler.h), plus "grasp" (a partial fist, t in [0.3, 0.75] of
+// the fist angles, as when holding an object) and "pca" (Gaussian coefficients on the
+// model's pose PCA basis, clamped to the limits). Every pose is clamped to the limits.
+
+#include <Eigen/Core>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/hand_anatomy.h"
+#include "core/hand_lbs.h"
+#include "core/hand_model.h"
+#include "core/hand_pose_sampler.h"
+#include "core/rasterizer.h"
+#include "core/rig.h"
+
+namespace handlabel {
+
+struct SynthSceneOptions {
+  // Relative frequencies of the pose kinds (>= 0, not all zero).
+  double weight_open = 1.0;
+  double weight_fist = 0.7;
+  double weight_pinch = 1.0;
+  double weight_point = 0.7;
+  double weight_random = 0.3;  // uniform within the limits: often unnatural
+  double weight_grasp = 1.5;
+  double weight_pca = 0.7;
+  // Jitter of archetype angles, degrees.
+  double jitter_deg = 6.0;
+  // Standard deviation of pose PCA coefficients ("pca" kind), radians, and how many
+  // leading components are drawn.
+  double pca_sigma = 0.6;
+  int pca_components = 12;
+  // Standard deviation of the shape coefficients (clamped to +-2.5 sigma).
+  double betas_sigma = 1.0;
+  // Add 1..max_objects objects (sphere, box, cylinder) held near or in the hand.
+  bool objects = false;
+  int max_objects = 2;
+  // The hand centre is drawn uniformly in a ball of this radius (m) around the
+  // workspace centre (the world origin of the presets).
+  Eigen::Vector3d workspace_center = Eigen::Vector3d::Zero();
+  double workspace_radius = 0.06;
+  // Placement attempts; the one where the most cameras see all 21 keypoints wins.
+  int placement_tries = 12;
+  // Throws InputError naming the field.
+  void Check() const;
+};
+
+std::vector<std::string> SynthPoseKindNames();  // open fist pinch point random grasp pca
+
+struct SynthObject {
+  std::string kind;          // "sphere", "box" or "cylinder"
+  Eigen::Vector3d size;      // sphere: (r, r, r); box: edges; cylinder: (r, r, height)
+  Rigid3 world_from_object;  // object centre and axes
+  Eigen::Vector3f color;     // albedo
+  int texture_kind = 0;      // 0 plain, 1 stripes, 2 checker
+  RenderMesh mesh;           // in world coordinates
+};
+
+struct SynthScene {
+  HandSide side = HandSide::kRight;
+  std::string pose_kind;
+  HandParams params;       // world frame = the rig's world frame
+  HandMesh hand;           // posed (world)
+  RenderMesh hand_render;  // hand mesh with skin colours and normals
+  Eigen::Vector3f skin = Eigen::Vector3f::Ones();
+  ShadingOptions lighting;
+  std::vector<SynthObject> objects;
+  int cameras_seeing_hand = 0;  // cameras with all 21 keypoints inside the image
+};
+
+// The mesh of an object in its own frame (as SampleSynthScene tessellates it): kind
+// "sphere" (radius size.x), "box" (edges size), "cylinder" (radius size.x, height
+// size.z, along z). Throws InputError for unknown kinds or non-positive sizes.
+RenderMesh MakeObjectMesh(const std::string& kind, const Eigen::Vector3d& size);
+
+// Samples one scene. Deterministic in `rng`'s state.
+SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
+                            const HandLimits& limits, const Rig& rig,
+                            const SynthSceneOptions& options, std::mt19937_64& rng);
+
+}  // namespace handlabel

@@ -1,0 +1,232 @@
+#include "core/pickle_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "core/errors.h"
+#include "core/torch_archive.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+using K = PickleValue::Kind;
+using namespace std::string_literals;
+
+std::string DataPath(const std::string& rel) {
+  return std::string(HANDLABEL_SOURCE_DIR) + "/tests/data/" + rel;
+}
+
+std::string ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The error message ReadPickle gives, or "" when it succeeds.
+std::string PickleError(const std::string& bytes, const PickleLimits& limits = {}) {
+  try {
+    ReadPickle(bytes, "hostile.pkl", limits);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+class SmallPickle : public ::testing::TestWithParam<int> {};
+
+// make_mano_fixtures.py pickles one dict at every protocol: the text opcodes of
+// protocol 0, the binary ones of 1-3, frames / memoize / short unicode of 4 and the
+// bytearray buffers of 5 must all give the same values.
+TEST_P(SmallPickle, EveryProtocolDecodesTheSameValues) {
+  const PickleValue v =
+      ReadPickleFile(DataPath("mano/small_p" + std::to_string(GetParam()) + ".pkl"));
+  ASSERT_EQ(v.kind, K::kDict);
+  const PickleValue* arr = v.Find("arr");
+  ASSERT_NE(arr, nullptr);
+  ASSERT_EQ(arr->kind, K::kArray);
+  EXPECT_EQ(arr->array->shape, (std::vector<int64_t>{2, 3}));
+  EXPECT_EQ(arr->array->ToDoubles(), (std::vector<double>{0, 1.5, 3, 4.5, 6, 7.5}));
+  EXPECT_EQ(v.Find("big")->array->ToInt64s(), (std::vector<int64_t>{1, -2, 3}));
+  EXPECT_EQ(v.Find("fortran")->array->ToInt64s(),
+            (std::vector<int64_t>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(v.Find("text")->text, "h\xc3\xa9llo \xe2\x98\x83");
+  EXPECT_EQ(v.Find("bytes")->kind, K::kBytes);
+  EXPECT_EQ(v.Find("bytes")->text, std::string("\x00\xff\n", 3));
+  const std::vector<int64_t> ints = {
+      0,         1,        -1, 255, 256, 65536, -(int64_t{1} << 31), int64_t{1} << 40,
+      INT64_MIN, INT64_MAX};
+  const PickleValue* tuple = v.Find("ints");
+  ASSERT_EQ(tuple->items.size(), ints.size());
+  for (size_t i = 0; i < ints.size(); ++i) EXPECT_EQ(tuple->items[i].integer, ints[i]);
+  EXPECT_EQ(v.Find("float")->real, 0.1);
+  EXPECT_EQ(v.Find("none")->kind, K::kNone);
+  EXPECT_TRUE(v.Find("flags")->items[0].boolean);
+  EXPECT_FALSE(v.Find("flags")->items[1].boolean);
+  EXPECT_EQ(v.Find("set")->items.at(0).integer, 3);
+  EXPECT_EQ(v.Find("od")->Find("k")->integer, 1);
+  EXPECT_EQ(v.Find("scalar")->real, 2.5);
+  EXPECT_EQ(v.Find("nested")->items.at(0).items.at(1).items.at(0).integer, 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Protocols, SmallPickle, ::testing::Range(0, 6));
+
+TEST(PickleReader, ReadsTheOfficialMANOStructure) {
+  const PickleValue v = ReadPickleFile(DataPath("mano/mano_py2_right.pkl"));
+  EXPECT_EQ(v.Find("bs_style")->text, "lbs");
+  const PickleValue* shapedirs = v.Find("shapedirs");
+  EXPECT_EQ(shapedirs->type_name, "chumpy.reordering.Select");
+  EXPECT_EQ(shapedirs->array->shape, (std::vector<int64_t>{12, 3, 10}));
+  EXPECT_EQ(v.Find("weights")->type_name, "chumpy.ch.Ch");
+  const PickleValue* reg = v.Find("J_regressor");
+  ASSERT_EQ(reg->kind, K::kSparse);
+  EXPECT_EQ(reg->sparse->format, "csc");
+  EXPECT_EQ(reg->sparse->rows, 16);
+  EXPECT_EQ(reg->sparse->cols, 12);
+  EXPECT_EQ(v.Find("f")->array->dtype, DType::kUInt32);
+}
+
+TEST(PickleReader, ReadsTorchSaveStateDicts) {
+  const TorchArchive archive(DataPath("npy/state_dict.pt"));
+  const NamedArrays tensors = archive.Tensors();
+  ASSERT_EQ(tensors.size(), 4u);
+  EXPECT_EQ(tensors[0].first, "weight");
+  EXPECT_EQ(tensors[0].second.dtype, DType::kFloat32);
+  EXPECT_EQ(tensors[0].second.shape, (std::vector<int64_t>{2, 3, 4}));
+  for (int i = 0; i < 24; ++i) EXPECT_EQ(tensors[0].second.ToDoubles()[i], i * 1.25 - 7);
+  EXPECT_EQ(tensors[1].second.ToDoubles(), (std::vector<double>{-7, -5.75, -4.5, -3.25}));
+  // steps = arange(24).reshape(6, 4).T[1:] * 5 - 40: a strided view at offset 1.
+  const NdArray& steps = tensors[2].second;
+  EXPECT_EQ(steps.shape, (std::vector<int64_t>{3, 6}));
+  const std::vector<int64_t> s = steps.ToInt64s();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 6; ++c) EXPECT_EQ(s[r * 6 + c], (c * 4 + r + 1) * 5 - 40);
+  }
+  EXPECT_EQ(tensors[3].second.dtype, DType::kFloat16);
+  EXPECT_EQ(tensors[3].second.ToDoubles()[5], 5 * 1.25 - 7);
+}
+
+// ---- hostile input -----------------------------------------------------------------
+
+TEST(PickleReader, RefusesUnknownGlobalsNamingThemAndTheOffset) {
+  // cos\nsystem\n(S'echo hacked'\ntR.  -- the classic.
+  const std::string evil = "cos\nsystem\n(S'echo hacked'\ntR.";
+  const std::string error = PickleError(evil);
+  EXPECT_NE(error.find("global 'os.system'"), std::string::npos) << error;
+  EXPECT_NE(error.find("GLOBAL at offset 0"), std::string::npos) << error;
+  EXPECT_NE(error.find("hostile.pkl"), std::string::npos) << error;
+  // Protocol 4 STACK_GLOBAL of builtins.eval.
+  const std::string eval =
+      "\x80\x04\x8c\x08"
+      "builtins"
+      "\x8c\x04"
+      "eval"
+      "\x93"
+      "\x8c\x01"
+      "1"
+      "\x85R.";
+  EXPECT_NE(PickleError(eval).find("global 'builtins.eval'"), std::string::npos);
+  // A known class is not a licence to call anything: REDUCE on numpy.ndarray.
+  EXPECT_NE(PickleError("cnumpy\nndarray\n)R.").find("REDUCE"), std::string::npos);
+  // Persistent ids other than torch storages, extension codes, out-of-band buffers.
+  EXPECT_NE(PickleError("Pfoo\n.").find("PERSID"), std::string::npos);
+  EXPECT_NE(PickleError("\x80\x02\x82\x01.").find("EXT1"), std::string::npos);
+  EXPECT_NE(PickleError("\x80\x05\x97.").find("NEXT_BUFFER"), std::string::npos);
+  EXPECT_NE(PickleError("\xff").find("unknown opcode"), std::string::npos);
+}
+
+TEST(PickleReader, RefusesHugeDeclaredSizesBeforeAllocating) {
+  // BINBYTES8 declaring 2^62 bytes, BINUNICODE8 the same, LONG4 with a 2 GiB integer.
+  EXPECT_NE(PickleError(std::string("\x80\x04\x8e\x00\x00\x00\x00\x00\x00\x00\x40", 11))
+                .find("truncated"),
+            std::string::npos);
+  EXPECT_NE(PickleError(std::string("\x80\x04\x8d\xff\xff\xff\xff\xff\xff\xff\x7f", 11))
+                .find("truncated"),
+            std::string::npos);
+  EXPECT_NE(
+      PickleError(std::string("\x80\x02\x8b\x00\x00\x00\x80", 7)).find("at most 8 bytes"),
+      std::string::npos);
+  // An ndarray whose shape claims 10^18 elements but carries 8 bytes of data.
+  std::string bytes = ReadBytes(DataPath("mano/small_p2.pkl"));
+  const std::string shape = std::string("K\x02K\x03\x86", 5);  // (2, 3)
+  const size_t at = bytes.find(shape);
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at, shape.size(),
+                std::string("\x8a\x08\x00\x00\x64\xa7\xb3\xb6\xe0\x0dK\x03\x86", 13));
+  const std::string error = PickleError(bytes);
+  EXPECT_NE(error.find("limit"), std::string::npos) << error;
+  // A memo PUT at index 2^32-1 does not allocate 2^32 slots.
+  EXPECT_EQ(
+      PickleError(std::string("\x80\x02N\x72\xff\xff\xff\xff\x6a\xff\xff\xff\xff.", 14)),
+      "");
+  // Value and byte budgets.
+  PickleLimits tight;
+  tight.max_values = 100;
+  std::string many = "\x80\x02]";
+  for (int i = 0; i < 200; ++i) many += "Na";
+  EXPECT_NE(PickleError(many + ".", tight).find("at most 100 values"), std::string::npos);
+  tight = PickleLimits();
+  tight.max_total_bytes = 1000;
+  EXPECT_NE(PickleError(ReadBytes(DataPath("mano/mano_py2_right.pkl")), tight)
+                .find("at most 1000 bytes"),
+            std::string::npos);
+}
+
+TEST(PickleReader, RefusesDeepNestingAndCyclesWithoutRecursingDeeply) {
+  // 100000 nested lists: ]]]]...a a a  (each APPEND puts the inner list into the outer).
+  std::string deep = "\x80\x02";
+  for (int i = 0; i < 100000; ++i) deep += "]";
+  for (int i = 0; i < 99999; ++i) deep += "a";
+  deep += ".";
+  EXPECT_NE(PickleError(deep).find("levels deep"), std::string::npos);
+  // A list that contains itself: ] q0 h0 a .
+  const std::string cycle =
+      "\x80\x02]q\x00h\x00"
+      "a."s;
+  EXPECT_NE(PickleError(cycle).find("levels deep"), std::string::npos)
+      << PickleError(cycle);
+  // Exponential sharing: L0=[], L(k+1)=[Lk, Lk]: 2^40 leaves if expanded.
+  std::string laughs = "\x80\x02]q\x00"s;
+  for (int k = 0; k < 40; ++k) {
+    laughs += "](h";
+    laughs += static_cast<char>(k);
+    laughs += "h";
+    laughs += static_cast<char>(k);
+    laughs += "eq";
+    laughs += static_cast<char>(k + 1);
+  }
+  laughs += ".";
+  PickleLimits limits;
+  limits.max_values = 100000;
+  EXPECT_NE(PickleError(laughs, limits).find("values"), std::string::npos);
+}
+
+TEST(PickleReader, EveryTruncationFailsCleanly) {
+  for (const char* file : {"mano/small_p0.pkl", "mano/small_p2.pkl", "mano/small_p5.pkl",
+                           "mano/mano_py2_right.pkl"}) {
+    const std::string bytes = ReadBytes(DataPath(file));
+    const size_t step = std::max<size_t>(1, bytes.size() / 300);
+    for (size_t n = 0; n + 1 < bytes.size(); n += step) {
+      const std::string error = PickleError(bytes.substr(0, n));
+      EXPECT_NE(error, "") << file << " cut at " << n;
+    }
+  }
+}
+
+TEST(PickleReader, RandomByteFlipsNeverCrash) {
+  const std::string good = ReadBytes(DataPath("mano/mano_py2_right.pkl"));
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string bad = good;
+    for (int k = 0; k < 3; ++k) {
+      bad[static_cast<size_t>(testing::Uniform(0, bad.size() - 1))] =
+          static_cast<char>(testing::Uniform(0, 256));
+    }
+    PickleError(bad);  // either decodes or throws InputError; never anything else
+  }
+}
+
+}  // namespace
+}  // namespace handlabel

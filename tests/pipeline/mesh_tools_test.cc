@@ -1,0 +1,146 @@
+// Implicit mesher, mesh checks, NNLS and the PNG encoder on problems with known answers.
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <cmath>
+
+#include "pipeline/implicit_mesher.h"
+#include "pipeline/mesh_checks.h"
+#include "pipeline/mesh_decimation.h"
+#include "pipeline/mesh_render.h"
+#include "pipeline/nnls.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+void ToArrays(const TriangleMesh& mesh, Points3d* v, Faces* f) {
+  v->resize(static_cast<Eigen::Index>(mesh.vertices.size()), 3);
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) v->row(i) = mesh.vertices[i];
+  f->resize(static_cast<Eigen::Index>(mesh.faces.size()), 3);
+  for (size_t i = 0; i < mesh.faces.size(); ++i) f->row(i) = mesh.faces[i];
+}
+
+TriangleMesh Sphere(double radius, double step) {
+  ImplicitMesherOptions options;
+  options.step = step;
+  const Eigen::Vector3d c(0.0013, -0.0007, 0.0021);  // off-grid centre
+  return MeshImplicitSurface(
+      [&](const Eigen::Vector3d& p) { return (p - c).norm() - radius; },
+      Eigen::Vector3d::Constant(-0.03), Eigen::Vector3d::Constant(0.03), options);
+}
+
+TEST(ImplicitMesher, SphereIsClosedOutwardAndHasTheRightVolume) {
+  const double r = 0.02;
+  const TriangleMesh mesh = Sphere(r, 0.0015);
+  Points3d v;
+  Faces f;
+  ToArrays(mesh, &v, &f);
+  const MeshTopology topo = AnalyzeMeshTopology(static_cast<int>(v.rows()), f);
+  EXPECT_TRUE(topo.IsClosedManifold())
+      << "boundary " << topo.boundary_edges << " nonmanifold " << topo.nonmanifold_edges
+      << " misoriented " << topo.misoriented_edges << " euler "
+      << topo.euler_characteristic;
+  const double exact = 4.0 / 3.0 * M_PI * r * r * r;
+  EXPECT_NEAR(SignedVolume(v, f), exact, 0.01 * exact);
+  for (const auto& p : mesh.vertices)
+    EXPECT_NEAR((p - Eigen::Vector3d(0.0013, -0.0007, 0.0021)).norm(), r, 2e-4);
+}
+
+TEST(MeshDecimation, KeepsASphereClosedAndRound) {
+  const TriangleMesh fine = Sphere(0.02, 0.0015);
+  DecimationOptions options;
+  options.target_vertices = 300;
+  TriangleMesh coarse = DecimateMesh(fine, options);
+  EXPECT_EQ(static_cast<int>(coarse.vertices.size()), 300);
+  const Eigen::Vector3d c(0.0013, -0.0007, 0.0021);
+  RelaxMesh(&coarse, 3, [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return c + 0.02 * (p - c).normalized();
+  });
+  Points3d v;
+  Faces f;
+  ToArrays(coarse, &v, &f);
+  EXPECT_TRUE(AnalyzeMeshTopology(static_cast<int>(v.rows()), f).IsClosedManifold());
+  EXPECT_EQ(CountSelfIntersections(v, f), 0);
+  const double exact = 4.0 / 3.0 * M_PI * 0.02 * 0.02 * 0.02;
+  EXPECT_NEAR(SignedVolume(v, f), exact, 0.03 * exact);
+}
+
+TEST(MeshChecks, DetectsOpenFlippedAndIntersectingMeshes) {
+  // A tetrahedron, outward.
+  Points3d v(4, 3);
+  v << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  Faces f(4, 3);
+  f << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  EXPECT_TRUE(AnalyzeMeshTopology(4, f).IsClosedManifold());
+  EXPECT_NEAR(SignedVolume(v, f), 1.0 / 6.0, 1e-12);
+  Faces flipped = f;
+  flipped.row(0) << 0, 1, 2;
+  EXPECT_EQ(AnalyzeMeshTopology(4, flipped).misoriented_edges, 3);
+  EXPECT_EQ(AnalyzeMeshTopology(4, f.topRows(3)).boundary_edges, 3);
+  EXPECT_EQ(CountSelfIntersections(v, f), 0);
+  // Two triangles crossing each other, sharing no vertex.
+  Points3d w(6, 3);
+  w << -1, 0, 0, 1, 0, 0, 0, 1, 0,  //
+      0, 0.5, -1, 0, 0.5, 1, 0, -1, 0;
+  Faces g(2, 3);
+  g << 0, 1, 2, 3, 4, 5;
+  EXPECT_EQ(CountSelfIntersections(w, g), 1);
+  // Moved aside: the second triangle now passes beside the first.
+  w.row(5) << 0, 0.8, 0.5;
+  w.row(3) << 5, 0.5, -1;
+  w.row(4) << 5, 0.5, 1;
+  EXPECT_EQ(CountSelfIntersections(w, g), 0);
+}
+
+TEST(Nnls, MatchesAKnownSolutionAndStaysNonNegative) {
+  // Exact non-negative solution is recovered.
+  Eigen::MatrixXd a = Eigen::MatrixXd::Random(20, 6);
+  Eigen::VectorXd x_true(6);
+  x_true << 0.5, 0, 1.2, 0, 0.3, 2.0;
+  Eigen::VectorXd x = SolveNnls(a, a * x_true);
+  EXPECT_LT((x - x_true).norm(), 1e-9);
+  // Unconstrained optimum with negative entries: result is >= 0 and satisfies KKT
+  // (gradient >= 0 on the zero set, ~0 on the positive set).
+  const Eigen::VectorXd b = Eigen::VectorXd::Random(20);
+  x = SolveNnls(a, b);
+  const Eigen::VectorXd grad = a.transpose() * (a * x - b);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_GE(x[i], 0.0);
+    if (x[i] > 0)
+      EXPECT_NEAR(grad[i], 0.0, 1e-9);
+    else
+      EXPECT_GE(grad[i], -1e-9);
+  }
+}
+
+TEST(PngEncoder, WritesAValidPngWithTheRightPixels) {
+  RgbImage image(5, 3, 0);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x) image.at(x, y)[0] = static_cast<uint8_t>(10 * x + y);
+  const std::string png = EncodePngRgb(image);
+  ASSERT_EQ(png.substr(1, 3), "PNG");
+  EXPECT_EQ(png, EncodePngRgb(image));  // deterministic
+  // IHDR size fields and the inflated IDAT rows.
+  EXPECT_EQ(static_cast<unsigned char>(png[19]), 5);
+  EXPECT_EQ(static_cast<unsigned char>(png[23]), 3);
+  const size_t idat = png.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  const uint32_t len = (static_cast<unsigned char>(png[idat - 4]) << 24) |
+                       (static_cast<unsigned char>(png[idat - 3]) << 16) |
+                       (static_cast<unsigned char>(png[idat - 2]) << 8) |
+                       static_cast<unsigned char>(png[idat - 1]);
+  std::string raw(3 * (16), '\0');
+  uLongf raw_len = raw.size();
+  ASSERT_EQ(uncompress(reinterpret_cast<Bytef*>(&raw[0]), &raw_len,
+                       reinterpret_cast<const Bytef*>(png.data() + idat + 4), len),
+            Z_OK);
+  ASSERT_EQ(raw_len, 3u * 16u);
+  EXPECT_EQ(static_cast<unsigned char>(raw[1 + 3 * 4]), 40);           // (4, 0) red
+  EXPECT_EQ(static_cast<unsigned char>(raw[2 * 16 + 1 + 3 * 2]), 22);  // (2, 2) red
+}
+
+}  // namespace
+}  // namespace handlabel
