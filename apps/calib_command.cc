@@ -100,6 +100,8 @@ int RunCalibRenderBoard(int argc, char** argv) {
       "calib render-board");
   std::string out, board_text = "charuco:11x8:0.03:0.022";
   SyntheticBoardCaptureOptions options;
+  options.num_frames = 40;  // the configuration of the accuracy table in docs/cameras.md
+  options.near_frames_per_camera = 16;
   BoardRenderOptions render;
   app.add_option("--out", out, "output folder (created)")->required();
   app.add_option("--board", board_text, "board spec")->capture_default_str();

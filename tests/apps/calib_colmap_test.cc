@@ -70,20 +70,21 @@ TEST(CalibColmap, RecoversASyntheticRigUpToTheKnownScale) {
     GTEST_SKIP() << "no colmap binary";
   const std::string dir = testing::ScratchDir();
   Rig truth;
-  for (int i = 0; i < 6; ++i) {
-    const double a = 0.25 * i;
+  // Small images and few cameras keep COLMAP's run short.
+  for (int i = 0; i < 4; ++i) {
+    const double a = 0.3 * i;
     const Eigen::Vector3d eye(0.9 * std::cos(a) + 0.2, 0.9 * std::sin(a) + 0.2, 0.7);
     truth.Add({"cam" + std::to_string(i),
-               Camera::Pinhole(500, 500, 319.5, 239.5, 640, 480),
+               Camera::Pinhole(250, 250, 159.5, 119.5, 320, 240),
                LookAt(eye, Eigen::Vector3d(-0.1, -0.1, 0.1), Eigen::Vector3d::UnitZ())});
     fs::create_directories(dir + "/images/" + truth[i].name);
     WriteGrayImage(RenderScene(truth[i]),
                    dir + "/images/" + truth[i].name + "/000000.png");
   }
-  const double distance = (truth[0].CenterInWorld() - truth[5].CenterInWorld()).norm();
+  const double distance = (truth[0].CenterInWorld() - truth[3].CenterInWorld()).norm();
   const auto r = testing::RunHandlabelCommand(
       {"calib", "colmap", "--images", dir + "/images", "--model", "SIMPLE_PINHOLE",
-       "--scale", "cam0,cam5," + std::to_string(distance), "--out", dir + "/out",
+       "--scale", "cam0,cam3," + std::to_string(distance), "--out", dir + "/out",
        "--threads", "1"});
   ASSERT_EQ(r.status, 0) << r.err << r.out;
   const RigDifference d = CompareRigs(ReadRigJson(dir + "/out/rig.json"), truth);
