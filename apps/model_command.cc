@@ -122,7 +122,7 @@ int RunModelInfo(int argc, char** argv) {
 int RunModelConvert(int argc, char** argv) {
   CLI::App app(
       "Convert any supported hand model file (MANO pickle, re-saved pickle, smplx npz) "
-      "into the handlabel model file (.npz; numpy and smplx read it too).",
+      "into the handlabel model file (a smplx-style .npz with handlabel_* metadata).",
       "model convert");
   std::string in, out;
   ModelFileFlags flags;
@@ -152,6 +152,9 @@ const std::vector<ModelSubcommand>& ModelSubcommands() {
       {"info", "print a model file's statistics", RunModelInfo},
       {"convert", "convert a MANO / smplx model file to the handlabel format",
        RunModelConvert},
+      {"build", "build the open hand model (ours, MANO-compatible)", RunModelBuild},
+      {"render", "render a preview sheet (PNG) of a model in several poses",
+       RunModelRender},
   };
   return table;
 }

@@ -23,10 +23,12 @@ const char* SystemGetenv(const char* name) { return std::getenv(name); }
 ShardSpec ParseShard(const std::string& text, const std::string& source) {
   const size_t slash = text.find('/');
   ShardSpec shard;
-  if (slash == std::string::npos || !ParseNonNegative(text.substr(0, slash), &shard.index) ||
+  if (slash == std::string::npos ||
+      !ParseNonNegative(text.substr(0, slash), &shard.index) ||
       !ParseNonNegative(text.substr(slash + 1), &shard.count) || shard.count < 1 ||
       shard.index >= shard.count) {
-    throw InputError(source, "shard", "'i/N' with 0 <= i < N, e.g. 3/16", "'" + text + "'");
+    throw InputError(source, "shard", "'i/N' with 0 <= i < N, e.g. 3/16",
+                     "'" + text + "'");
   }
   return shard;
 }
@@ -37,8 +39,9 @@ std::optional<ShardSpec> ShardFromEnvironment(const char* (*getenv_fn)(const cha
   if (slurm_id) {
     const char* slurm_count = getenv_fn("SLURM_ARRAY_TASK_COUNT");
     if (!slurm_count) {
-      throw InputError("environment", "SLURM_ARRAY_TASK_COUNT",
-                       "set together with SLURM_ARRAY_TASK_ID (use sbatch --array=0-(N-1))");
+      throw InputError(
+          "environment", "SLURM_ARRAY_TASK_COUNT",
+          "set together with SLURM_ARRAY_TASK_ID (use sbatch --array=0-(N-1))");
     }
     return ParseShard(std::string(slurm_id) + "/" + slurm_count,
                       "SLURM_ARRAY_TASK_ID/SLURM_ARRAY_TASK_COUNT");

@@ -14,7 +14,9 @@ namespace handlabel {
 struct ShardSpec {
   int index = 0;
   int count = 1;
-  std::string ToString() const { return std::to_string(index) + "/" + std::to_string(count); }
+  std::string ToString() const {
+    return std::to_string(index) + "/" + std::to_string(count);
+  }
 };
 
 // Parses "i/N" with 0 <= i < N; throws InputError naming `source` otherwise.

@@ -103,21 +103,19 @@ SynthObject SampleObject(const Eigen::Vector3d& anchor, const Eigen::Vector3d& a
     const double r = Uniform(rng, 0.02, 0.045);
     obj.kind = "sphere";
     obj.size = Eigen::Vector3d(r, r, r);
-    obj.mesh = MakeSphere(r, 16, 24);
     half = r;
   } else if (kind == 1) {
     obj.kind = "box";
     obj.size = Eigen::Vector3d(Uniform(rng, 0.025, 0.09), Uniform(rng, 0.025, 0.09),
                                Uniform(rng, 0.025, 0.09));
-    obj.mesh = MakeBox(obj.size, 4);
     half = 0.5 * obj.size.minCoeff();
   } else {
     const double r = Uniform(rng, 0.015, 0.04);
     obj.kind = "cylinder";
     obj.size = Eigen::Vector3d(r, r, Uniform(rng, 0.06, 0.16));
-    obj.mesh = MakeCylinder(r, obj.size.z(), 24, 4);
     half = r;
   }
+  obj.mesh = MakeObjectMesh(obj.kind, obj.size);
   obj.world_from_object =
       Rigid3(RandomRotation(rng), anchor + (half + Uniform(rng, 0.0, 0.01)) * away);
   TransformMesh(obj.world_from_object, &obj.mesh);
@@ -147,6 +145,16 @@ int CamerasSeeingAll(const Rig& rig, const Points3d& points) {
 }
 
 }  // namespace
+
+RenderMesh MakeObjectMesh(const std::string& kind, const Eigen::Vector3d& size) {
+  if (!(size.array() > 0).all()) {
+    throw InputError("object", "size", "positive sizes", "");
+  }
+  if (kind == "sphere") return MakeSphere(size.x(), 16, 24);
+  if (kind == "box") return MakeBox(size, 4);
+  if (kind == "cylinder") return MakeCylinder(size.x(), size.z(), 24, 4);
+  throw InputError("object", "kind", "sphere, box or cylinder", kind);
+}
 
 void SynthSceneOptions::Check() const {
   const std::string src = "synthetic scene options";
@@ -266,7 +274,7 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
     scene.lighting.lights.push_back(light);
   }
 
-  // Objects: the first one in the hand (in front of the palm, or between thumb and
+  // Objects: the first one in the hand (in front of the palm, or at the thumb and
   // index tips for pinches), the others nearby.
   if (o.objects) {
     const int count = 1 + static_cast<int>(Uniform(rng, 0, o.max_objects));
@@ -282,8 +290,10 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
     for (int i = 0; i < count; ++i) {
       Eigen::Vector3d anchor, away;
       if (i == 0 && scene.pose_kind == "pinch") {
+        // Held at the pinching tips, on the side away from the palm (not swallowing
+        // the fingertips).
         anchor = 0.5 * (k.row(4) + k.row(8)).transpose();
-        away = Eigen::Vector3d::Zero();
+        away = (anchor - palm_centre).normalized();
       } else if (i == 0) {
         anchor = palm_centre + 0.01 * palm_normal;
         away = palm_normal;

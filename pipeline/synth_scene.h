@@ -75,6 +75,11 @@ struct SynthScene {
   int cameras_seeing_hand = 0;  // cameras with all 21 keypoints inside the image
 };
 
+// The mesh of an object in its own frame (as SampleSynthScene tessellates it): kind
+// "sphere" (radius size.x), "box" (edges size), "cylinder" (radius size.x, height
+// size.z, along z). Throws InputError for unknown kinds or non-positive sizes.
+RenderMesh MakeObjectMesh(const std::string& kind, const Eigen::Vector3d& size);
+
 // Samples one scene. Deterministic in `rng`'s state.
 SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
                             const HandLimits& limits, const Rig& rig,
