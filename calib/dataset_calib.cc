@@ -54,8 +54,7 @@ Rigid3 CamFromCommon(const std::vector<double>& v, const std::string& path,
 
 Camera DexYcbIntrinsics(const fs::path& folder, const std::string& serial) {
   // <serial>_<W>x<H>.yml; the size comes from the name.
-  const std::regex name(std::regex_replace(serial, std::regex("[^0-9A-Za-z]"), "") +
-                        "_([0-9]+)x([0-9]+)\\.yml");
+  static const std::regex size_suffix("_([0-9]+)x([0-9]+)\\.yml");
   if (fs::is_directory(folder)) {
     std::vector<fs::path> files;
     for (const auto& e : fs::directory_iterator(folder)) files.push_back(e.path());
@@ -63,7 +62,9 @@ Camera DexYcbIntrinsics(const fs::path& folder, const std::string& serial) {
     for (const fs::path& file : files) {
       std::smatch m;
       const std::string filename = file.filename().string();
-      if (!std::regex_match(filename, m, name)) continue;
+      if (filename.rfind(serial, 0) != 0) continue;
+      const std::string rest = filename.substr(serial.size());
+      if (!std::regex_match(rest, m, size_suffix)) continue;
       const YAML::Node color = LoadYaml(file)["color"];
       const std::string p = file.string();
       if (!color) throw InputError(p, "color", "a map with fx, fy, ppx, ppy", "missing");
