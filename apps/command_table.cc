@@ -31,6 +31,7 @@ const std::vector<Command>& AllCommands() {
       {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",
        RunCameras},
       {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
+      {"fit", "fit the hand model to a capture's 2D keypoints and masks (Ceres)", RunFit},
   };
   return commands;
 }

@@ -28,5 +28,6 @@ int RunSynth(int argc, char** argv);
 // `model build` / `model render` (apps/model_build_command.cc).
 int RunModelBuild(int argc, char** argv);
 int RunModelRender(int argc, char** argv);
+int RunFit(int argc, char** argv);
 
 }  // namespace handlabel
