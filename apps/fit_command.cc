@@ -21,12 +21,14 @@ int RunFit(int argc, char** argv) {
       "--out fits/dexycb",
       "fit");
   FitCaptureOptions o;
-  std::string frames, hand_model, loss = "huber";
+  std::string frames, ignore, hand_model, loss = "huber";
   bool no_silhouettes = false, no_limits = false, fixed_shape = false;
   app.add_option("--capture", o.capture_dir, "capture folder (native layout)")
       ->required();
   app.add_option("--out", o.out_dir, "output folder (created)")->required();
   app.add_option("--frames", frames, "comma-separated frame ids (default: all)");
+  app.add_option("--ignore-views", ignore,
+                 "comma-separated camera names whose keypoints and masks are ignored");
   app.add_option("--max-frames", o.max_frames, "fit only the first N chosen frames")
       ->capture_default_str();
   app.add_option("--init", o.init,
@@ -60,6 +62,9 @@ int RunFit(int argc, char** argv) {
   app.add_option("--hand-model", hand_model,
                  "model file or 'capsule'; default: $HANDLABEL_HAND_MODEL, then "
                  "models/open_hand_<side>.npz, then the built-in capsule hand");
+  app.add_option("--overlay", o.overlay_png,
+                 "also write a PNG of the first fitted frame: every view with the fitted "
+                 "silhouette, keypoints and the 2D evidence");
   app.add_option("--threads", o.num_threads, "frames in parallel, 0 = all cores")
       ->capture_default_str();
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
@@ -67,6 +72,10 @@ int RunFit(int argc, char** argv) {
     std::stringstream list(frames);
     for (std::string id; std::getline(list, id, ',');) {
       if (!id.empty()) o.frames.push_back(id);
+    }
+    std::stringstream names(ignore);
+    for (std::string name; std::getline(names, name, ',');) {
+      if (!name.empty()) o.ignore_views.push_back(name);
     }
     o.fit.keypoint_loss.type = RobustLossFromName(loss, "--loss");
     o.config.use_silhouettes = !no_silhouettes;

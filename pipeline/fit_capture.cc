@@ -16,6 +16,7 @@
 #include "fitting/silhouette_render.h"
 #include "pipeline/atomic_file.h"
 #include "pipeline/capture_reader.h"
+#include "pipeline/fit_overlay.h"
 
 namespace handlabel {
 namespace {
@@ -183,6 +184,12 @@ FitCaptureSummary FitCapture(const FitCaptureOptions& options, const HandModel& 
     throw InputError("--init", "gt", "a capture with ground truth");
   }
 
+  std::vector<char> ignored(capture.rig().size(), 0);
+  for (const std::string& name : options.ignore_views) {
+    const int c = capture.rig().IndexOf(name);
+    if (c < 0) throw InputError("--ignore-views", name, "a camera name of the capture");
+    ignored[c] = 1;
+  }
   const CeresHandFitter fitter(model, options.config, options.fit);
   const HandAnatomy anatomy = ComputeHandAnatomy(model);
   const HandLimits limits = DefaultHandLimits();
@@ -206,6 +213,10 @@ FitCaptureSummary FitCapture(const FitCaptureOptions& options, const HandModel& 
     }
     if (!mask_kind.empty()) {
       for (size_t c = 0; c < capture.rig().size(); ++c) {
+        if (ignored[c]) {
+          input.masks.emplace_back();
+          continue;
+        }
         input.masks.push_back(MaskFromImage(
             mask_kind == kFileMask ? capture.ReadMask(f, static_cast<int>(c))
                                    : capture.ReadDetectionMask(f, static_cast<int>(c))));
@@ -226,6 +237,17 @@ FitCaptureSummary FitCapture(const FitCaptureOptions& options, const HandModel& 
       init = ReadInitFile(options.init, id);
     }
     const HandFitResult result = fitter.Fit(input, init);
+    if (i == 0 && !options.overlay_png.empty()) {
+      std::vector<ImageU8> images;
+      std::vector<PixelRays> overlay_rays;
+      for (size_t c = 0; c < capture.rig().size(); ++c) {
+        images.push_back(capture.ReadImage(f, static_cast<int>(c)));
+        if (rays.empty()) overlay_rays.emplace_back(capture.rig()[c].camera);
+      }
+      WritePng(options.overlay_png,
+               MakeFitOverlay(images, input.views, rays.empty() ? overlay_rays : rays,
+                              result.vertices, model.faces, result.keypoints));
+    }
 
     FrameOutcome& out = outcomes[i];
     out.params = result.params;
@@ -324,6 +346,7 @@ FitCaptureSummary FitCapture(const FitCaptureOptions& options, const HandModel& 
   j["evidence"] = use_detections ? "detections" : "keypoints";
   j["masks"] = mask_kind.empty() ? "none" : mask_kind;
   j["init"] = options.init;
+  j["ignored_views"] = options.ignore_views;
   j["robust_loss"] = RobustLossName(options.fit.keypoint_loss.type);
   j["seconds_per_frame"] = {{"mean", s.mean_seconds},
                             {"median", sorted.empty() ? 0.0 : sorted[sorted.size() / 2]},

@@ -38,9 +38,13 @@ struct FitCaptureOptions {
   // Masks: "detections" (noisy masks), "truth", "none", or "auto" (detections, else
   // truth, else none).
   std::string masks = "auto";
+  // Camera names whose keypoints and masks are ignored (a broken or occluded camera).
+  std::vector<std::string> ignore_views;
   HandFitConfig config;
   HandFitOptions fit;
   int num_threads = 1;  // frames in parallel; 0 = all cores
+  // If set, a PNG of the first fitted frame (pipeline/fit_overlay.h) is written here.
+  std::string overlay_png;
   // Throws InputError naming the flag.
   void Check() const;
 };
