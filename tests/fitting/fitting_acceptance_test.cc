@@ -29,13 +29,11 @@ const HandModel& OpenHand() {
   return model;
 }
 
-const std::vector<PixelRays>& RigRays() {
-  static const std::vector<PixelRays> rays = [] {
-    std::vector<PixelRays> r;
-    for (const RigCamera& cam : testing::DexYcbLikeRig()) r.emplace_back(cam.camera);
-    return r;
-  }();
-  return rays;
+std::vector<PixelRays> RigRays(double image_scale) {
+  std::vector<PixelRays> r;
+  for (const RigCamera& cam : testing::DexYcbLikeRig(image_scale))
+    r.emplace_back(cam.camera);
+  return r;
 }
 
 struct Totals {
@@ -56,7 +54,10 @@ struct Totals {
 
 // noisy = false: exact keypoints and masks. true: 2 px noise, 10 % outliers, one or
 // two views without keypoints or masks (alternating), masks kept for the others.
-Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed) {
+// image_scale 0.5 (320x240 images) keeps the enabled tests fast.
+Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed,
+                   double image_scale = 1.0) {
+  const std::vector<PixelRays> rays = RigRays(image_scale);
   const HandModel& model = OpenHand();
   HandFitOptions options;
   if (!silhouettes) options.silhouette_rounds = 0;
@@ -68,11 +69,11 @@ Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed) {
   std::mt19937_64 rng(seed);
   Totals t;
   for (int f = 0; f < frames; ++f) {
-    testing::SceneFrame frame = testing::RandomSceneFrame(model, rng);
+    testing::SceneFrame frame = testing::RandomSceneFrame(model, rng, 0.8, image_scale);
     HandFitInput input;
     for (size_t v = 0; v < frame.views.size(); ++v) {
       input.masks.push_back(RenderHandMask(frame.mesh.vertices, model.faces,
-                                           frame.views[v].camera, RigRays()[v]));
+                                           frame.views[v].camera, rays[v]));
     }
     if (noisy) {
       const std::vector<int> occluded =
@@ -82,7 +83,7 @@ Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed) {
     }
     if (!silhouettes) input.masks.clear();
     input.views = frame.views;
-    input.pixel_rays = &RigRays();
+    input.pixel_rays = &rays;
     const auto start = std::chrono::steady_clock::now();
     const HandFitResult r = fitter.Fit(input, fitter.InitFromViews(input.views));
     t.seconds +=
@@ -107,14 +108,14 @@ Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed) {
 }
 
 TEST(FittingAcceptance, NoiseFreeKeypointsAndMasks) {
-  const Totals t = RunScenario(1, false, true, 1);
+  const Totals t = RunScenario(1, false, true, 1, 0.5);
   t.Print("noise-free kp+masks");
   EXPECT_LE(t.mpjpe / t.frames, 0.001);
   EXPECT_LE(t.mpvpe / t.frames, 0.0015);
 }
 
 TEST(FittingAcceptance, NoisyOutliersOccludedViews) {
-  const Totals t = RunScenario(1, true, false, 2);
+  const Totals t = RunScenario(1, true, false, 2, 0.5);
   t.Print("noisy kp only");
   EXPECT_LE(t.mpjpe / t.frames, 0.006);
   EXPECT_LT(t.mpjpe, t.plain_mpjpe);
