@@ -37,7 +37,6 @@ json PointsJson(const Points3d& p) {
   return a;
 }
 
-double NumberOrNull(const json& j) { return j.is_number() ? j.get<double>() : NAN; }
 json Finite(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
 Eigen::VectorXd VectorFromJson(const json& j, const std::string& source,
@@ -246,7 +245,8 @@ FitCaptureSummary FitCapture(const FitCaptureOptions& options, const HandModel& 
       }
       WritePng(options.overlay_png,
                MakeFitOverlay(images, input.views, rays.empty() ? overlay_rays : rays,
-                              result.vertices, model.faces, result.keypoints));
+                              result.vertices, model.faces, result.keypoints),
+               PngWriteOptions{9});
     }
 
     FrameOutcome& out = outcomes[i];

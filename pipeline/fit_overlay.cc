@@ -38,9 +38,9 @@ ImageU8 MakeFitOverlay(const std::vector<ImageU8>& images,
            "one image and one set of rays per view");
   HL_CHECK(options.columns >= 1 && options.tile_width >= 16, "overlay layout");
   if (views.empty()) return ImageU8(1, 1, 3);
+  // Square tiles, each cropped around the fitted hand in its view.
   const int tw = options.tile_width;
-  const double aspect = double(images[0].height) / std::max(1, images[0].width);
-  const int th = std::max(1, static_cast<int>(std::lround(tw * aspect)));
+  const int th = tw;
   const int cols = std::min<int>(options.columns, static_cast<int>(views.size()));
   const int rows = (static_cast<int>(views.size()) + cols - 1) / cols;
   ImageU8 sheet(cols * tw, rows * th, 3, 0);
@@ -48,12 +48,26 @@ ImageU8 MakeFitOverlay(const std::vector<ImageU8>& images,
   for (size_t v = 0; v < views.size(); ++v) {
     const ImageU8& img = images[v];
     const MaskImage mask = RenderHandMask(vertices, faces, views[v].camera, rays[v]);
-    const double scale = double(img.width) / tw;
+    Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      Eigen::Vector2d uv;
+      if (!views[v].camera.ProjectWorld(keypoints.row(k).transpose(), &uv)) continue;
+      lo = lo.cwiseMin(uv);
+      hi = hi.cwiseMax(uv);
+    }
+    if (lo.x() > hi.x()) {  // hand behind the camera: the whole image
+      lo = Eigen::Vector2d(0, 0);
+      hi = Eigen::Vector2d(img.width, img.height);
+    }
+    const double side = std::max(40.0, 1.5 * (hi - lo).maxCoeff());
+    const Eigen::Vector2d origin = 0.5 * (lo + hi) - Eigen::Vector2d(side, side) / 2;
+    const double scale = side / tw;
     ImageU8 tile(tw, th, 3, 0);
     for (int y = 0; y < th; ++y) {
       for (int x = 0; x < tw; ++x) {
-        const int sx = std::min(img.width - 1, static_cast<int>(x * scale));
-        const int sy = std::min(img.height - 1, static_cast<int>(y * scale));
+        const int sx = static_cast<int>(std::floor(origin.x() + x * scale));
+        const int sy = static_cast<int>(std::floor(origin.y() + y * scale));
+        if (sx < 0 || sy < 0 || sx >= img.width || sy >= img.height) continue;
         for (int c = 0; c < 3; ++c) {
           const double value = img.at(sx, sy, img.channels == 1 ? 0 : c);
           tile.at(x, y, c) =
@@ -61,7 +75,9 @@ ImageU8 MakeFitOverlay(const std::vector<ImageU8>& images,
         }
       }
     }
-    auto to_tile = [&](const Eigen::Vector2d& uv) { return Eigen::Vector2d(uv / scale); };
+    auto to_tile = [&](const Eigen::Vector2d& uv) {
+      return Eigen::Vector2d((uv - origin) / scale);
+    };
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       if (!(views[v].confidence[k] > 0.0)) continue;
       const Eigen::Vector2d p = to_tile(views[v].uv_px.row(k).transpose());

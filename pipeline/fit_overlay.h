@@ -1,5 +1,6 @@
 #pragma once
-// A picture of one fitted frame: every view in a grid with the fitted mesh's silhouette
+// A picture of one fitted frame: every view in a grid (square tiles cropped around
+// the fitted hand) with the fitted mesh's silhouette
 // tinted green over the image, the fitted keypoints and skeleton (green) and the 2D
 // evidence the fit used (red crosses), for checking a fit at a glance.
 
@@ -12,7 +13,7 @@ namespace handlabel {
 
 struct FitOverlayOptions {
   int columns = 4;       // views per row (>= 1)
-  int tile_width = 320;  // each view scaled to this width (>= 16)
+  int tile_width = 240;  // side of each square tile in pixels (>= 16)
 };
 
 // `images[v]` is view v's RGB image, `rays[v]` its PixelRays; `vertices` / `keypoints`
