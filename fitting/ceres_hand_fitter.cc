@@ -271,8 +271,14 @@ class FitRun {
   void SolvePoints3d(const Points3dTargets& targets, Blocks* b, bool full) const {
     for (int stage = 0; stage < (full ? 2 : 1); ++stage) {
       StageProblem problem(b);
-      problem.AddFull("points3d", Points3dCost<P, kBetas>::Create(
-                                      evaluator_, targets, options_.points3d_sigma_m));
+      // Keypoints only (the initialisation): the analytic Jacobian is much cheaper.
+      problem.AddFull("points3d",
+                      targets.vertex_ids.empty()
+                          ? Keypoints3dCostFunction::Create(evaluator_, targets.keypoints,
+                                                            targets.keypoint_weights,
+                                                            options_.points3d_sigma_m)
+                          : Points3dCost<P, kBetas>::Create(evaluator_, targets,
+                                                            options_.points3d_sigma_m));
       if (stage == 0) {
         problem.Hold(b->pose.data());
         problem.Hold(b->betas);
