@@ -21,7 +21,7 @@ int RunFit(int argc, char** argv) {
       "--out fits/dexycb",
       "fit");
   FitCaptureOptions o;
-  std::string frames, ignore, hand_model, loss = "huber";
+  std::string frames, ignore, hand_model, loss = "cauchy";
   bool no_silhouettes = false, no_limits = false, fixed_shape = false;
   app.add_option("--capture", o.capture_dir, "capture folder (native layout)")
       ->required();
@@ -39,7 +39,7 @@ int RunFit(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--masks", o.masks, "masks: auto | detections | truth | none")
       ->capture_default_str();
-  app.add_option("--loss", loss, "robust keypoint loss: huber | cauchy | trivial")
+  app.add_option("--loss", loss, "robust keypoint loss: cauchy | huber | trivial")
       ->capture_default_str();
   app.add_option("--loss-scale", o.fit.keypoint_loss.scale,
                  "robust loss scale, in units of --keypoint-sigma")
