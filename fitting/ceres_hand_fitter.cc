@@ -271,8 +271,14 @@ class FitRun {
   void SolvePoints3d(const Points3dTargets& targets, Blocks* b, bool full) const {
     for (int stage = 0; stage < (full ? 2 : 1); ++stage) {
       StageProblem problem(b);
-      problem.AddFull("points3d", Points3dCost<P, kBetas>::Create(
-                                      evaluator_, targets, options_.points3d_sigma_m));
+      // Keypoints only (the initialisation): the analytic Jacobian is much cheaper.
+      problem.AddFull("points3d",
+                      targets.vertex_ids.empty()
+                          ? Keypoints3dCostFunction::Create(evaluator_, targets.keypoints,
+                                                            targets.keypoint_weights,
+                                                            options_.points3d_sigma_m)
+                          : Points3dCost<P, kBetas>::Create(evaluator_, targets,
+                                                            options_.points3d_sigma_m));
       if (stage == 0) {
         problem.Hold(b->pose.data());
         problem.Hold(b->betas);
@@ -409,7 +415,7 @@ class FitRun {
       }
       StageProblem problem(&b);
       full_problem(&problem);
-      problem.AddFull("silhouette", MultiViewSilhouetteCost<P, kBetas>::Create(
+      problem.AddFull("silhouette", MultiViewSilhouetteCostFunction<P, kBetas>::Create(
                                         evaluator_, vertex_ids, sil_views,
                                         options_.silhouette_sigma_px));
       run(&problem, options_.silhouette_iterations);

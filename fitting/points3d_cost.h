@@ -6,6 +6,7 @@
 // Residuals: 3 per keypoint (21, SNAP order) then 3 per listed vertex.
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/cost_function.h>
 
 #include <cmath>
 #include <vector>
@@ -86,6 +87,68 @@ class Points3dCost {
   const HandEvaluator& evaluator_;
   Points3dTargets targets_;
   double inv_sigma_;
+};
+
+// The keypoint part of Points3dCost (no vertices) with the analytic Jacobian of
+// HandEvaluator::KeypointsAndJacobian: the IK-style initialisation's cost, several times
+// cheaper than Jets. Parameter blocks (3, pose_dim, num_betas, 3); 63 residuals.
+class Keypoints3dCostFunction : public ceres::CostFunction {
+ public:
+  // `evaluator` must outlive the cost function; weights: 21 values >= 0.
+  Keypoints3dCostFunction(const HandEvaluator& evaluator, const Points3d& keypoints,
+                          const Eigen::VectorXd& weights, double sigma)
+      : evaluator_(evaluator), targets_(keypoints) {
+    HL_CHECK(keypoints.rows() == kNumHandKeypoints && weights.size() == kNumHandKeypoints,
+             "21 keypoints and weights");
+    scale_ = weights.cwiseMax(0.0).cwiseSqrt() / sigma;
+    set_num_residuals(3 * kNumHandKeypoints);
+    mutable_parameter_block_sizes()->assign(
+        {3, evaluator.pose_dim(), evaluator.num_betas(), 3});
+  }
+  static ceres::CostFunction* Create(const HandEvaluator& evaluator,
+                                     const Points3d& keypoints,
+                                     const Eigen::VectorXd& weights, double sigma) {
+    return new Keypoints3dCostFunction(evaluator, keypoints, weights, sigma);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int n = evaluator_.num_params();
+    double keypoints[3 * kNumHandKeypoints];
+    std::vector<double> jac;
+    if (jacobians != nullptr) {
+      jac.resize(3 * kNumHandKeypoints * n);
+      evaluator_.KeypointsAndJacobian(parameters[0], parameters[1], parameters[2],
+                                      parameters[3], keypoints, jac.data());
+    } else {
+      evaluator_.Keypoints(parameters[0], parameters[1], parameters[2], parameters[3],
+                           keypoints);
+    }
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        residuals[3 * k + c] = (keypoints[3 * k + c] - targets_(k, c)) * scale_[k];
+      }
+    }
+    if (jacobians == nullptr) return true;
+    const int sizes[4] = {3, evaluator_.pose_dim(), evaluator_.num_betas(), 3};
+    int offset = 0;
+    for (int b = 0; b < 4; ++b) {
+      if (jacobians[b] != nullptr) {
+        for (int r = 0; r < 3 * kNumHandKeypoints; ++r) {
+          for (int c = 0; c < sizes[b]; ++c) {
+            jacobians[b][r * sizes[b] + c] = jac[r * n + offset + c] * scale_[r / 3];
+          }
+        }
+      }
+      offset += sizes[b];
+    }
+    return true;
+  }
+
+ private:
+  const HandEvaluator& evaluator_;
+  Points3d targets_;
+  Eigen::VectorXd scale_;
 };
 
 }  // namespace handlabel

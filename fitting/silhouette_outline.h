@@ -16,8 +16,8 @@ struct MaskOutline {
 
 // Mask pixels with a 4-neighbour outside the mask (pixels on the image border are not
 // outline: the hand continues beyond the image), evenly subsampled in scan order to at
-// most `max_samples`; each point is moved half a pixel along its outward normal (the
-// gradient of the signed distance to the outline).
+// most `max_samples`; each point is moved half a pixel along its outward normal (from
+// the centroid of the mask pixels in a 7x7 window towards the pixel).
 MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples);
 
 // For every outline point, the index (into `projected`) of the nearest projected point;

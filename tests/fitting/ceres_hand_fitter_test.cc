@@ -120,7 +120,7 @@ TEST(CeresHandFitterSilhouetteTest, NoiseFreeKeypointsAndMasks) {
   options.silhouette_rounds = 2;
   const CeresHandFitter fitter(model, {}, options);
   std::vector<PixelRays> rays;
-  for (const RigCamera& cam : testing::DexYcbLikeRig()) rays.emplace_back(cam.camera);
+  for (const RigCamera& cam : testing::DexYcbLikeRig(0.5)) rays.emplace_back(cam.camera);
   for (int trial = 0; trial < 2; ++trial) {
     const testing::SceneFrame frame =
         testing::RandomSceneFrame(model, testing::TestRng());

@@ -18,7 +18,8 @@
 
 namespace handlabel::testing {
 
-inline std::vector<RigCamera> DexYcbLikeRig() {
+// image_scale < 1 shrinks the images (and the focal lengths) for fast tests.
+inline std::vector<RigCamera> DexYcbLikeRig(double image_scale = 1.0) {
   std::vector<RigCamera> cameras;
   for (int i = 0; i < 8; ++i) {
     const double azimuth = 2.0 * M_PI * i / 8.0 + 0.2;
@@ -46,7 +47,7 @@ struct SceneFrame {
 };
 
 inline SceneFrame RandomSceneFrame(const HandModel& model, std::mt19937_64& rng,
-                                   double betas_sigma = 0.8) {
+                                   double betas_sigma = 0.8, double image_scale = 1.0) {
   const HandAnatomy anatomy = ComputeHandAnatomy(model);
   SceneFrame f;
   f.params.hand_pose =
@@ -63,7 +64,7 @@ inline SceneFrame RandomSceneFrame(const HandModel& model, std::mt19937_64& rng,
   const Eigen::Vector3d centre = at_origin.keypoints.colwise().mean().transpose();
   f.params.transl = -centre + 0.04 * Eigen::Vector3d(g(rng), g(rng), g(rng));
   f.mesh = PoseHand(model, f.params);
-  for (const RigCamera& cam : DexYcbLikeRig()) {
+  for (const RigCamera& cam : DexYcbLikeRig(image_scale)) {
     KeypointView view;
     view.camera = cam;
     for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -87,8 +88,8 @@ inline void CorruptViews(std::vector<KeypointView>* views, double sigma_px,
   for (KeypointView& view : *views) {
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       if (u(rng) < outlier_fraction) {
-        view.uv_px(k, 0) = 640.0 * u(rng);
-        view.uv_px(k, 1) = 480.0 * u(rng);
+        view.uv_px(k, 0) = view.camera.camera.width() * u(rng);
+        view.uv_px(k, 1) = view.camera.camera.height() * u(rng);
       } else {
         view.uv_px(k, 0) += g(rng);
         view.uv_px(k, 1) += g(rng);

@@ -1,0 +1,101 @@
+// Cost of fitting one multi-view frame with CeresHandFitter on the shipped open hand
+// (or whatever ResolveHandModel finds), 8-camera DexYCB-like rig, 2 px keypoint noise:
+//   BM_FitKeypoints             triangulation init + keypoint stages, one thread
+//   BM_FitKeypointsSilhouettes  the same plus silhouette rounds (masks rendered before)
+//   BM_FitFramesParallel/2      frames per second, TBB over frames on 2 threads
+//
+//   ./build/bench/fitting_bench [--benchmark_filter=Keypoints]
+// Targets (issue 5): <= 10 ms keypoints only, <= 0.25 s with silhouettes.
+
+#include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <random>
+#include <vector>
+
+#include "fitting/ceres_hand_fitter.h"
+#include "fitting/silhouette_render.h"
+#include "pipeline/hand_model_source.h"
+#include "tests/fitting/fitting_scene.h"
+
+namespace handlabel {
+namespace {
+
+struct BenchFrames {
+  HandModel model;
+  std::vector<HandFitInput> inputs;
+  std::vector<PixelRays> rays;
+};
+
+const BenchFrames& Frames() {
+  static const BenchFrames* frames = [] {
+    auto* f = new BenchFrames;
+    f->model = ResolveHandModel("", HandSide::kRight).model;
+    for (const RigCamera& cam : testing::DexYcbLikeRig())
+      f->rays.emplace_back(cam.camera);
+    std::mt19937_64 rng(5);
+    for (int i = 0; i < 8; ++i) {
+      testing::SceneFrame frame = testing::RandomSceneFrame(f->model, rng);
+      HandFitInput input;
+      for (size_t v = 0; v < frame.views.size(); ++v) {
+        input.masks.push_back(RenderHandMask(frame.mesh.vertices, f->model.faces,
+                                             frame.views[v].camera, f->rays[v]));
+      }
+      testing::CorruptViews(&frame.views, 2.0, 0.0, {}, rng);
+      input.views = frame.views;
+      f->inputs.push_back(input);
+    }
+    return f;
+  }();
+  return *frames;
+}
+
+void FitOne(const CeresHandFitter& fitter, HandFitInput input, bool masks) {
+  if (!masks) input.masks.clear();
+  const HandFitResult r = fitter.Fit(input, fitter.InitFromViews(input.views));
+  benchmark::DoNotOptimize(r.params.transl);
+}
+
+void BM_FitKeypoints(benchmark::State& state) {
+  const BenchFrames& f = Frames();
+  const CeresHandFitter fitter(f.model);
+  size_t i = 0;
+  for (auto _ : state) FitOne(fitter, f.inputs[i++ % f.inputs.size()], false);
+}
+BENCHMARK(BM_FitKeypoints)->Unit(benchmark::kMillisecond);
+
+void BM_FitKeypointsSilhouettes(benchmark::State& state) {
+  const BenchFrames& f = Frames();
+  const CeresHandFitter fitter(f.model);
+  size_t i = 0;
+  for (auto _ : state) {
+    HandFitInput input = f.inputs[i++ % f.inputs.size()];
+    input.pixel_rays = &f.rays;
+    FitOne(fitter, input, true);
+  }
+}
+BENCHMARK(BM_FitKeypointsSilhouettes)->Unit(benchmark::kMillisecond);
+
+void BM_FitFramesParallel(benchmark::State& state) {
+  const BenchFrames& f = Frames();
+  const CeresHandFitter fitter(f.model);
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, state.range(0));
+  for (auto _ : state) {
+    tbb::parallel_for(size_t(0), f.inputs.size(),
+                      [&](size_t i) { FitOne(fitter, f.inputs[i], false); });
+  }
+  state.counters["frames_per_second"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * f.inputs.size()),
+                         benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_FitFramesParallel)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace handlabel
+
+BENCHMARK_MAIN();

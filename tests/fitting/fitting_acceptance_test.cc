@@ -1,0 +1,183 @@
+// Acceptance of issue 5 on the shipped open hand (models/open_hand_right.npz) with the
+// DexYCB-like rig of fitting_scene.h: noise-free keypoints + masks, noisy keypoints with
+// outliers and occluded views (robust vs plain least squares), joint limits. The enabled
+// tests use 1 frame (the noisy one keypoints only, to stay fast); the 50-frame report
+// runs with
+//   build/tests/fitting_tests --gtest_also_run_disabled_tests \
+//       --gtest_filter='FittingAcceptance.DISABLED_*'
+// and prints the numbers written in docs/fitting.md.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include "core/hand_anatomy.h"
+#include "core/hand_model_io.h"
+#include "core/metrics.h"
+#include "fitting/ceres_hand_fitter.h"
+#include "fitting/silhouette_render.h"
+#include "tests/fitting/fitting_scene.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+const HandModel& OpenHand() {
+  static const HandModel model =
+      LoadHandModel(std::string(HANDLABEL_SOURCE_DIR) + "/models/open_hand_right.npz");
+  return model;
+}
+
+std::vector<PixelRays> RigRays(double image_scale) {
+  std::vector<PixelRays> r;
+  for (const RigCamera& cam : testing::DexYcbLikeRig(image_scale))
+    r.emplace_back(cam.camera);
+  return r;
+}
+
+struct Totals {
+  int frames = 0;
+  double mpjpe = 0, mpvpe = 0, pa_mpjpe = 0, seconds = 0, worst_limit_deg = 0;
+  double plain_mpjpe = 0, worst_mpjpe = 0;
+  void Print(const char* name) const {
+    std::printf(
+        "%s: %d frames, MPJPE %.3f mm (worst frame %.3f), MPVPE %.3f mm, PA-MPJPE %.3f "
+        "mm, "
+        "%.3f s/frame, worst limit violation %.2f deg, plain least squares MPJPE %.3f "
+        "mm\n",
+        name, frames, 1000 * mpjpe / frames, 1000 * worst_mpjpe, 1000 * mpvpe / frames,
+        1000 * pa_mpjpe / frames, seconds / frames, worst_limit_deg,
+        1000 * plain_mpjpe / frames);
+  }
+};
+
+// noisy = false: exact keypoints and masks. true: 2 px noise, 10 % outliers, one or
+// two views without keypoints or masks (alternating), masks kept for the others.
+// image_scale 0.5 (320x240 images) keeps the enabled tests fast.
+Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed,
+                   double image_scale = 1.0) {
+  const std::vector<PixelRays> rays = RigRays(image_scale);
+  const HandModel& model = OpenHand();
+  HandFitOptions options;
+  if (!silhouettes) options.silhouette_rounds = 0;
+  const CeresHandFitter fitter(model, {}, options);
+  HandFitOptions plain_options = options;
+  plain_options.keypoint_loss.type = RobustLossType::kTrivial;
+  const CeresHandFitter plain(model, {}, plain_options);
+  const HandAnatomy anatomy = ComputeHandAnatomy(model);
+  std::mt19937_64 rng(seed);
+  Totals t;
+  for (int f = 0; f < frames; ++f) {
+    testing::SceneFrame frame = testing::RandomSceneFrame(model, rng, 0.8, image_scale);
+    HandFitInput input;
+    for (size_t v = 0; v < frame.views.size(); ++v) {
+      input.masks.push_back(RenderHandMask(frame.mesh.vertices, model.faces,
+                                           frame.views[v].camera, rays[v]));
+    }
+    if (noisy) {
+      const std::vector<int> occluded =
+          f % 2 == 0 ? std::vector<int>{f % 8} : std::vector<int>{f % 8, (f + 3) % 8};
+      testing::CorruptViews(&frame.views, 2.0, 0.1, occluded, rng);
+      for (int v : occluded) input.masks[v] = MaskImage();
+    }
+    if (!silhouettes) input.masks.clear();
+    input.views = frame.views;
+    input.pixel_rays = &rays;
+    const auto start = std::chrono::steady_clock::now();
+    const HandFitResult r = fitter.Fit(input, fitter.InitFromViews(input.views));
+    t.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const HandFrameMetrics m = EvaluateHandFrame(r.keypoints, frame.mesh.keypoints,
+                                                 r.vertices, frame.mesh.vertices);
+    t.mpjpe += m.mpjpe;
+    t.mpvpe += m.mpvpe;
+    t.pa_mpjpe += m.pa_mpjpe;
+    t.worst_mpjpe = std::max(t.worst_mpjpe, m.mpjpe);
+    HandPoseVector angles;
+    HandAnatomicalAngles(anatomy, r.params.hand_pose.data(), angles.data());
+    t.worst_limit_deg =
+        std::max(t.worst_limit_deg, MaxLimitViolationDeg(DefaultHandLimits(), angles));
+    if (noisy) {
+      const HandFitResult p = plain.Fit(input, plain.InitFromViews(input.views));
+      t.plain_mpjpe += MeanPointError(p.keypoints, frame.mesh.keypoints);
+    }
+    ++t.frames;
+  }
+  return t;
+}
+
+TEST(FittingAcceptance, NoiseFreeKeypointsAndMasks) {
+  const Totals t = RunScenario(1, false, true, 1, 0.5);
+  t.Print("noise-free kp+masks");
+  EXPECT_LE(t.mpjpe / t.frames, 0.001);
+  EXPECT_LE(t.mpvpe / t.frames, 0.0015);
+}
+
+TEST(FittingAcceptance, NoisyOutliersOccludedViews) {
+  const Totals t = RunScenario(1, true, false, 2, 0.5);
+  t.Print("noisy kp only");
+  EXPECT_LE(t.mpjpe / t.frames, 0.006);
+  EXPECT_LT(t.mpjpe, t.plain_mpjpe);
+  EXPECT_LE(t.worst_limit_deg, 5.0);
+}
+
+TEST(FittingAcceptance, DISABLED_FiftyFrames) {
+  const Totals exact = RunScenario(50, false, true, 10);
+  exact.Print("noise-free kp+masks");
+  const Totals exact_kp = RunScenario(50, false, false, 10);
+  exact_kp.Print("noise-free kp only");
+  const Totals noisy = RunScenario(50, true, true, 11);
+  noisy.Print("noisy kp+masks");
+  const Totals noisy_kp = RunScenario(50, true, false, 11);
+  noisy_kp.Print("noisy kp only");
+  EXPECT_LE(exact.mpjpe / exact.frames, 0.001);
+  EXPECT_LE(exact.mpvpe / exact.frames, 0.0015);
+  EXPECT_LE(noisy.mpjpe / noisy.frames, 0.006);
+  EXPECT_LT(noisy.mpjpe, noisy.plain_mpjpe);
+  EXPECT_LE(noisy.worst_limit_deg, 5.0);
+}
+
+}  // namespace
+}  // namespace handlabel
+
+namespace handlabel {
+namespace {
+
+// Pose as PCA coefficients (the open hand has a 45-component basis): with all 45
+// components the fit is as exact as with axis-angle; with 12 it still lands close.
+TEST(FittingPca, KeypointsOnlyWithPcaPose) {
+  std::mt19937_64 rng(21);
+  const testing::SceneFrame frame = testing::RandomSceneFrame(OpenHand(), rng, 0.8, 0.5);
+  HandFitInput input;
+  input.views = frame.views;
+  for (int comps : {45, 12}) {
+    HandFitConfig config;
+    config.pose_pca_comps = comps;
+    const CeresHandFitter fitter(OpenHand(), config);
+    const HandFitResult r = fitter.Fit(input, fitter.InitFromViews(input.views));
+    const double error = MeanPointError(r.keypoints, frame.mesh.keypoints);
+    EXPECT_LT(error, comps == 45 ? 0.001 : 0.01) << comps;
+  }
+}
+
+// Temporal term: starting from and pulled towards the previous frame's parameters
+// (here the truth), a noisy frame fits at least as well as without it.
+TEST(FittingTemporal, PreviousFrameHelpsNoisyFrame) {
+  std::mt19937_64 rng(22);
+  testing::SceneFrame frame = testing::RandomSceneFrame(OpenHand(), rng, 0.8, 0.5);
+  testing::CorruptViews(&frame.views, 3.0, 0.1, {0, 1, 2}, rng);
+  const CeresHandFitter fitter(OpenHand());
+  HandFitInput input;
+  input.views = frame.views;
+  const double alone =
+      MeanPointError(fitter.Fit(input, fitter.InitFromViews(input.views)).keypoints,
+                     frame.mesh.keypoints);
+  input.previous = frame.params;
+  const HandFitResult r = fitter.Fit(input, frame.params);
+  EXPECT_TRUE(r.term_costs.count("temporal"));
+  EXPECT_LE(MeanPointError(r.keypoints, frame.mesh.keypoints), alone + 1e-4);
+}
+
+}  // namespace
+}  // namespace handlabel

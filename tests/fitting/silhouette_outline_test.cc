@@ -1,0 +1,43 @@
+#include "fitting/silhouette_outline.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace handlabel {
+namespace {
+
+// A disk of radius 20 px centred at (50.3, 40.6): outline points lie on the circle to
+// within the pixel grid and their normals point radially outwards.
+TEST(SilhouetteOutlineTest, DiskOutlineAndNormals) {
+  const Eigen::Vector2d centre(50.3, 40.6);
+  const double radius = 20.0;
+  MaskImage mask = MaskImage::Zero(90, 110);
+  for (int y = 0; y < 90; ++y) {
+    for (int x = 0; x < 110; ++x) {
+      mask(y, x) = (Eigen::Vector2d(x, y) - centre).norm() <= radius;
+    }
+  }
+  const MaskOutline outline = SampleMaskOutline(mask, 40);
+  ASSERT_GE(outline.points.size(), 30u);
+  ASSERT_LE(outline.points.size(), 41u);
+  for (size_t i = 0; i < outline.points.size(); ++i) {
+    const Eigen::Vector2d radial = (outline.points[i] - centre).normalized();
+    EXPECT_NEAR((outline.points[i] - centre).norm(), radius, 0.8);
+    EXPECT_GT(outline.normals[i].dot(radial), std::cos(12.0 * M_PI / 180.0));
+  }
+}
+
+TEST(SilhouetteOutlineTest, MatchesNearestValidPoint) {
+  MaskOutline outline;
+  outline.points = {{0, 0}, {10, 0}};
+  outline.normals = {{1, 0}, {1, 0}};
+  const std::vector<Eigen::Vector2d> projected = {{1, 0}, {9, 0}, {10, 0.5}};
+  const std::vector<int> match = MatchOutlineToPoints(outline, projected, {1, 1, 0});
+  EXPECT_EQ(match[0], 0);
+  EXPECT_EQ(match[1], 1);  // the nearer point 2 is not valid
+  EXPECT_EQ(MatchOutlineToPoints(outline, projected, {0, 0, 0})[0], -1);
+}
+
+}  // namespace
+}  // namespace handlabel
