@@ -22,6 +22,7 @@ int RunSynth(int argc, char** argv) {
   SynthCaptureOptions o;
   std::string out_dir, size, hand_model, side = "right", contact_sheet;
   bool objects = false, overwrite = false, no_detections = false, no_clutter = false;
+  bool sheet_crop = false;
   app.add_option("--out", out_dir, "output folder (created)")->required();
   app.add_option(
          "--preset", o.rig.preset,
@@ -61,6 +62,8 @@ int RunSynth(int argc, char** argv) {
   app.add_option(
       "--contact-sheet", contact_sheet,
       "also write a PNG of frame 0: all views with mask and keypoint overlays");
+  app.add_flag("--contact-sheet-crop", sheet_crop,
+               "contact sheet: show a crop around the hand in each view");
   app.add_flag("--overwrite", overwrite, "replace a capture already in --out");
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("synth", [&] {
@@ -93,7 +96,9 @@ int RunSynth(int argc, char** argv) {
               << " views show the hand, " << s.views_occluded << " occluded, "
               << s.views_out_of_frame << " out of frame)\n";
     if (!contact_sheet.empty()) {
-      WritePng(contact_sheet, MakeContactSheet(CaptureReader(out_dir), 0));
+      ContactSheetOptions sheet;
+      sheet.crop_to_hand = sheet_crop;
+      WritePng(contact_sheet, MakeContactSheet(CaptureReader(out_dir), 0, sheet));
       std::cout << "contact sheet: " << contact_sheet << "\n";
     }
     return 0;

@@ -4,20 +4,28 @@
 //   ./build/bench/synth_bench
 // RenderView: one view of a fixed scene (rasterise hand + object, shade, masks,
 //   keypoint visibility, cluttered background): the per-view cost.
-// GenerateFrame/N: a whole frame with N cameras as SynthGenerator makes it (scene
+// GenerateFrame/model/N: a whole frame with N cameras as SynthGenerator makes it (scene
 //   sampling, N views, simulated detections), reported as views/s.
-// WriteFrame: GenerateFrame plus PNG encoding of image, mask, object mask and
+// WriteFrame: GenerateFrame (open hand, 8 cameras) plus PNG encoding of image, mask,
+// object mask and
 //   detection mask (no disk I/O), per view.
-// The hand is the built-in capsule hand (~1150 vertices, ~2100 faces, MANO-sized).
+// Argument 0: the built-in capsule hand (~1150 vertices, ~2100 faces); 1: the shipped
+// open hand (models/open_hand_right.npz, 778 vertices, 1538 faces, like MANO).
 
 #include <benchmark/benchmark.h>
 
 #include "core/image.h"
 #include "pipeline/capsule_hand.h"
+#include "pipeline/hand_model_source.h"
 #include "pipeline/synth_capture.h"
 
 namespace handlabel {
 namespace {
+
+HandModel BenchModel(int which) {
+  return which == 0 ? MakeCapsuleHand(HandSide::kRight)
+                    : ResolveHandModel("", HandSide::kRight).model;
+}
 
 SynthCaptureOptions BenchOptions(int cameras) {
   SynthCaptureOptions o;
@@ -32,7 +40,7 @@ SynthCaptureOptions BenchOptions(int cameras) {
 }
 
 void BM_RenderView(benchmark::State& state) {
-  const SynthGenerator gen(MakeCapsuleHand(HandSide::kRight),
+  const SynthGenerator gen(BenchModel(static_cast<int>(state.range(0))),
                            MakePresetRig(BenchOptions(8).rig, 3), BenchOptions(8));
   const SynthFrame frame = gen.Generate(0);
   const PixelRays rays(gen.rig()[0].camera);
@@ -45,12 +53,12 @@ void BM_RenderView(benchmark::State& state) {
   state.counters["views/s"] =
       benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_RenderView)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RenderView)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_GenerateFrame(benchmark::State& state) {
-  const int cameras = static_cast<int>(state.range(0));
+  const int cameras = static_cast<int>(state.range(1));
   const SynthCaptureOptions o = BenchOptions(cameras);
-  const SynthGenerator gen(MakeCapsuleHand(HandSide::kRight),
+  const SynthGenerator gen(BenchModel(static_cast<int>(state.range(0))),
                            MakePresetRig(o.rig, o.seed), o);
   int f = 0;
   for (auto _ : state) {
@@ -60,13 +68,17 @@ void BM_GenerateFrame(benchmark::State& state) {
   state.counters["views/s"] =
       benchmark::Counter(state.iterations() * cameras, benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_GenerateFrame)->Arg(1)->Arg(8)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GenerateFrame)
+    ->Args({0, 1})
+    ->Args({0, 8})
+    ->Args({1, 1})
+    ->Args({1, 8})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_WriteFrame(benchmark::State& state) {
   const int cameras = 8;
   const SynthCaptureOptions o = BenchOptions(cameras);
-  const SynthGenerator gen(MakeCapsuleHand(HandSide::kRight),
-                           MakePresetRig(o.rig, o.seed), o);
+  const SynthGenerator gen(BenchModel(1), MakePresetRig(o.rig, o.seed), o);
   int f = 0;
   for (auto _ : state) {
     const SynthFrame frame = gen.Generate(f++);

@@ -55,50 +55,84 @@ ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
   for (const RigCamera& c : capture.rig().cameras()) {
     aspect = std::max(aspect, static_cast<double>(c.camera.height()) / c.camera.width());
   }
-  const int tw = o.tile_width, th = static_cast<int>(std::lround(tw * aspect));
+  const int tw = o.tile_width;
+  const int th = o.crop_to_hand ? tw : static_cast<int>(std::lround(tw * aspect));
   const int cols = std::min(o.columns, n), rows = (n + cols - 1) / cols;
   const int gap = 4;
   ImageU8 sheet(cols * tw + (cols + 1) * gap, rows * th + (rows + 1) * gap, 3, 30);
   const bool has_kp = o.keypoints && capture.Has(kFileKeypoints);
-  const std::vector<ViewKeypoints> kps =
-      has_kp ? capture.ReadKeypoints(frame) : std::vector<ViewKeypoints>();
+  const std::vector<ViewKeypoints> kps = has_kp || o.crop_to_hand
+                                             ? capture.ReadKeypoints(frame)
+                                             : std::vector<ViewKeypoints>();
   const bool has_det = o.detections && capture.Has(kFileDetections);
   const std::vector<ViewKeypoints> dets =
       has_det ? capture.ReadDetections(frame) : std::vector<ViewKeypoints>();
+  const uint8_t outline[3] = {0, 255, 80};
   for (int c = 0; c < n; ++c) {
     const ImageU8 image = capture.ReadImage(frame, c);
     const bool masked = o.mask_overlay && capture.Has(kFileMask);
     const ImageU8 mask = masked ? capture.ReadMask(frame, c) : ImageU8();
-    const double s = static_cast<double>(tw) / image.width;  // image -> tile scale
+    // Source window: origin (x0, y0) and scale s (tile pixels per image pixel).
+    double x0 = -0.5, y0 = -0.5, s = static_cast<double>(tw) / image.width;
+    if (o.crop_to_hand) {
+      Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        if (kps[c].visibility[k] == 0) continue;
+        lo = lo.cwiseMin(kps[c].keypoints.row(k).transpose());
+        hi = hi.cwiseMax(kps[c].keypoints.row(k).transpose());
+      }
+      if (lo.x() <= hi.x()) {
+        const double side = std::max(48.0, 1.6 * (hi - lo).maxCoeff());
+        x0 = 0.5 * (lo.x() + hi.x()) - 0.5 * side;
+        y0 = 0.5 * (lo.y() + hi.y()) - 0.5 * side;
+        s = tw / side;
+      } else {
+        s = std::min(static_cast<double>(tw) / image.width,
+                     static_cast<double>(th) / image.height);
+      }
+    }
     const int ox = gap + (c % cols) * (tw + gap), oy = gap + (c / cols) * (th + gap);
-    // Nearest-neighbour scaling of the image, mask tinted green.
+    // Nearest-neighbour sampling of the window; outside the image stays dark.
     ImageU8 tile(tw, th, 3, 0);
+    std::vector<int> src(static_cast<size_t>(tw) * th,
+                         -1);  // source pixel per tile pixel
     for (int y = 0; y < th; ++y) {
       for (int x = 0; x < tw; ++x) {
-        const int sx = std::min(image.width - 1, static_cast<int>((x + 0.5) / s));
-        const int sy = static_cast<int>((y + 0.5) / s);
-        if (sy >= image.height) continue;
-        const bool m = masked && mask.at(sx, sy) != 0;
-        for (int k = 0; k < 3; ++k) {
-          const int v = image.at(sx, sy, k);
-          tile.at(x, y, k) =
-              static_cast<uint8_t>(m ? (k == 1 ? (v + 255) / 2 : v * 3 / 4) : v);
+        const int sx = static_cast<int>(std::floor(x0 + (x + 0.5) / s + 0.5));
+        const int sy = static_cast<int>(std::floor(y0 + (y + 0.5) / s + 0.5));
+        if (!image.Contains(sx, sy)) continue;
+        src[y * tw + x] = sy * image.width + sx;
+        for (int k = 0; k < 3; ++k) tile.at(x, y, k) = image.at(sx, sy, k);
+      }
+    }
+    if (masked) {  // outline: tile pixels whose mask value differs from a neighbour's
+      auto on = [&](int x, int y) {
+        const int i = src[y * tw + x];
+        return i >= 0 && mask.data[i] != 0;
+      };
+      for (int y = 1; y + 1 < th; ++y) {
+        for (int x = 1; x + 1 < tw; ++x) {
+          if (on(x, y) &&
+              (!on(x - 1, y) || !on(x + 1, y) || !on(x, y - 1) || !on(x, y + 1))) {
+            PutPixel(&tile, x, y, outline);
+          }
         }
       }
     }
-    auto px = [&](double u) { return (u + 0.5) * s - 0.5; };
+    auto px = [&](double u) { return (u - x0) * s - 0.5; };
+    auto py = [&](double v) { return (v - y0) * s - 0.5; };
     if (has_kp) {
       const ViewKeypoints& v = kps[c];
       for (const auto& bone : kBones) {
         const int a = bone[0], b = bone[1];
         if (v.visibility[a] == 0 || v.visibility[b] == 0) continue;
-        DrawLine(&tile, px(v.keypoints(a, 0)), px(v.keypoints(a, 1)),
-                 px(v.keypoints(b, 0)), px(v.keypoints(b, 1)),
+        DrawLine(&tile, px(v.keypoints(a, 0)), py(v.keypoints(a, 1)),
+                 px(v.keypoints(b, 0)), py(v.keypoints(b, 1)),
                  kFingerColors[FingerOf(b)]);
       }
       for (int k = 0; k < kNumHandKeypoints; ++k) {
         if (v.visibility[k] == 0) continue;
-        DrawDot(&tile, px(v.keypoints(k, 0)), px(v.keypoints(k, 1)), 3,
+        DrawDot(&tile, px(v.keypoints(k, 0)), py(v.keypoints(k, 1)), 3,
                 kFingerColors[FingerOf(k)], v.visibility[k] == 2);
       }
     }
@@ -107,7 +141,7 @@ ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
       const ViewKeypoints& d = dets[c];
       for (int k = 0; k < kNumHandKeypoints; ++k) {
         if (!(d.confidence[k] > 0)) continue;
-        const double x = px(d.keypoints(k, 0)), y = px(d.keypoints(k, 1));
+        const double x = px(d.keypoints(k, 0)), y = py(d.keypoints(k, 1));
         DrawLine(&tile, x - 3, y - 3, x + 3, y + 3, white);
         DrawLine(&tile, x - 3, y + 3, x + 3, y - 3, white);
       }

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/errors.h"
+#include "core/hand_model_io.h"
 #include "pipeline/build_config.h"
 #include "pipeline/capsule_hand.h"
 
@@ -22,10 +23,23 @@ ResolvedHandModel FromValue(const std::string& value, const std::string& origin,
     throw InputError(origin, "hand model", "an existing model file or \"capsule\"",
                      value);
   }
-  // Model files load through core/hand_model_io.h (branch "loaders"), merged later.
-  throw InputError(origin, "hand model",
-                   "\"capsule\" (loading model files arrives with core/hand_model_io)",
-                   value);
+  // The file's own side (own format, or MANO_LEFT / MANO_RIGHT in the name) wins; a
+  // file that records no side is taken as the side asked for.
+  HandModelLoadOptions options;
+  try {
+    out.model = LoadHandModel(value, options);
+  } catch (const InputError& e) {
+    if (e.field() != "side") throw;
+    options.side = side;
+    out.model = LoadHandModel(value, options);
+  }
+  if (out.model.side != side) {
+    const auto name = [](HandSide s) { return s == HandSide::kLeft ? "left" : "right"; };
+    throw InputError(origin, "hand model", std::string("a ") + name(side) + " hand model",
+                     value + " (a " + name(out.model.side) + " hand)");
+  }
+  out.source = value;
+  return out;
 }
 
 }  // namespace

@@ -61,18 +61,22 @@ void ExpectError(const std::string& yaml, const std::string& field,
 
 TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
   const std::string base = "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n";
-  ExpectError(base + "refine: {mode: sometimes}\n", "refine.mode", "off | always | fallback");
+  ExpectError(base + "refine: {mode: sometimes}\n", "refine.mode",
+              "off | always | fallback");
   ExpectError(base + "refine: {mode: always, max_reprojection_px: abc}\n",
               "refine.max_reprojection_px", "a number");
   ExpectError(base + "outptu: {dir: x}\n", "outptu", "a known key");
   ExpectError(base + "refine: {mode: always, tolerance: 3}\n", "refine.tolerance",
               "a known key");
-  ExpectError("input: {path: c}\nnetwork: {weights: w}\n", "output.dir", "an output folder");
-  ExpectError("input: {path: c, format: kinect}\noutput: {dir: o}\nnetwork: {weights: w}\n",
-              "input.format", "native | dexycb");
+  ExpectError("input: {path: c}\nnetwork: {weights: w}\n", "output.dir",
+              "an output folder");
+  ExpectError(
+      "input: {path: c, format: kinect}\noutput: {dir: o}\nnetwork: {weights: w}\n",
+      "input.format", "native | dexycb");
   ExpectError("input: {path: c}\noutput: {dir: o}\n", "refine.mode", "'always' when");
-  ExpectError("input: {path: c}\noutput: {dir: o, meshes: [stl]}\nnetwork: {weights: w}\n",
-              "output.meshes", "ply and/or obj");
+  ExpectError(
+      "input: {path: c}\noutput: {dir: o, meshes: [stl]}\nnetwork: {weights: w}\n",
+      "output.meshes", "ply and/or obj");
 }
 
 TEST(JobConfig, MissingOrBrokenFileIsAClearError) {

@@ -8,6 +8,7 @@
 #include <map>
 
 #include "core/errors.h"
+#include "core/hand_model_io.h"
 #include "core/mesh_primitives.h"
 #include "pipeline/capsule_hand.h"
 #include "pipeline/capture_reader.h"
@@ -73,13 +74,23 @@ TEST(SynthCapture, StoredKeypointsAreTheGroundTruthJointsProjectedWithTheStoredR
   EXPECT_GT(visible, 100);
 }
 
-TEST(SynthCapture, MaskIsExactlyTheHandPixelsInFrontOfTheObjects) {
+// The capsule hand (no file needed) and the shipped open hand.
+class SynthCaptureModels : public ::testing::TestWithParam<std::string> {
+ protected:
+  HandModel Model() const {
+    return GetParam() == "capsule" ? MakeCapsuleHand(HandSide::kRight)
+                                   : LoadHandModel(std::string(HANDLABEL_SOURCE_DIR) +
+                                                   "/models/" + GetParam());
+  }
+};
+
+TEST_P(SynthCaptureModels, MaskIsExactlyTheHandPixelsInFrontOfTheObjects) {
   // Re-render hand and objects separately from the stored ground truth; the stored
   // mask must be the pixels where the hand is drawn and no object is nearer.
   const std::string dir = ScratchDir() + "/cap";
   SynthCaptureOptions o = SmallOptions();
   o.scene.max_objects = 3;
-  const HandModel model = MakeCapsuleHand(HandSide::kRight);
+  const HandModel model = Model();
   WriteSynthCapture(model, o, dir, "builtin:capsule");
   const CaptureReader reader(dir);
   int hidden_by_object = 0, hand_pixels = 0;
@@ -125,6 +136,13 @@ TEST(SynthCapture, MaskIsExactlyTheHandPixelsInFrontOfTheObjects) {
   EXPECT_GT(hand_pixels, 1000);
   EXPECT_GT(hidden_by_object, 20) << "objects should hide some of the hand";
 }
+
+INSTANTIATE_TEST_SUITE_P(Models, SynthCaptureModels,
+                         ::testing::Values("capsule", "open_hand_right.npz"),
+                         [](const auto& info) {
+                           return info.param == "capsule" ? std::string("Capsule")
+                                                          : std::string("OpenHand");
+                         });
 
 // Distance from p to triangle abc (Ericson, closest point on triangle).
 double PointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
