@@ -32,6 +32,7 @@ const std::vector<Command>& AllCommands() {
        RunCameras},
       {"calib", "calibrate a camera rig from board images or with COLMAP", RunCalib},
       {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
+      {"fit", "fit the hand model to a capture's 2D keypoints and masks (Ceres)", RunFit},
   };
   return commands;
 }

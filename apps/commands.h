@@ -29,5 +29,6 @@ int RunMerge(int argc, char** argv);
 int RunCameras(int argc, char** argv);
 int RunCalib(int argc, char** argv);
 int RunSynth(int argc, char** argv);
+int RunFit(int argc, char** argv);
 
 }  // namespace handlabel

@@ -409,7 +409,7 @@ class FitRun {
       }
       StageProblem problem(&b);
       full_problem(&problem);
-      problem.AddFull("silhouette", MultiViewSilhouetteCost<P, kBetas>::Create(
+      problem.AddFull("silhouette", MultiViewSilhouetteCostFunction<P, kBetas>::Create(
                                         evaluator_, vertex_ids, sil_views,
                                         options_.silhouette_sigma_px));
       run(&problem, options_.silhouette_iterations);

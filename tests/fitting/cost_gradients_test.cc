@@ -218,6 +218,28 @@ TEST_F(CostGradientsTest, Silhouette) {
   std::unique_ptr<ceres::CostFunction> cost(
       MultiViewSilhouetteCost<>::Create(evaluator_, ids, views, 2.0));
   ExpectGradientsMatch(*cost, params_.Blocks(), 1e-5);
+  // The analytic-projection version agrees with autodiff.
+  std::unique_ptr<ceres::CostFunction> fast(
+      MultiViewSilhouetteCostFunction<>::Create(evaluator_, ids, views, 2.0));
+  const int n = cost->num_residuals();
+  ASSERT_EQ(fast->num_residuals(), n);
+  const int sizes[4] = {3, 45, 10, 3};
+  std::vector<Eigen::MatrixXd> ja(4), jb(4);
+  std::vector<double*> pa(4), pb(4);
+  for (int b = 0; b < 4; ++b) {
+    ja[b].resize(sizes[b], n);
+    jb[b].resize(sizes[b], n);
+    pa[b] = ja[b].data();
+    pb[b] = jb[b].data();
+  }
+  Eigen::VectorXd ra(n), rb(n);
+  ASSERT_TRUE(cost->Evaluate(params_.Blocks().data(), ra.data(), pa.data()));
+  ASSERT_TRUE(fast->Evaluate(params_.Blocks().data(), rb.data(), pb.data()));
+  EXPECT_THAT(rb, testing::MatrixNear(ra, 1e-9));
+  for (int b = 0; b < 4; ++b) {
+    const double scale = std::max(1.0, ja[b].cwiseAbs().maxCoeff());
+    EXPECT_THAT(jb[b], testing::MatrixNear(ja[b], 1e-8 * scale)) << "block " << b;
+  }
 }
 
 TEST(AxisAngleManifoldTest, Invariants) {
