@@ -30,6 +30,7 @@ const std::vector<Command>& AllCommands() {
       {"merge", "join the shards of a labeling job (manifest + summary)", RunMerge},
       {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",
        RunCameras},
+      {"calib", "calibrate a camera rig from board images or with COLMAP", RunCalib},
       {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
   };
   return commands;

@@ -21,12 +21,13 @@ int RunHandlabel(int argc, char** argv);
 
 int RunVersion(int argc, char** argv);
 int RunModel(int argc, char** argv);
-int RunLabel(int argc, char** argv);
-int RunMerge(int argc, char** argv);
-int RunCameras(int argc, char** argv);
-int RunSynth(int argc, char** argv);
 // `model build` / `model render` (apps/model_build_command.cc).
 int RunModelBuild(int argc, char** argv);
 int RunModelRender(int argc, char** argv);
+int RunLabel(int argc, char** argv);
+int RunMerge(int argc, char** argv);
+int RunCameras(int argc, char** argv);
+int RunCalib(int argc, char** argv);
+int RunSynth(int argc, char** argv);
 
 }  // namespace handlabel

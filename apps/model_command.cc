@@ -122,7 +122,7 @@ int RunModelInfo(int argc, char** argv) {
 int RunModelConvert(int argc, char** argv) {
   CLI::App app(
       "Convert any supported hand model file (MANO pickle, re-saved pickle, smplx npz) "
-      "into the handlabel model file (.npz; numpy and smplx read it too).",
+      "into the handlabel model file (a smplx-style .npz with handlabel_* metadata).",
       "model convert");
   std::string in, out;
   ModelFileFlags flags;

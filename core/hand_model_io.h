@@ -8,7 +8,7 @@
 //   kSmplxNpz       .npz conversions with smplx-style keys (v_template, f, shapedirs,
 //                   posedirs, J_regressor dense or as a pickled sparse object,
 //                   weights, kintree_table, hands_components, hands_mean)
-//   kHandlabelNpz   the project's own file: a smplx-style .npz (so numpy and smplx read
+//   kHandlabelNpz   the project's own file: a smplx-style .npz (so numpy reads
 //                   it too) plus handlabel_* entries; see docs/hand-model-files.md.
 // Every loaded model has passed HandModel::Check. Errors are InputErrors naming the
 // file and the key.

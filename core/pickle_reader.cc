@@ -8,91 +8,16 @@
 
 #include "core/errors.h"
 #include "core/npy.h"
+#include "core/pickle_globals.h"
+#include "core/utf8.h"
 
 namespace handlabel {
 namespace {
 
-// The callables and classes the reader understands. Anything else is refused.
-enum class Global {
-  kNdarray,
-  kReconstruct,
-  kDTypeClass,
-  kScalar,
-  kFromBuffer,
-  kSet,
-  kFrozenSet,
-  kBytesClass,
-  kBytearray,
-  kObjectClass,
-  kCodecsEncode,
-  kCopyregReconstructor,
-  kOrderedDict,
-  kCh,
-  kSelect,
-  kCscMatrix,
-  kCsrMatrix,
-  kRebuildTensorV2,
-  kRebuildParameter,
-  kStorage,
-};
-
-struct KnownGlobal {
-  const char* module;
-  const char* name;
-  Global global;
-  DType storage_dtype;
-};
-
-constexpr KnownGlobal kKnownGlobals[] = {
-    {"numpy", "ndarray", Global::kNdarray, DType::kUInt8},
-    {"numpy", "dtype", Global::kDTypeClass, DType::kUInt8},
-    {"numpy.core.multiarray", "_reconstruct", Global::kReconstruct, DType::kUInt8},
-    {"numpy._core.multiarray", "_reconstruct", Global::kReconstruct, DType::kUInt8},
-    {"numpy.core.multiarray", "scalar", Global::kScalar, DType::kUInt8},
-    {"numpy._core.multiarray", "scalar", Global::kScalar, DType::kUInt8},
-    {"numpy.core.numeric", "_frombuffer", Global::kFromBuffer, DType::kUInt8},
-    {"numpy._core.numeric", "_frombuffer", Global::kFromBuffer, DType::kUInt8},
-    {"__builtin__", "set", Global::kSet, DType::kUInt8},
-    {"builtins", "set", Global::kSet, DType::kUInt8},
-    {"__builtin__", "frozenset", Global::kFrozenSet, DType::kUInt8},
-    {"builtins", "frozenset", Global::kFrozenSet, DType::kUInt8},
-    {"__builtin__", "bytes", Global::kBytesClass, DType::kUInt8},
-    {"builtins", "bytes", Global::kBytesClass, DType::kUInt8},
-    {"__builtin__", "bytearray", Global::kBytearray, DType::kUInt8},
-    {"builtins", "bytearray", Global::kBytearray, DType::kUInt8},
-    {"__builtin__", "object", Global::kObjectClass, DType::kUInt8},
-    {"builtins", "object", Global::kObjectClass, DType::kUInt8},
-    {"_codecs", "encode", Global::kCodecsEncode, DType::kUInt8},
-    {"copy_reg", "_reconstructor", Global::kCopyregReconstructor, DType::kUInt8},
-    {"copyreg", "_reconstructor", Global::kCopyregReconstructor, DType::kUInt8},
-    {"collections", "OrderedDict", Global::kOrderedDict, DType::kUInt8},
-    {"chumpy.ch", "Ch", Global::kCh, DType::kUInt8},
-    {"chumpy.reordering", "Select", Global::kSelect, DType::kUInt8},
-    {"scipy.sparse.csc", "csc_matrix", Global::kCscMatrix, DType::kUInt8},
-    {"scipy.sparse._csc", "csc_matrix", Global::kCscMatrix, DType::kUInt8},
-    {"scipy.sparse", "csc_matrix", Global::kCscMatrix, DType::kUInt8},
-    {"scipy.sparse.csr", "csr_matrix", Global::kCsrMatrix, DType::kUInt8},
-    {"scipy.sparse._csr", "csr_matrix", Global::kCsrMatrix, DType::kUInt8},
-    {"scipy.sparse", "csr_matrix", Global::kCsrMatrix, DType::kUInt8},
-    {"torch._utils", "_rebuild_tensor_v2", Global::kRebuildTensorV2, DType::kUInt8},
-    {"torch._utils", "_rebuild_parameter", Global::kRebuildParameter, DType::kUInt8},
-    {"torch", "FloatStorage", Global::kStorage, DType::kFloat32},
-    {"torch", "DoubleStorage", Global::kStorage, DType::kFloat64},
-    {"torch", "HalfStorage", Global::kStorage, DType::kFloat16},
-    {"torch", "LongStorage", Global::kStorage, DType::kInt64},
-    {"torch", "IntStorage", Global::kStorage, DType::kInt32},
-    {"torch", "ShortStorage", Global::kStorage, DType::kInt16},
-    {"torch", "CharStorage", Global::kStorage, DType::kInt8},
-    {"torch", "ByteStorage", Global::kStorage, DType::kUInt8},
-    {"torch", "BoolStorage", Global::kStorage, DType::kBool},
-};
-
-// Classes whose instances the reader can build (NEWOBJ / REDUCE / INST / OBJ) and
-// fill from BUILD state.
-bool IsInstanceClass(Global g) {
-  return g == Global::kCh || g == Global::kSelect || g == Global::kCscMatrix ||
-         g == Global::kCsrMatrix || g == Global::kOrderedDict;
-}
+using pickle::Global;
+using pickle::IsInstanceClass;
+using pickle::LookupPickleGlobal;
+using pickle::PickleOpcodeName;
 
 // Values while reading. Ids index Reader::nodes_; containers refer to children by id,
 // so shared and even cyclic references cost nothing and never recurse here.
@@ -138,193 +63,6 @@ struct Node {
   std::shared_ptr<TensorRef> tensor;  // kStorage, kTensor
 };
 
-const char* OpcodeName(uint8_t op) {
-  switch (op) {
-    case '(':
-      return "MARK";
-    case '.':
-      return "STOP";
-    case '0':
-      return "POP";
-    case '1':
-      return "POP_MARK";
-    case '2':
-      return "DUP";
-    case 'F':
-      return "FLOAT";
-    case 'I':
-      return "INT";
-    case 'J':
-      return "BININT";
-    case 'K':
-      return "BININT1";
-    case 'L':
-      return "LONG";
-    case 'M':
-      return "BININT2";
-    case 'N':
-      return "NONE";
-    case 'P':
-      return "PERSID";
-    case 'Q':
-      return "BINPERSID";
-    case 'R':
-      return "REDUCE";
-    case 'S':
-      return "STRING";
-    case 'T':
-      return "BINSTRING";
-    case 'U':
-      return "SHORT_BINSTRING";
-    case 'V':
-      return "UNICODE";
-    case 'X':
-      return "BINUNICODE";
-    case 'a':
-      return "APPEND";
-    case 'b':
-      return "BUILD";
-    case 'c':
-      return "GLOBAL";
-    case 'd':
-      return "DICT";
-    case '}':
-      return "EMPTY_DICT";
-    case 'e':
-      return "APPENDS";
-    case 'g':
-      return "GET";
-    case 'h':
-      return "BINGET";
-    case 'i':
-      return "INST";
-    case 'j':
-      return "LONG_BINGET";
-    case 'l':
-      return "LIST";
-    case ']':
-      return "EMPTY_LIST";
-    case 'o':
-      return "OBJ";
-    case 'p':
-      return "PUT";
-    case 'q':
-      return "BINPUT";
-    case 'r':
-      return "LONG_BINPUT";
-    case 's':
-      return "SETITEM";
-    case 't':
-      return "TUPLE";
-    case ')':
-      return "EMPTY_TUPLE";
-    case 'u':
-      return "SETITEMS";
-    case 'G':
-      return "BINFLOAT";
-    case 0x80:
-      return "PROTO";
-    case 0x81:
-      return "NEWOBJ";
-    case 0x82:
-      return "EXT1";
-    case 0x83:
-      return "EXT2";
-    case 0x84:
-      return "EXT4";
-    case 0x85:
-      return "TUPLE1";
-    case 0x86:
-      return "TUPLE2";
-    case 0x87:
-      return "TUPLE3";
-    case 0x88:
-      return "NEWTRUE";
-    case 0x89:
-      return "NEWFALSE";
-    case 0x8a:
-      return "LONG1";
-    case 0x8b:
-      return "LONG4";
-    case 'B':
-      return "BINBYTES";
-    case 'C':
-      return "SHORT_BINBYTES";
-    case 0x8c:
-      return "SHORT_BINUNICODE";
-    case 0x8d:
-      return "BINUNICODE8";
-    case 0x8e:
-      return "BINBYTES8";
-    case 0x8f:
-      return "EMPTY_SET";
-    case 0x90:
-      return "ADDITEMS";
-    case 0x91:
-      return "FROZENSET";
-    case 0x92:
-      return "NEWOBJ_EX";
-    case 0x93:
-      return "STACK_GLOBAL";
-    case 0x94:
-      return "MEMOIZE";
-    case 0x95:
-      return "FRAME";
-    case 0x96:
-      return "BYTEARRAY8";
-    case 0x97:
-      return "NEXT_BUFFER";
-    case 0x98:
-      return "READONLY_BUFFER";
-  }
-  return nullptr;
-}
-
-void AppendUtf8(uint32_t c, std::string* out) {
-  if (c < 0x80) {
-    out->push_back(static_cast<char>(c));
-  } else if (c < 0x800) {
-    out->push_back(static_cast<char>(0xC0 | (c >> 6)));
-    out->push_back(static_cast<char>(0x80 | (c & 0x3F)));
-  } else if (c < 0x10000) {
-    out->push_back(static_cast<char>(0xE0 | (c >> 12)));
-    out->push_back(static_cast<char>(0x80 | ((c >> 6) & 0x3F)));
-    out->push_back(static_cast<char>(0x80 | (c & 0x3F)));
-  } else {
-    out->push_back(static_cast<char>(0xF0 | ((c >> 18) & 0x07)));
-    out->push_back(static_cast<char>(0x80 | ((c >> 12) & 0x3F)));
-    out->push_back(static_cast<char>(0x80 | ((c >> 6) & 0x3F)));
-    out->push_back(static_cast<char>(0x80 | (c & 0x3F)));
-  }
-}
-
-std::string Latin1ToUtf8(const std::string& s) {
-  std::string out;
-  for (unsigned char c : s) AppendUtf8(c, &out);
-  return out;
-}
-
-// UTF-8 text whose code points are all below 256 -> those bytes (Python's
-// str.encode('latin1')); false if a code point does not fit.
-bool Utf8ToLatin1(const std::string& s, std::string* out) {
-  out->clear();
-  for (size_t i = 0; i < s.size(); ++i) {
-    const unsigned char c = s[i];
-    if (c < 0x80) {
-      out->push_back(static_cast<char>(c));
-    } else if ((c & 0xE0) == 0xC0 && i + 1 < s.size()) {
-      const uint32_t cp =
-          ((c & 0x1F) << 6) | (static_cast<unsigned char>(s[i + 1]) & 0x3F);
-      if (cp > 0xFF) return false;
-      out->push_back(static_cast<char>(cp));
-      ++i;
-    } else {
-      return false;
-    }
-  }
-  return true;
-}
-
 class Reader {
  public:
   Reader(const std::string& bytes, const std::string& source, const PickleLimits& limits)
@@ -343,7 +81,7 @@ class Reader {
         got + " (opcode " + OpName() + " at offset " + std::to_string(op_offset_) + ")");
   }
   std::string OpName() const {
-    const char* name = OpcodeName(op_);
+    const char* name = PickleOpcodeName(op_);
     if (name) return name;
     char hex[8];
     std::snprintf(hex, sizeof(hex), "0x%02x", op_);
@@ -401,6 +139,7 @@ class Reader {
     nodes_.back().kind = kind;
     return static_cast<int>(nodes_.size()) - 1;
   }
+  // References into nodes_ are invalidated by NewNode: never hold one across it.
   Node& N(int id) { return nodes_[id]; }
   void Push(int id) { stack_.push_back(id); }
   int Pop() {
@@ -441,7 +180,7 @@ class Reader {
     N(id).text = std::move(s);
     return id;
   }
-  int MakeSequence(NodeKind kind, const std::vector<int>& items) {
+  int MakeSequence(NodeKind kind, std::vector<int> items) {  // a copy (see N())
     const int id = NewNode(kind);
     for (int item : items) Nest(id, item);
     N(id).items = items;
@@ -469,7 +208,7 @@ class Reader {
     if (N(id).kind == NodeKind::kBool) return N(id).boolean;
     Fail(std::string(what) + " as an integer", KindName(id));
   }
-  const std::vector<int>& TupleOf(int id, const char* what) {
+  std::vector<int> TupleOf(int id, const char* what) {  // a copy (see N())
     const NodeKind k = N(id).kind;
     if (k == NodeKind::kTuple || k == NodeKind::kList) return N(id).items;
     Fail(std::string(what) + " as a tuple", KindName(id));
@@ -526,14 +265,14 @@ class Reader {
 
   // ---- globals -------------------------------------------------------------------
   int MakeGlobal(const std::string& module, const std::string& name) {
-    for (const KnownGlobal& k : kKnownGlobals) {
-      if (module == k.module && name == k.name) {
-        const int id = NewNode(NodeKind::kGlobal);
-        N(id).global = k.global;
-        N(id).global_name = module + "." + name;
-        N(id).dtype = k.storage_dtype;
-        return id;
-      }
+    Global global;
+    DType storage_dtype;
+    if (LookupPickleGlobal(module, name, &global, &storage_dtype)) {
+      const int id = NewNode(NodeKind::kGlobal);
+      N(id).global = global;
+      N(id).global_name = module + "." + name;
+      N(id).dtype = storage_dtype;
+      return id;
     }
     Fail(
         "only the numpy, chumpy, scipy.sparse, collections and torch globals that "
@@ -639,7 +378,8 @@ class Reader {
 
   // ---- REDUCE / NEWOBJ / BUILD ---------------------------------------------------
   int NewInstance(int cls_id) {
-    const Node& cls = N(cls_id);
+    // Copies, not references: NewNode may move every node.
+    const Node cls = N(cls_id);
     if (cls.kind != NodeKind::kGlobal || !IsInstanceClass(cls.global)) {
       Fail(
           "a class the reader can build (chumpy Ch/Select, scipy csc/csr_matrix, "
@@ -654,7 +394,7 @@ class Reader {
   }
 
   int Reduce(int callable, int args_id) {
-    const Node& f = N(callable);
+    const Node f = N(callable);  // a copy: NewNode below may move every node
     if (f.kind != NodeKind::kGlobal) Fail("a global to call", KindName(callable));
     const std::vector<int> args = TupleOf(args_id, "call arguments");
     switch (f.global) {
@@ -868,6 +608,13 @@ class Reader {
     return s[0] == '-' ? -static_cast<int64_t>(v) : static_cast<int64_t>(v);
   }
 
+  int HexDigit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    Fail("a hex digit", std::string("'") + c + "'");
+  }
+
   // Python repr of a str: '...' or "..." with backslash escapes.
   std::string UnquoteString(const std::string& s) {
     if (s.size() < 2 || (s[0] != '\'' && s[0] != '"') || s.back() != s[0]) {
@@ -902,7 +649,7 @@ class Reader {
           break;
         case 'x': {
           if (i + 2 >= s.size()) Fail("\\x and two hex digits", "end");
-          out.push_back(static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16)));
+          out.push_back(static_cast<char>(16 * HexDigit(s[i + 1]) + HexDigit(s[i + 2])));
           i += 2;
           break;
         }
@@ -937,7 +684,7 @@ class Reader {
         for (size_t k = 0; k < digits; ++k) {
           const char h = s[i + 2 + k];
           if (!std::isxdigit(static_cast<unsigned char>(h))) Fail("hex digits", "other");
-          cp = cp * 16 + static_cast<uint32_t>(std::stoi(std::string(1, h), nullptr, 16));
+          cp = cp * 16 + static_cast<uint32_t>(HexDigit(h));
         }
         if (cp > 0x10FFFF) Fail("a Unicode code point", "a larger number");
         AppendUtf8(cp, &out);
@@ -1187,7 +934,8 @@ class Reader {
           if (N(name).kind != NodeKind::kText || N(module).kind != NodeKind::kText) {
             Fail("module and name strings", "other values");
           }
-          Push(MakeGlobal(N(module).text, N(name).text));
+          const std::string module_name = N(module).text, global_name = N(name).text;
+          Push(MakeGlobal(module_name, global_name));
           break;
         }
         case 'R': {

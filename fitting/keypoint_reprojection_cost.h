@@ -24,8 +24,8 @@
 
 #include "core/camera_models.h"
 #include "core/hand_evaluator.h"
-#include "fitting/robust_loss.h"
 #include "fitting/keypoint_view.h"
+#include "fitting/robust_loss.h"
 
 namespace handlabel {
 
@@ -35,9 +35,9 @@ struct KeypointViewData {
   double intrinsics[12] = {};
   Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rotation;  // cam_from_world
   Eigen::Vector3d translation;
-  Keypoints2d uv_px;
-  KeypointWeights weight;  // sqrt(confidence) / sigma_px
-  Camera camera;           // for the analytic projection Jacobian
+  KeypointPixels uv_px;
+  KeypointConfidences weight;  // sqrt(confidence) / sigma_px
+  Camera camera;               // for the analytic projection Jacobian
 };
 
 inline std::vector<KeypointViewData> MakeKeypointViewData(

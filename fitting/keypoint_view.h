@@ -9,14 +9,14 @@
 
 namespace handlabel {
 
-using Keypoints2d = Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor>;
-using KeypointWeights = Eigen::Matrix<double, kNumHandKeypoints, 1>;
+using KeypointPixels = Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor>;
+using KeypointConfidences = Eigen::Matrix<double, kNumHandKeypoints, 1>;
 
 struct KeypointView {
   RigCamera camera;  // intrinsics (with distortion) and cam_from_world
-  Keypoints2d uv_px = Keypoints2d::Zero();  // distorted pixels, as detected
+  KeypointPixels uv_px = KeypointPixels::Zero();  // distorted pixels, as detected
   // >= 0 each; 0 = not detected (ignored). Multiplies the squared error.
-  KeypointWeights confidence = KeypointWeights::Zero();
+  KeypointConfidences confidence = KeypointConfidences::Zero();
 };
 
 }  // namespace handlabel

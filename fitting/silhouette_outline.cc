@@ -4,6 +4,9 @@
 #include <limits>
 
 namespace handlabel {
+namespace {
+constexpr int kNormalReach = 3;
+}  // namespace
 
 MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples) {
   const int h = static_cast<int>(mask.rows()), w = static_cast<int>(mask.cols());

@@ -1,12 +1,12 @@
 #pragma once
-// Errors of one frame's hand against ground truth, as scalars that average exactly
-// over frames (every frame has 21 keypoints), so shards can be merged by averaging:
+// Errors of one frame's hand against ground truth (core/metrics.h, the POEM paper's
+// definitions), as scalars that average exactly over frames (every frame has 21
+// keypoints and PCK is linear in the frames), so shards merge by averaging:
 //   mpjpe_mm     mean keypoint distance
-//   pa_mpjpe_mm  the same after the best similarity transform (Procrustes: rotation,
-//                translation, scale) of the keypoints onto the ground truth
+//   pa_mpjpe_mm  the same after Procrustes alignment with scale
 //   mpvpe_mm     mean vertex distance (only when both meshes have the same vertices)
-//   auc          area under the PCK curve for thresholds 0..50 mm, normalised to [0, 1]
-//                (per keypoint exactly max(0, 1 - error / 50 mm))
+//   pa_mpvpe_mm  the same after Procrustes alignment
+//   auc          area under the keypoint PCK curve, 0..20 mm in 20 steps (POEM's)
 
 #include <map>
 #include <string>
@@ -15,10 +15,8 @@
 
 namespace handlabel {
 
-constexpr double kAucMaxThresholdMm = 50.0;
-
 std::map<std::string, double> HandErrors(const Points3d& keypoints,
                                          const Points3d& vertices,
-                                         const HandGroundTruth& truth);
+                                         const FrameGroundTruth& truth);
 
 }  // namespace handlabel

@@ -23,15 +23,20 @@ ResolvedHandModel FromValue(const std::string& value, const std::string& origin,
     throw InputError(origin, "hand model", "an existing model file or \"capsule\"",
                      value);
   }
-  HandModelLoadOptions load;
-  load.side = side;  // for files that do not record their side
-  out.model = LoadHandModel(value, load);
+  // The file's own side (own format, or MANO_LEFT / MANO_RIGHT in the name) wins; a
+  // file that records no side is taken as the side asked for.
+  HandModelLoadOptions options;
+  try {
+    out.model = LoadHandModel(value, options);
+  } catch (const InputError& e) {
+    if (e.field() != "side") throw;
+    options.side = side;
+    out.model = LoadHandModel(value, options);
+  }
   if (out.model.side != side) {
-    const char* names[2] = {"right", "left"};
-    throw InputError(
-        origin, "hand model",
-        std::string("a ") + names[side == HandSide::kLeft] + " hand (as --side asks)",
-        value + " is a " + names[out.model.side == HandSide::kLeft] + " hand");
+    const auto name = [](HandSide s) { return s == HandSide::kLeft ? "left" : "right"; };
+    throw InputError(origin, "hand model", std::string("a ") + name(side) + " hand model",
+                     value + " (a " + name(out.model.side) + " hand)");
   }
   out.source = value;
   return out;

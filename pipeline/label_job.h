@@ -37,7 +37,7 @@ class OverlayWriter {
 struct LabelStageSet {
   const FrameSource* source = nullptr;      // required
   MeshPredictor* predictor = nullptr;       // nullptr: the job has no network
-  const HandFitter* fitter = nullptr;       // nullptr: refine off and no baseline
+  const LabelFitter* fitter = nullptr;      // nullptr: refine off and no baseline
   const OverlayWriter* overlays = nullptr;  // nullptr: no overlay pictures
   std::string hand_model_name;              // recorded in provenance
   HandSide side = HandSide::kRight;

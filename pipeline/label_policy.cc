@@ -8,7 +8,7 @@ namespace handlabel {
 namespace {
 
 void AddMetrics(const std::string& group, const Points3d& keypoints,
-                const Points3d& vertices, const HandGroundTruth& truth,
+                const Points3d& vertices, const FrameGroundTruth& truth,
                 std::map<std::string, double>* metrics) {
   for (const auto& [name, value] : HandErrors(keypoints, vertices, truth)) {
     (*metrics)[group + "/" + name] = value;
@@ -36,11 +36,10 @@ Points3d NativeJointsFromKeypoints(const Points3d& keypoints) {
   return joints;
 }
 
-std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
-                                                    const FrameInput& frame,
-                                                    const MeshPrediction* prediction) {
+std::vector<std::optional<Keypoints2dView>> FitEvidence(
+    const JobConfig& job, const FrameInput& frame, const MeshPrediction* prediction) {
   const size_t views = frame.rig.size();
-  std::vector<std::optional<Keypoints2d>> evidence(views);
+  std::vector<std::optional<Keypoints2dView>> evidence(views);
   const bool use_files = job.keypoints != KeypointSource::kNetwork;
   const bool use_network = job.keypoints != KeypointSource::kFiles;
   if (use_files && !frame.keypoints_2d.empty()) {
@@ -84,7 +83,7 @@ FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
 
   auto fit = [&](const MeshPrediction* init) {
     if (!context.fitter) throw Error("refine.mode needs a fitter, and none was built");
-    FitRequest request;
+    LabelFitRequest request;
     request.frame = &frame;
     request.init = init;
     request.keypoints_2d = FitEvidence(job, frame, prediction);
@@ -102,7 +101,7 @@ FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
     throw Error("refine.mode is off and there is no network prediction");
   } else {
     const bool refine = prediction && job.refine_mode == RefineMode::kAlways;
-    FitResult result = fit(refine ? prediction : nullptr);
+    LabelFit result = fit(refine ? prediction : nullptr);
     label.path = refine ? LabelPath::kRefined : LabelPath::kFallbackFit;
     label.params = result.params;
     label.mesh = std::move(result.mesh);
@@ -119,7 +118,7 @@ FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
   }
 
   if (job.evaluate && frame.ground_truth) {
-    const HandGroundTruth& truth = *frame.ground_truth;
+    const FrameGroundTruth& truth = *frame.ground_truth;
     AddMetrics("labels", label.mesh.keypoints, label.mesh.vertices, truth,
                &outcome.metrics);
     AddMetrics(ToString(label.path), label.mesh.keypoints, label.mesh.vertices, truth,
@@ -135,7 +134,7 @@ FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
       } else {
         // The baseline is for comparison only; its failure does not fail the frame.
         try {
-          const FitResult baseline = fit(nullptr);
+          const LabelFit baseline = fit(nullptr);
           AddMetrics("fit_only", baseline.mesh.keypoints, baseline.mesh.vertices, truth,
                      &outcome.metrics);
         } catch (const std::exception&) {

@@ -20,7 +20,7 @@ namespace handlabel {
 // What one frame needs besides its input: the stages and the fixed provenance.
 struct LabelContext {
   const JobConfig* job = nullptr;
-  const HandFitter* fitter = nullptr;  // nullptr when refine.mode is off
+  const LabelFitter* fitter = nullptr;  // nullptr when refine.mode is off
   HandSide side = HandSide::kRight;
   Provenance provenance;  // the same for every frame of the job
 };
@@ -33,9 +33,9 @@ struct FrameOutcome {
 // The 2D evidence for the fitter per job field evidence.keypoints_2d: the network's
 // keypoints, the capture's keypoint files, or both (files where a view has one, else
 // the network's). Throws Error when the chosen source has nothing for this frame.
-std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
-                                                    const FrameInput& frame,
-                                                    const MeshPrediction* prediction);
+std::vector<std::optional<Keypoints2dView>> FitEvidence(const JobConfig& job,
+                                                        const FrameInput& frame,
+                                                        const MeshPrediction* prediction);
 
 // Labels one frame. `prediction` is nullptr when the job has no network. Throws when
 // the frame cannot be labelled (the runner records the message as the reason).

@@ -1,6 +1,10 @@
 #include "pipeline/label_stage_factory.h"
 
 #include "core/errors.h"
+#include "pipeline/ceres_label_fitter.h"
+#include "pipeline/hand_model_source.h"
+#include "pipeline/label_overlay.h"
+#include "pipeline/native_frame_source.h"
 
 namespace handlabel {
 
@@ -17,15 +21,42 @@ LabelStageSet BuiltLabelStages::Set() const {
 }
 
 std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
-  // The capture readers (native layout first) plug in here as they land.
+  std::optional<Rig> cameras;
+  if (job.cameras_source == "file")
+    cameras = ReadCamerasFile(job.cameras_file, job.source_file);
+  if (job.input_format == "native") {
+    return std::make_unique<NativeFrameSource>(job.input_path, cameras);
+  }
+  // DexYCB / HO3D / OakInk layouts: convert to the native layout first (their readers
+  // plug in here).
   throw InputError(job.source_file, "input.format",
-                   "a capture format with a reader in this build (none yet)",
+                   "a format this build reads directly (native)",
                    "'" + job.input_format + "'");
 }
 
 BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   BuiltLabelStages built;
   built.source = BuildFrameSource(job);
+  HandSide side = HandSide::kRight;
+  if (const auto* native = dynamic_cast<const NativeFrameSource*>(built.source.get())) {
+    side = native->reader().manifest().hand_side == "left" ? HandSide::kLeft
+                                                           : HandSide::kRight;
+  }
+  built.hand_model = ResolveHandModel(job.hand_model, side).model;
+  if (!job.network_weights.empty()) {
+    throw InputError(job.source_file, "network.weights",
+                     "empty: this build has no network predictor yet (use refine.mode "
+                     "always with evidence.keypoints_2d files)",
+                     "'" + job.network_weights + "'");
+  }
+  if (job.refine_mode != RefineMode::kOff || job.baseline) {
+    HandFitOptions options;
+    options.num_threads = 1;  // frames run in parallel
+    built.fitter = std::make_unique<CeresLabelFitter>(
+        built.hand_model, job.masks == MaskSource::kFiles, HandFitConfig(), options);
+  }
+  if (job.overlays)
+    built.overlays = std::make_unique<RasterOverlayWriter>(built.hand_model);
   return built;
 }
 

@@ -14,7 +14,7 @@ namespace handlabel {
 struct BuiltLabelStages {
   std::unique_ptr<FrameSource> source;
   std::unique_ptr<MeshPredictor> predictor;
-  std::unique_ptr<HandFitter> fitter;
+  std::unique_ptr<LabelFitter> fitter;
   std::unique_ptr<OverlayWriter> overlays;
   HandModel hand_model;
   // Views of the above for RunLabelJob.

@@ -19,7 +19,7 @@
 namespace handlabel {
 
 // One view's 2D keypoints.
-struct Keypoints2d {
+struct Keypoints2dView {
   Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor> uv_px =
       Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor>::Zero();
   // Per keypoint, in [0, 1]; 0 = not detected.
@@ -27,7 +27,7 @@ struct Keypoints2d {
       Eigen::Matrix<double, kNumHandKeypoints, 1>::Zero();
 };
 
-struct HandGroundTruth {
+struct FrameGroundTruth {
   Points3d keypoints;                // 21 x 3
   Points3d vertices;                 // V x 3, or empty when the capture has none
   std::optional<HandParams> params;  // when the capture has them
@@ -42,16 +42,16 @@ struct FrameInput {
   std::vector<std::string> mask_paths;   // one per rig camera, or empty
   // 2D keypoints from files, one entry per rig camera (nullopt: none for that view);
   // empty when the capture has no keypoint files.
-  std::vector<std::optional<Keypoints2d>> keypoints_2d;
-  std::optional<HandGroundTruth> ground_truth;
+  std::vector<std::optional<Keypoints2dView>> keypoints_2d;
+  std::optional<FrameGroundTruth> ground_truth;
 };
 
 // The network's answer for one frame.
 struct MeshPrediction {
-  Points3d vertices;                      // V x 3
-  Points3d keypoints;                     // 21 x 3
-  std::vector<Keypoints2d> keypoints_2d;  // one per rig camera: the network's own 2D
-  std::optional<HandParams> params;       // when the network regresses them
+  Points3d vertices;                          // V x 3
+  Points3d keypoints;                         // 21 x 3
+  std::vector<Keypoints2dView> keypoints_2d;  // one per rig camera: the network's own 2D
+  std::optional<HandParams> params;           // when the network regresses them
 };
 
 class FrameSource {
@@ -79,28 +79,28 @@ class MeshPredictor {
       const std::vector<const FrameInput*>& frames) = 0;
 };
 
-struct FitRequest {
+struct LabelFitRequest {
   const FrameInput* frame = nullptr;
   // The network's mesh to start from (refine), or nullptr: fit from the 2D evidence
   // alone (fallback fit and the fit-only baseline).
   const MeshPrediction* init = nullptr;
   // 2D evidence, one entry per rig camera (job field evidence.keypoints_2d).
-  std::vector<std::optional<Keypoints2d>> keypoints_2d;
+  std::vector<std::optional<Keypoints2dView>> keypoints_2d;
   uint64_t seed = 0;
 };
 
-struct FitResult {
+struct LabelFit {
   HandParams params;
   HandMesh mesh;
   nlohmann::json
       report;  // solver summary (cost, iterations, ...), written into the label
 };
 
-class HandFitter {
+class LabelFitter {
  public:
-  virtual ~HandFitter() = default;
+  virtual ~LabelFitter() = default;
   // Thread-safe (called concurrently for different frames). Throws when the fit fails.
-  virtual FitResult Fit(const FitRequest& request) const = 0;
+  virtual LabelFit Fit(const LabelFitRequest& request) const = 0;
   virtual std::string Describe() const = 0;
 };
 

@@ -13,7 +13,8 @@ const std::vector<std::pair<std::string, std::string>> kMetricColumns = {
     {"mpjpe_mm", "MPJPE mm"},
     {"pa_mpjpe_mm", "PA-MPJPE mm"},
     {"mpvpe_mm", "MPVPE mm"},
-    {"auc", "AUC 0-50mm"}};
+    {"pa_mpvpe_mm", "PA-MPVPE mm"},
+    {"auc", "AUC 0-20mm"}};
 
 std::string Number(double value, int decimals) {
   char text[32];

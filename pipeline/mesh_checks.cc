@@ -119,11 +119,16 @@ double SignedVolume(const Points3d& v, const Faces& faces) {
 }
 
 int CountSelfIntersections(const Points3d& v, const Faces& faces) {
+  return static_cast<int>(SelfIntersectingFacePairs(v, faces).size());
+}
+
+std::vector<std::pair<int, int>> SelfIntersectingFacePairs(const Points3d& v,
+                                                           const Faces& faces) {
   const Eigen::Index nf = faces.rows();
   std::vector<Eigen::AlignedBox3d> boxes(nf);
   for (Eigen::Index f = 0; f < nf; ++f)
     for (int k = 0; k < 3; ++k) boxes[f].extend(Eigen::Vector3d(v.row(faces(f, k))));
-  int count = 0;
+  std::vector<std::pair<int, int>> pairs;
   for (Eigen::Index f = 0; f < nf; ++f) {
     for (Eigen::Index g = f + 1; g < nf; ++g) {
       if (!boxes[f].intersects(boxes[g])) continue;
@@ -141,10 +146,10 @@ int CountSelfIntersections(const Points3d& v, const Faces& faces) {
                                     b, c);
         }
       }
-      if (hit) ++count;
+      if (hit) pairs.emplace_back(static_cast<int>(f), static_cast<int>(g));
     }
   }
-  return count;
+  return pairs;
 }
 
 std::vector<Eigen::Matrix3d> GlobalJointRotations(const HandModel& model,

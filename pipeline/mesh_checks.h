@@ -35,6 +35,9 @@ double SignedVolume(const Points3d& vertices,
                     const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>& faces);
 
 // Pairs of faces that share no vertex but intersect (edge of one crosses the other).
+std::vector<std::pair<int, int>> SelfIntersectingFacePairs(
+    const Points3d& vertices,
+    const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>& faces);
 int CountSelfIntersections(
     const Points3d& vertices,
     const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>& faces);

@@ -9,6 +9,7 @@
 #include "core/hand_anatomy.h"
 #include "core/hand_pose_sampler.h"
 #include "pipeline/implicit_mesher.h"
+#include "pipeline/mesh_checks.h"
 #include "pipeline/nnls.h"
 #include "pipeline/open_hand_shape_space.h"
 
@@ -28,6 +29,36 @@ Eigen::Vector3d ProjectToSurface(const OpenHandShape& shape, Eigen::Vector3d p) 
     if (std::abs(f) < 1e-7) break;
   }
   return p;
+}
+
+Points3d ToPoints(const std::vector<Eigen::Vector3d>& v) {
+  Points3d p(static_cast<Eigen::Index>(v.size()), 3);
+  for (size_t i = 0; i < v.size(); ++i) p.row(i) = v[i].transpose();
+  return p;
+}
+
+// Tangential relaxation onto the surface, one round at a time; moves that make faces
+// cross (relaxing across the creases between neighbouring fingers can) are undone.
+void RelaxWithoutIntersections(TriangleMesh* mesh, int iterations,
+                               const OpenHandShape& shape) {
+  Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> faces(mesh->faces.size(), 3);
+  for (size_t f = 0; f < mesh->faces.size(); ++f)
+    faces.row(f) = mesh->faces[f].transpose();
+  for (int it = 0; it < iterations; ++it) {
+    const std::vector<Eigen::Vector3d> before = mesh->vertices;
+    RelaxMesh(mesh, 1,
+              [&](const Eigen::Vector3d& p) { return ProjectToSurface(shape, p); });
+    for (int round = 0; round < 50; ++round) {
+      const auto pairs = SelfIntersectingFacePairs(ToPoints(mesh->vertices), faces);
+      if (pairs.empty()) break;
+      for (const auto& [f, g] : pairs) {
+        for (int k = 0; k < 3; ++k) {
+          mesh->vertices[faces(f, k)] = before[faces(f, k)];
+          mesh->vertices[faces(g, k)] = before[faces(g, k)];
+        }
+      }
+    }
+  }
 }
 
 // Direction of the bone leaving joint j (wrist: towards the middle knuckle).
@@ -151,8 +182,7 @@ HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions
   DecimationOptions decimation;
   decimation.target_vertices = options.target_vertices;
   TriangleMesh mesh = DecimateMesh(fine, decimation);
-  RelaxMesh(&mesh, options.relax_iterations,
-            [&](const Eigen::Vector3d& p) { return ProjectToSurface(shape, p); });
+  RelaxWithoutIntersections(&mesh, options.relax_iterations, shape);
   const int nv = static_cast<int>(mesh.vertices.size());
 
   HandModel model;

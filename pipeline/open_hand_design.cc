@@ -83,6 +83,7 @@ void OpenHandDesign::Check() const {
   positive(wrist_half_width, "wrist_half_width");
   positive(wrist_half_thickness, "wrist_half_thickness");
   positive(wrist_stub_length, "wrist_stub_length");
+  positive(wrist_cut, "wrist_cut");
 }
 
 OpenHandDesign DefaultOpenHandDesign() {
@@ -90,13 +91,13 @@ OpenHandDesign DefaultOpenHandDesign() {
   // MCP joints relative to the wrist joint: the knuckle line arches (middle most distal,
   // little finger ~13 mm proximal) and the transverse arch lowers the outer knuckles.
   d.fingers[0] =
-      Finger({-0.089, -0.001, 0.026}, 7.0, {39.8, 22.4, 20.8}, {9.8, 9.0, 8.0, 7.0});
+      Finger({-0.089, -0.001, 0.027}, 8.5, {39.8, 22.4, 20.8}, {10.2, 9.4, 8.5, 7.5});
   d.fingers[1] =
-      Finger({-0.093, 0.002, 0.006}, 1.0, {44.6, 26.3, 22.4}, {10.0, 9.2, 8.1, 7.1});
+      Finger({-0.093, 0.002, 0.006}, 1.0, {44.6, 26.3, 22.4}, {10.4, 9.6, 8.6, 7.6});
   d.fingers[2] =
-      Finger({-0.088, 0.000, -0.013}, -5.0, {41.4, 25.7, 22.3}, {9.3, 8.6, 7.6, 6.8});
+      Finger({-0.088, 0.000, -0.014}, -5.5, {41.4, 25.7, 22.3}, {9.8, 9.0, 8.1, 7.3});
   d.fingers[3] =
-      Finger({-0.080, -0.003, -0.030}, -12.0, {32.7, 18.1, 20.7}, {8.3, 7.7, 6.9, 6.2});
+      Finger({-0.080, -0.003, -0.032}, -13.0, {32.7, 18.1, 20.7}, {8.9, 8.2, 7.4, 6.7});
   // Thumb: CMC on the radial, palmar side of the wrist; the rest pose is abducted and
   // slightly pronated, pointing distally and radially as in MANO's template.
   d.thumb.cmc = Eigen::Vector3d(-0.022, -0.012, 0.018);
@@ -104,7 +105,7 @@ OpenHandDesign DefaultOpenHandDesign() {
                         Eigen::Vector3d(-0.70, -0.10, 0.71),
                         Eigen::Vector3d(-0.78, -0.05, 0.62)};
   d.thumb.lengths = {0.044, 0.031, 0.0265};
-  d.thumb.radii = {0.0130, 0.0105, 0.0100, 0.0085};
+  d.thumb.radii = {0.0140, 0.0115, 0.0108, 0.0092};
   return d;
 }
 
@@ -144,6 +145,7 @@ OpenHandShape ShapeFromDesign(const OpenHandDesign& design) {
   s.palm_blend = design.palm_blend;
   s.finger_blend = design.finger_blend;
   s.thumb_blend = design.thumb_blend;
+  s.cut_x = design.wrist.x() + design.wrist_cut;
 
   // Palm slab from the wrist to just before the knuckles.
   const Eigen::Vector3d& index_mcp = sk.joints[1];
@@ -239,7 +241,9 @@ double OpenHandShape::Evaluate(const Eigen::Vector3d& p, int* bone) const {
   }
   if (bone) *bone = best_bone;
   const double hand = SmoothMin(palm_value, finger_value, finger_blend);
-  return SmoothMin(hand, thumb_value, thumb_blend);
+  const double whole = SmoothMin(hand, thumb_value, thumb_blend);
+  // Flat wrist end with a rounded rim (smooth intersection with x <= cut_x).
+  return -SmoothMin(-whole, -(p.x() - cut_x), palm_blend);
 }
 
 Eigen::Vector3d OpenHandShape::Gradient(const Eigen::Vector3d& p, double h) const {
@@ -324,6 +328,7 @@ OpenHandDesign SampleOpenHandDesign(const OpenHandDesign& mean,
   d.wrist_half_width *= scale * width;
   d.wrist_half_thickness *= scale * thick;
   d.wrist_stub_length *= scale;
+  d.wrist_cut *= scale;
   d.palm_edge_margin *= scale * width;
   d.palm_blend *= scale;
   d.finger_blend *= scale;

@@ -48,12 +48,13 @@ struct OpenHandDesign {
   // index, middle, ring, pinky (anatomical order, not MANO's chain order).
   std::array<OpenHandFingerDesign, 4> fingers;
   OpenHandThumbDesign thumb;
-  double finger_thickness = 0.86;   // dorsal-palmar size / lateral size of fingers
-  double palm_thickness = 0.030;    // full dorsal-palmar thickness of the palm
+  double finger_thickness = 0.88;   // dorsal-palmar size / lateral size of fingers
+  double palm_thickness = 0.032;    // full dorsal-palmar thickness of the palm
   double palm_edge_margin = 0.004;  // palm reaches this far beyond the outer knuckles
   double wrist_half_width = 0.028;  // forearm stub at the wrist
   double wrist_half_thickness = 0.018;
-  double wrist_stub_length = 0.022;  // forearm stub beyond the wrist joint (+x)
+  double wrist_stub_length = 0.030;  // forearm stub beyond the wrist joint (+x) ...
+  double wrist_cut = 0.016;          // ... cut flat this far beyond the wrist joint
   // Smooth-union radii: palm parts, palm with fingers, palm with thumb.
   double palm_blend = 0.010;
   double finger_blend = 0.006;
@@ -102,6 +103,7 @@ struct OpenHandShape {
   std::vector<OpenHandCapsule> thumb;
   std::array<std::vector<OpenHandCapsule>, 4> fingers;
   double palm_blend = 0, finger_blend = 0, thumb_blend = 0;
+  double cut_x = 1e9;  // flat wrist end: everything at x > cut_x is removed (rounded)
 
   // Signed value at p; `bone` (optional) gets the bone of the nearest part.
   double Evaluate(const Eigen::Vector3d& p, int* bone = nullptr) const;

@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "core/hand_lbs.h"
 #include "core/npz.h"
+#include "tests/core/mano_sized_model.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -234,6 +235,28 @@ TEST(HandModelIo, BadFilesGiveErrorsNamingFileAndKey) {
   path = testing::ScratchDir() + "/cut_right.pkl";
   std::ofstream(path, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   EXPECT_NE(LoadError(path).find("truncated"), std::string::npos) << LoadError(path);
+}
+
+// A MANO-sized file in the official layout (written by the C++ test writer, since MANO
+// cannot be committed): loads without options, with manopth's fingertips, exactly.
+TEST(HandModelIo, ManoSizedOfficialLayoutLoadsExactlyWithDefaults) {
+  const HandModel m = testing::RandomManoSizedModel(testing::TestSeed());
+  const std::string path = testing::ScratchDir() + "/MANO_RIGHT.pkl";
+  std::ofstream(path, std::ios::binary) << testing::ManoStylePickle(m);
+  const LoadedHandModel loaded = LoadHandModelFile(path);
+  EXPECT_EQ(loaded.format, HandModelFormat::kManoPickle);
+  const HandModel& l = loaded.model;
+  EXPECT_EQ(l.side, HandSide::kRight);
+  EXPECT_EQ(l.tip_vertex_ids, (std::array<int, 5>{745, 317, 444, 556, 673}));
+  EXPECT_EQ(Eigen::MatrixXd(l.v_template), Eigen::MatrixXd(m.v_template));
+  EXPECT_EQ(l.faces, m.faces);
+  EXPECT_EQ(l.shapedirs, m.shapedirs);
+  EXPECT_EQ(l.posedirs, m.posedirs);
+  EXPECT_EQ(Eigen::MatrixXd(l.joint_regressor), Eigen::MatrixXd(m.joint_regressor));
+  EXPECT_EQ(Eigen::MatrixXd(l.skinning_weights), Eigen::MatrixXd(m.skinning_weights));
+  EXPECT_EQ(l.pose_pca_basis, m.pose_pca_basis);
+  EXPECT_EQ(l.pose_mean, m.pose_mean);
+  EXPECT_EQ(l.parents, m.parents);
 }
 
 }  // namespace

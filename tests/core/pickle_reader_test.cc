@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -226,6 +227,39 @@ TEST(PickleReader, RandomByteFlipsNeverCrash) {
     }
     PickleError(bad);  // either decodes or throws InputError; never anything else
   }
+}
+
+// The fuzz target's corpus (fuzz/corpus/pickle_reader: named seeds plus inputs the
+// fuzzer kept), each input whole and with random edits; runs without clang.
+TEST(PickleReader, FuzzCorpusSmoke) {
+  const std::string dir =
+      std::string(HANDLABEL_SOURCE_DIR) + "/fuzz/corpus/pickle_reader";
+  int inputs = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string bytes = ReadBytes(entry.path().string());
+    const std::string error = PickleError(bytes);
+    if (entry.path().extension() == ".pkl") EXPECT_EQ(error, "") << entry.path();
+    ++inputs;
+    for (int trial = 0; trial < 20 && !bytes.empty(); ++trial) {
+      std::string bad = bytes;
+      const int edits = 1 + static_cast<int>(testing::Uniform(0, 4));
+      for (int k = 0; k < edits && !bad.empty(); ++k) {
+        const size_t at = static_cast<size_t>(testing::Uniform(0, bad.size() - 1));
+        switch (static_cast<int>(testing::Uniform(0, 3))) {
+          case 0:
+            bad[at] = static_cast<char>(testing::Uniform(0, 256));
+            break;
+          case 1:
+            bad.erase(at, 1);
+            break;
+          default:
+            bad.insert(at, 1, static_cast<char>(testing::Uniform(0, 256)));
+        }
+      }
+      PickleError(bad);  // decodes or throws InputError, nothing else
+    }
+  }
+  EXPECT_GE(inputs, 10);
 }
 
 }  // namespace

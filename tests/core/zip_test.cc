@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -173,6 +174,30 @@ TEST(ZipReader, RejectsCorruptArchivesWithClearErrors) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("declared"), std::string::npos) << e.what();
   }
+}
+
+// The npz fuzz target's corpus (fuzz/corpus/npz_reader), read as LoadHandModel reads
+// .npz entries: nothing but success or InputError.
+TEST(ZipReader, FuzzCorpusSmoke) {
+  const std::string dir = std::string(HANDLABEL_SOURCE_DIR) + "/fuzz/corpus/npz_reader";
+  int inputs = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string bytes = ReadBytes(entry.path().string());
+    ++inputs;
+    try {
+      if (LooksLikeZip(bytes)) {
+        const ZipReader zip = ZipReader::FromBytes(bytes, "corpus.npz");
+        for (const ZipEntry& e : zip.entries()) {
+          const std::string data = zip.Read(e);
+          if (!ParseNpyHeader(data, e.name).is_object) ParseNpy(data, e.name);
+        }
+      } else {
+        ParseNpy(bytes, "corpus.npy");
+      }
+    } catch (const InputError&) {
+    }
+  }
+  EXPECT_GE(inputs, 15);
 }
 
 }  // namespace

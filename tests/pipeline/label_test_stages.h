@@ -42,8 +42,9 @@ inline Rig MakeFourCameraRig() {
   return rig;
 }
 
-inline Keypoints2d ProjectKeypoints(const RigCamera& camera, const Points3d& keypoints) {
-  Keypoints2d view;
+inline Keypoints2dView ProjectKeypoints(const RigCamera& camera,
+                                        const Points3d& keypoints) {
+  Keypoints2dView view;
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     Eigen::Vector2d uv;
     camera.ProjectWorld(keypoints.row(k).transpose(), &uv);
@@ -84,7 +85,7 @@ class TestCapture : public FrameSource {
     frame.id = id;
     frame.rig = rig_;
     const HandMesh mesh = PoseHand(model_, params_[f]);
-    HandGroundTruth truth;
+    FrameGroundTruth truth;
     truth.keypoints = mesh.keypoints;
     truth.vertices = mesh.vertices;
     truth.params = params_[f];
@@ -148,12 +149,12 @@ class TestPredictor : public MeshPredictor {
 
 // Triangulates each keypoint from the evidence (a stand-in for the Ceres fitter with
 // the same contract); throws for frames in `throws`.
-class TestFitter : public HandFitter {
+class TestFitter : public LabelFitter {
  public:
-  FitResult Fit(const FitRequest& request) const override {
+  LabelFit Fit(const LabelFitRequest& request) const override {
     ++fits;
     if (throws.count(request.frame->id)) throw std::runtime_error("solver diverged");
-    FitResult result;
+    LabelFit result;
     result.mesh.keypoints.resize(kNumHandKeypoints, 3);
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       std::vector<ViewObservation> observations;

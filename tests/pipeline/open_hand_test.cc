@@ -19,7 +19,7 @@ namespace {
 
 OpenHandBuildOptions CoarseOptions() {
   OpenHandBuildOptions o;
-  o.grid_step = 0.003;
+  o.grid_step = 0.004;
   o.relax_iterations = 3;
   o.num_shape_samples = 40;
   o.num_pose_samples = 200;

@@ -1,0 +1,259 @@
+#include "calib/board_calib.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "calib/board_calib_init.h"
+#include "calib/board_corner_cost.h"
+#include "core/errors.h"
+
+namespace handlabel {
+namespace {
+
+// The optimised state, laid out as Ceres parameter blocks.
+struct Pose {
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();  // coeffs x, y, z, w
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  Pose() = default;
+  explicit Pose(const Rigid3& r) : q(r.rotation), t(r.translation) {}
+  Rigid3 ToRigid() const { return Rigid3(q, t); }
+};
+
+struct Observation {
+  int camera;
+  std::string frame;
+  int corner_id;
+  Eigen::Vector2d pixel;
+  bool inlier = true;
+};
+
+struct State {
+  std::vector<std::vector<double>> intrinsics;
+  std::vector<Pose> cam_from_world;
+  std::map<std::string, Pose> world_from_board;
+};
+
+Eigen::Vector2d Residual(const State& s, const std::vector<CameraModelId>& models,
+                         const BoardSpec& board, const Observation& o, bool* ok) {
+  const BoardCornerCost cost(models[o.camera], board.Corner(o.corner_id), o.pixel);
+  const Pose& cam = s.cam_from_world[o.camera];
+  const Pose& b = s.world_from_board.at(o.frame);
+  Eigen::Vector2d r;
+  *ok = cost(s.intrinsics[o.camera].data(), cam.q.coeffs().data(), cam.t.data(),
+             b.q.coeffs().data(), b.t.data(), r.data());
+  return r;
+}
+
+void Solve(State* s, const std::vector<CameraModelId>& models, const BoardSpec& board,
+           const std::vector<Observation>& observations, size_t master,
+           const BoardCalibOptions& options) {
+  ceres::Problem problem;
+  for (const Observation& o : observations) {
+    if (!o.inlier) continue;
+    Pose& cam = s->cam_from_world[o.camera];
+    Pose& b = s->world_from_board.at(o.frame);
+    problem.AddResidualBlock(
+        BoardCornerCost::Create(models[o.camera], board.Corner(o.corner_id), o.pixel),
+        new ceres::HuberLoss(options.huber_px), s->intrinsics[o.camera].data(),
+        cam.q.coeffs().data(), cam.t.data(), b.q.coeffs().data(), b.t.data());
+  }
+  for (size_t c = 0; c < s->cam_from_world.size(); ++c) {
+    Pose& cam = s->cam_from_world[c];
+    if (!problem.HasParameterBlock(cam.q.coeffs().data())) continue;
+    problem.SetManifold(cam.q.coeffs().data(), new ceres::EigenQuaternionManifold);
+    if (c == master) {  // the gauge: the master camera is the world during the solve
+      problem.SetParameterBlockConstant(cam.q.coeffs().data());
+      problem.SetParameterBlockConstant(cam.t.data());
+    }
+  }
+  for (auto& [key, b] : s->world_from_board) {
+    if (problem.HasParameterBlock(b.q.coeffs().data())) {
+      problem.SetManifold(b.q.coeffs().data(), new ceres::EigenQuaternionManifold);
+    }
+  }
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_SCHUR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = options.num_threads;
+  solver.function_tolerance = 1e-12;
+  solver.parameter_tolerance = 1e-12;
+  solver.gradient_tolerance = 1e-14;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  if (!summary.IsSolutionUsable()) {
+    throw InputError("board calibration", "bundle adjustment", "a usable solution",
+                     summary.message);
+  }
+}
+
+}  // namespace
+
+void BoardCalibOptions::Check() const {
+  const std::string src = "BoardCalibOptions";
+  if (!(huber_px > 0)) throw InputError(src, "huber_px", "> 0");
+  if (outlier_rounds < 0) throw InputError(src, "outlier_rounds", ">= 0");
+  if (!(outlier_sigmas > 0)) throw InputError(src, "outlier_sigmas", "> 0");
+  if (!(min_outlier_px > 0)) throw InputError(src, "min_outlier_px", "> 0");
+  if (min_frames_per_camera < 1) throw InputError(src, "min_frames_per_camera", ">= 1");
+  if (max_iterations < 1) throw InputError(src, "max_iterations", ">= 1");
+  if (num_threads < 1) throw InputError(src, "num_threads", ">= 1");
+  if (world != "camera" && world != "board" && world.rfind("board:", 0) != 0) {
+    throw InputError(src, "world", "camera, board or board:FRAME", "'" + world + "'");
+  }
+}
+
+BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
+                                   const BoardSpec& board,
+                                   const BoardCalibOptions& options) {
+  options.Check();
+  board.Check();
+  if (views.empty())
+    throw InputError("board calibration", "cameras", "at least one camera");
+  size_t master = 0;
+  if (!options.master.empty()) {
+    const auto it =
+        std::find_if(views.begin(), views.end(),
+                     [&](const CameraBoardViews& v) { return v.name == options.master; });
+    if (it == views.end()) {
+      std::string known;
+      for (const auto& v : views) known += (known.empty() ? "" : ", ") + v.name;
+      throw InputError("--master", "camera", "one of [" + known + "]",
+                       "'" + options.master + "'");
+    }
+    master = static_cast<size_t>(it - views.begin());
+  }
+  for (const CameraBoardViews& v : views) {
+    if (static_cast<int>(v.frames.size()) < options.min_frames_per_camera) {
+      throw InputError("camera " + v.name, "board detections",
+                       "at least " + std::to_string(options.min_frames_per_camera) +
+                           " images with the board found",
+                       std::to_string(v.frames.size()));
+    }
+  }
+
+  // 1-2. Initial values.
+  BoardCalibResult result;
+  std::vector<InitialCamera> initial;
+  for (const CameraBoardViews& v : views) {
+    initial.push_back(InitialIntrinsics(v, board, options.model));
+  }
+  const std::vector<Rigid3> cam_from_master =
+      ChainExtrinsics(views, initial, master, &result.tree);
+  State state;
+  std::vector<CameraModelId> models;
+  for (size_t c = 0; c < views.size(); ++c) {
+    state.intrinsics.push_back(initial[c].camera.params());
+    state.cam_from_world.emplace_back(cam_from_master[c]);
+    models.push_back(options.model);
+  }
+  // Each frame's board pose from the camera that saw most of it.
+  std::map<std::string, std::pair<size_t, size_t>> best_view;  // key -> (corners, camera)
+  for (size_t c = 0; c < views.size(); ++c) {
+    for (const auto& [key, pose] : initial[c].cam_from_board) {
+      auto& best = best_view[key];
+      if (views[c].frames.at(key).size() > best.first)
+        best = {views[c].frames.at(key).size(), c};
+    }
+  }
+  for (const auto& [key, best] : best_view) {
+    const size_t c = best.second;
+    state.world_from_board[key] =
+        Pose(cam_from_master[c].Inverse() * initial[c].cam_from_board.at(key));
+  }
+  std::vector<Observation> observations;
+  for (size_t c = 0; c < views.size(); ++c) {
+    for (const auto& [key, obs] : views[c].frames) {
+      if (!state.world_from_board.count(key)) continue;  // no usable initial board pose
+      for (size_t i = 0; i < obs.size(); ++i) {
+        observations.push_back({static_cast<int>(c), key, obs.ids[i], obs.pixels[i]});
+      }
+    }
+  }
+
+  // 3. Bundle adjustment with outlier rounds.
+  Solve(&state, models, board, observations, master, options);
+  for (int round = 0; round < options.outlier_rounds; ++round) {
+    std::vector<double> norms;
+    for (const Observation& o : observations) {
+      bool ok;
+      if (o.inlier) norms.push_back(Residual(state, models, board, o, &ok).norm());
+    }
+    std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
+    // For 2D Gaussian residuals, median |r| = 1.1774 sigma.
+    const double sigma = norms[norms.size() / 2] / 1.1774;
+    const double threshold =
+        std::max(options.min_outlier_px, options.outlier_sigmas * sigma);
+    int changed = 0;
+    for (Observation& o : observations) {
+      bool ok;
+      const double r = Residual(state, models, board, o, &ok).norm();
+      const bool inlier = ok && r <= threshold;
+      if (inlier != o.inlier) ++changed;
+      o.inlier = inlier;
+    }
+    if (changed == 0) break;
+    Solve(&state, models, board, observations, master, options);
+  }
+
+  // 4. World frame.
+  Rigid3 master_from_world;  // identity for world = master camera
+  result.world = "camera:" + views[master].name;
+  if (options.world != "camera") {
+    std::string key;
+    if (options.world == "board") {
+      key = views[master].frames.begin()->first;
+    } else {
+      key = options.world.substr(6);
+      if (!state.world_from_board.count(key)) {
+        throw InputError("--world", "board:FRAME",
+                         "a frame in which some camera saw the board", "'" + key + "'");
+      }
+    }
+    master_from_world = state.world_from_board.at(key).ToRigid();
+    result.world = "board:" + key;
+  }
+  for (size_t c = 0; c < views.size(); ++c) {
+    RigCamera rc;
+    rc.name = views[c].name;
+    rc.camera = Camera(models[c], views[c].width, views[c].height, state.intrinsics[c],
+                       "calibrated camera " + views[c].name);
+    rc.cam_from_world = state.cam_from_world[c].ToRigid() * master_from_world;
+    result.rig.Add(rc);
+  }
+  for (const auto& [key, pose] : state.world_from_board) {
+    result.world_from_board[key] = master_from_world.Inverse() * pose.ToRigid();
+  }
+
+  // Statistics and residuals.
+  result.stats.resize(views.size());
+  std::vector<double> sum_sq(views.size(), 0.0);
+  double total_sq = 0;
+  int total = 0;
+  for (size_t c = 0; c < views.size(); ++c) {
+    result.stats[c].name = views[c].name;
+    result.stats[c].frames = static_cast<int>(views[c].frames.size());
+    result.stats[c].initial_rms_px = initial[c].rms_px;
+  }
+  for (const Observation& o : observations) {
+    bool ok;
+    const Eigen::Vector2d r = Residual(state, models, board, o, &ok);
+    result.residuals.push_back({o.camera, o.frame, o.corner_id, o.pixel, r, o.inlier});
+    CameraCalibStats& st = result.stats[o.camera];
+    if (o.inlier) {
+      ++st.observations;
+      sum_sq[o.camera] += r.squaredNorm();
+      total_sq += r.squaredNorm();
+      ++total;
+    } else {
+      ++st.outliers;
+    }
+  }
+  for (size_t c = 0; c < views.size(); ++c) {
+    const int n = result.stats[c].observations;
+    result.stats[c].rms_px = n > 0 ? std::sqrt(sum_sq[c] / n) : 0;
+  }
+  result.rms_px = total > 0 ? std::sqrt(total_sq / total) : 0;
+  return result;
+}
+
+}  // namespace handlabel

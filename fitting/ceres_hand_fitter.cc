@@ -1,0 +1,565 @@
+#include "fitting/ceres_hand_fitter.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "core/errors.h"
+#include "core/triangulation.h"
+#include "fitting/axis_angle_manifold.h"
+#include "fitting/joint_limit_cost.h"
+#include "fitting/keypoint_reprojection_cost.h"
+#include "fitting/prior_costs.h"
+#include "fitting/silhouette_cost.h"
+#include "fitting/silhouette_outline.h"
+#include "fitting/silhouette_render.h"
+
+namespace handlabel {
+namespace {
+
+constexpr int kBetas = 10;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Palm keypoints (SNAP): wrist and the four finger MCPs; rigid in the hand's frame.
+constexpr int kPalmKeypoints[] = {0, 5, 9, 13, 17};
+
+// The optimised parameter blocks.
+struct Blocks {
+  double orient[3] = {0, 0, 0};
+  std::vector<double> pose;
+  double betas[kBetas] = {};
+  double transl[3] = {0, 0, 0};
+};
+
+std::string Str(double x) { return std::to_string(x); }
+
+void RequirePositive(double value, const char* field) {
+  if (!(value > 0.0)) throw InputError("HandFitOptions", field, "> 0", Str(value));
+}
+void RequireNonNegative(int value, const char* field) {
+  if (value < 0) throw InputError("HandFitOptions", field, ">= 0", std::to_string(value));
+}
+
+ceres::Solver::Options SolverOptions(const HandFitOptions& o, int iterations) {
+  ceres::Solver::Options s;
+  s.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  s.max_num_iterations = iterations;
+  s.function_tolerance = o.function_tolerance;
+  s.parameter_tolerance = o.parameter_tolerance;
+  s.gradient_tolerance = 1e-12;
+  s.num_threads = o.num_threads;
+  s.logging_type = ceres::SILENT;
+  s.minimizer_progress_to_stdout = false;
+  return s;
+}
+
+// One stage's problem over the blocks, with the terms named for the result.
+class StageProblem {
+ public:
+  explicit StageProblem(Blocks* blocks) : blocks_(blocks) {
+    ceres::Problem::Options options;
+    options.manifold_ownership = ceres::TAKE_OWNERSHIP;
+    problem_ = std::make_unique<ceres::Problem>(options);
+    problem_->AddParameterBlock(blocks->orient, 3, CreateAxisAngleManifold());
+    problem_->AddParameterBlock(blocks->pose.data(),
+                                static_cast<int>(blocks->pose.size()));
+    problem_->AddParameterBlock(blocks->betas, kBetas);
+    problem_->AddParameterBlock(blocks->transl, 3);
+  }
+  void AddFull(const std::string& term, ceres::CostFunction* cost) {
+    ids_[term].push_back(problem_->AddResidualBlock(cost, nullptr, blocks_->orient,
+                                                    blocks_->pose.data(), blocks_->betas,
+                                                    blocks_->transl));
+  }
+  void Add(const std::string& term, ceres::CostFunction* cost, double* block) {
+    ids_[term].push_back(problem_->AddResidualBlock(cost, nullptr, block));
+  }
+  void Hold(double* block) { problem_->SetParameterBlockConstant(block); }
+
+  ceres::Solver::Summary Solve(const ceres::Solver::Options& options) {
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, problem_.get(), &summary);
+    return summary;
+  }
+  std::map<std::string, double> TermCosts() const {
+    std::map<std::string, double> costs;
+    for (const auto& [term, ids] : ids_) {
+      double total = 0.0;
+      for (ceres::ResidualBlockId id : ids) {
+        double cost = 0.0;
+        problem_->EvaluateResidualBlock(id, false, &cost, nullptr, nullptr);
+        total += cost;
+      }
+      costs[term] = total;
+    }
+    return costs;
+  }
+
+ private:
+  Blocks* blocks_;
+  std::unique_ptr<ceres::Problem> problem_;
+  std::map<std::string, std::vector<ceres::ResidualBlockId>> ids_;
+};
+
+bool IsDone(const ceres::Solver::Summary& s) {
+  return s.termination_type == ceres::CONVERGENCE ||
+         s.termination_type == ceres::USER_SUCCESS;
+}
+
+// Least-squares rotation R and translation t with target ~ R * source + t (Kabsch).
+void RigidAlign(const std::vector<Eigen::Vector3d>& source,
+                const std::vector<Eigen::Vector3d>& target, Eigen::Matrix3d* r,
+                Eigen::Vector3d* t) {
+  Eigen::Vector3d ms = Eigen::Vector3d::Zero(), mt = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < source.size(); ++i) {
+    ms += source[i];
+    mt += target[i];
+  }
+  ms /= source.size();
+  mt /= source.size();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < source.size(); ++i) {
+    cov += (target[i] - mt) * (source[i] - ms).transpose();
+  }
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Vector3d sign(1, 1, 1);
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) sign[2] = -1;
+  *r = svd.matrixU() * sign.asDiagonal() * svd.matrixV().transpose();
+  *t = mt - *r * ms;
+}
+
+}  // namespace
+
+void HandFitConfig::Check() const {
+  if (pose_pca_comps != 0 && pose_pca_comps != 12 && pose_pca_comps != 45) {
+    throw InputError("HandFitConfig", "pose_pca_comps", "0 (axis-angle), 12 or 45",
+                     std::to_string(pose_pca_comps));
+  }
+}
+
+void HandFitOptions::Check() const {
+  RequirePositive(keypoint_sigma_px, "keypoint_sigma_px");
+  RequirePositive(keypoint_loss.scale, "keypoint_loss.scale");
+  RequirePositive(limit_sigma_deg, "limit_sigma_deg");
+  RequirePositive(pose_prior_sigma_rad, "pose_prior_sigma_rad");
+  RequirePositive(shape_prior_sigma, "shape_prior_sigma");
+  RequirePositive(points3d_sigma_m, "points3d_sigma_m");
+  RequirePositive(temporal_pose_sigma_rad, "temporal_pose_sigma_rad");
+  RequirePositive(temporal_transl_sigma_m, "temporal_transl_sigma_m");
+  RequirePositive(silhouette_sigma_px, "silhouette_sigma_px");
+  if (silhouette_vertex_stride < 1) {
+    throw InputError("HandFitOptions", "silhouette_vertex_stride", ">= 1",
+                     std::to_string(silhouette_vertex_stride));
+  }
+  RequireNonNegative(silhouette_outline_samples, "silhouette_outline_samples");
+  RequireNonNegative(silhouette_rounds, "silhouette_rounds");
+  RequirePositive(silhouette_contour_cosine, "silhouette_contour_cosine");
+  RequireNonNegative(rigid_iterations, "rigid_iterations");
+  RequireNonNegative(keypoint_iterations, "keypoint_iterations");
+  RequireNonNegative(silhouette_iterations, "silhouette_iterations");
+  RequirePositive(function_tolerance, "function_tolerance");
+  RequirePositive(parameter_tolerance, "parameter_tolerance");
+  if (num_threads < 1) {
+    throw InputError("HandFitOptions", "num_threads", ">= 1",
+                     std::to_string(num_threads));
+  }
+  RequirePositive(triangulation_inlier_px, "triangulation_inlier_px");
+  RequirePositive(fallback_depth_m, "fallback_depth_m");
+}
+
+namespace {
+
+HandEvaluatorOptions EvaluatorOptionsFor(const HandModel& model, const HandFitConfig& c) {
+  if (model.num_betas() < kBetas) {
+    throw InputError(model.name, "shapedirs", "at least 10 shape coefficients",
+                     std::to_string(model.num_betas()));
+  }
+  HandEvaluatorOptions o;
+  o.num_betas = kBetas;
+  o.num_pca_comps = c.pose_pca_comps;
+  return o;
+}
+
+Eigen::Matrix<double, 45, 1> PoseMean(const HandModel& model) {
+  if (model.pose_mean.size() == kNumPoseParams) return model.pose_mean;
+  return Eigen::Matrix<double, 45, 1>::Zero();
+}
+
+}  // namespace
+
+CeresHandFitter::CeresHandFitter(const HandModel& model, const HandFitConfig& config,
+                                 const HandFitOptions& options)
+    : model_(model),
+      config_(config),
+      options_(options),
+      evaluator_(model,
+                 (config.Check(), options.Check(), EvaluatorOptionsFor(model, config))),
+      anatomy_(ComputeHandAnatomy(model)),
+      limits_(DefaultHandLimits()) {}
+
+namespace {
+
+// Everything the stages need, templated on the pose block size.
+template <int P>
+class FitRun {
+ public:
+  FitRun(const HandModel& model, const HandEvaluator& evaluator,
+         const HandAnatomy& anatomy, const HandLimits& limits,
+         const HandFitConfig& config, const HandFitOptions& options)
+      : model_(model),
+        evaluator_(evaluator),
+        anatomy_(anatomy),
+        limits_(limits),
+        config_(config),
+        options_(options) {}
+
+  Blocks ToBlocks(const HandParams& p) const {
+    Blocks b;
+    for (int i = 0; i < 3; ++i) {
+      b.orient[i] = p.global_orient[i];
+      b.transl[i] = p.transl[i];
+    }
+    for (int s = 0; s < kBetas; ++s) b.betas[s] = s < p.betas.size() ? p.betas[s] : 0.0;
+    if (config_.pose_pca_comps == 0) {
+      b.pose.assign(p.hand_pose.data(), p.hand_pose.data() + kNumPoseParams);
+    } else {
+      // Least-squares coefficients: basis^T c ~ pose - mean.
+      const int n = config_.pose_pca_comps;
+      const Eigen::MatrixXd basis = model_.pose_pca_basis.topRows(n);
+      const Eigen::VectorXd c = (basis * basis.transpose())
+                                    .ldlt()
+                                    .solve(basis * (p.hand_pose - PoseMean(model_)));
+      b.pose.assign(c.data(), c.data() + n);
+    }
+    return b;
+  }
+
+  HandParams FromBlocks(const Blocks& b) const {
+    HandParams p;
+    p.global_orient = Eigen::Vector3d(b.orient);
+    p.transl = Eigen::Vector3d(b.transl);
+    p.betas = Eigen::Map<const Eigen::VectorXd>(b.betas, kBetas);
+    evaluator_.AxisAnglePose(b.pose.data(), p.hand_pose.data());
+    return p;
+  }
+
+  void AddPriors(StageProblem* problem, Blocks* b) const {
+    if (config_.use_joint_limits) {
+      const double w = 1.0 / std::pow(options_.limit_sigma_deg * M_PI / 180.0, 2);
+      problem->Add("joint_limits",
+                   JointLimitCost<P>::Create(evaluator_, anatomy_, limits_, w),
+                   b->pose.data());
+    }
+    if (config_.use_pose_prior) {
+      const Eigen::Matrix<double, 45, 1> inv =
+          Eigen::Matrix<double, 45, 1>::Constant(1.0 / options_.pose_prior_sigma_rad);
+      problem->Add("pose_prior",
+                   PosePriorCost<P>::Create(evaluator_, PoseMean(model_), inv),
+                   b->pose.data());
+    }
+    if (config_.use_shape_prior) {
+      problem->Add("shape_prior",
+                   ShapePriorCost<kBetas>::Create(options_.shape_prior_sigma), b->betas);
+    }
+  }
+
+  // 3D targets as the only evidence: the IK-style initialisation.
+  void SolvePoints3d(const Points3dTargets& targets, Blocks* b, bool full) const {
+    for (int stage = 0; stage < (full ? 2 : 1); ++stage) {
+      StageProblem problem(b);
+      problem.AddFull("points3d", Points3dCost<P, kBetas>::Create(
+                                      evaluator_, targets, options_.points3d_sigma_m));
+      if (stage == 0) {
+        problem.Hold(b->pose.data());
+        problem.Hold(b->betas);
+      } else {
+        AddPriors(&problem, b);
+        if (!config_.optimise_shape) problem.Hold(b->betas);
+      }
+      problem.Solve(SolverOptions(options_, stage == 0 ? options_.rigid_iterations
+                                                       : options_.keypoint_iterations));
+    }
+  }
+
+  HandFitResult Fit(const HandFitInput& input, const HandParams& init) const {
+    const auto start = std::chrono::steady_clock::now();
+    Blocks b = ToBlocks(init);
+    Blocks previous;
+    if (input.previous) previous = ToBlocks(*input.previous);
+    const bool use_kp = config_.use_keypoints && !input.views.empty();
+    const bool use_3d = config_.use_points3d && input.targets3d.has_value();
+    const bool use_temporal = config_.use_temporal && input.previous.has_value();
+    if (!input.masks.empty() && input.masks.size() != input.views.size()) {
+      throw InputError(
+          "HandFitInput", "masks",
+          std::to_string(input.views.size()) + " masks (one per view) or none",
+          std::to_string(input.masks.size()));
+    }
+    bool use_sil = false;
+    for (const MaskImage& m : input.masks) use_sil |= m.size() > 0;
+    use_sil &= config_.use_silhouettes && options_.silhouette_rounds > 0;
+
+    HandFitResult result;
+    auto add_evidence = [&](StageProblem* problem) {
+      if (use_kp) {
+        problem->AddFull("keypoints", MultiViewKeypointCostFunction::Create(
+                                          evaluator_, input.views, options_.keypoint_loss,
+                                          options_.keypoint_sigma_px));
+      }
+      if (use_3d) {
+        problem->AddFull("points3d",
+                         Points3dCost<P, kBetas>::Create(evaluator_, *input.targets3d,
+                                                         options_.points3d_sigma_m));
+      }
+    };
+    auto add_temporal = [&](StageProblem* problem) {
+      if (!use_temporal) return;
+      problem->Add("temporal",
+                   ParameterPriorCost<P>::Create(previous.pose.data(),
+                                                 options_.temporal_pose_sigma_rad),
+                   b.pose.data());
+      problem->Add("temporal",
+                   ParameterPriorCost<3>::Create(previous.transl,
+                                                 options_.temporal_transl_sigma_m),
+                   b.transl);
+    };
+    auto run = [&](StageProblem* problem, int iterations) {
+      const ceres::Solver::Summary s =
+          problem->Solve(SolverOptions(options_, iterations));
+      result.iterations += static_cast<int>(s.iterations.size()) - 1;
+      result.converged = IsDone(s);
+      result.message = s.message;
+      result.term_costs = problem->TermCosts();
+    };
+
+    // 1. Rigid.
+    if ((use_kp || use_3d) && options_.rigid_iterations > 0) {
+      StageProblem problem(&b);
+      add_evidence(&problem);
+      problem.Hold(b.pose.data());
+      problem.Hold(b.betas);
+      run(&problem, options_.rigid_iterations);
+    }
+    // 2. Pose and shape on keypoints.
+    auto full_problem = [&](StageProblem* problem) {
+      add_evidence(problem);
+      AddPriors(problem, &b);
+      add_temporal(problem);
+      if (!config_.optimise_shape) problem->Hold(b.betas);
+    };
+    if (options_.keypoint_iterations > 0) {
+      StageProblem problem(&b);
+      full_problem(&problem);
+      run(&problem, options_.keypoint_iterations);
+    }
+    // 3. With silhouettes: re-match outlines, solve; repeat.
+    std::vector<int> vertex_ids;
+    for (int v = 0; v < evaluator_.num_vertices();
+         v += options_.silhouette_vertex_stride) {
+      vertex_ids.push_back(v);
+    }
+    std::vector<SilhouetteView> sil_views;
+    std::vector<MaskOutline> outlines;
+    if (use_sil) {
+      for (size_t v = 0; v < input.masks.size(); ++v) {
+        if (input.masks[v].size() == 0) continue;
+        SilhouetteView view;
+        view.camera = input.views[v].camera;
+        if (input.masks[v].rows() != view.camera.camera.height() ||
+            input.masks[v].cols() != view.camera.camera.width()) {
+          throw InputError("HandFitInput", "masks[" + std::to_string(v) + "]",
+                           "the camera's image size",
+                           std::to_string(input.masks[v].cols()) + "x" +
+                               std::to_string(input.masks[v].rows()));
+        }
+        view.distance_to_mask = DistanceToMask(input.masks[v]);
+        if (!std::isfinite(view.distance_to_mask(0, 0))) continue;  // empty mask
+        outlines.push_back(
+            SampleMaskOutline(input.masks[v], options_.silhouette_outline_samples));
+        sil_views.push_back(std::move(view));
+      }
+    }
+    for (int round = 0; !sil_views.empty() && round < options_.silhouette_rounds;
+         ++round) {
+      // Outline samples are matched only to contour-generator vertices (normal nearly
+      // perpendicular to the viewing ray): matching interior vertices would pull them
+      // outwards and inflate the hand.
+      Points3d all(evaluator_.num_vertices(), 3);
+      evaluator_.AllVertices(b.orient, b.pose.data(), b.betas, b.transl, all.data());
+      const MeshVertices normals = ComputeVertexNormals(all, model_.faces);
+      for (size_t v = 0; v < sil_views.size(); ++v) {
+        const Eigen::Vector3d centre = sil_views[v].camera.CenterInWorld();
+        std::vector<Eigen::Vector2d> uv(vertex_ids.size());
+        std::vector<char> valid(vertex_ids.size());
+        for (size_t i = 0; i < vertex_ids.size(); ++i) {
+          const Eigen::Vector3d x = all.row(vertex_ids[i]).transpose();
+          const Eigen::Vector3d n = normals.row(vertex_ids[i]).transpose();
+          const double along = std::abs(n.dot((x - centre).normalized()));
+          valid[i] = n.squaredNorm() > 0.5 &&
+                     along < options_.silhouette_contour_cosine &&
+                     sil_views[v].camera.ProjectWorld(x, &uv[i]);
+        }
+        sil_views[v].outline_px = outlines[v].points;
+        sil_views[v].outline_normal = outlines[v].normals;
+        sil_views[v].outline_vertex = MatchOutlineToPoints(outlines[v], uv, valid);
+      }
+      StageProblem problem(&b);
+      full_problem(&problem);
+      problem.AddFull("silhouette", MultiViewSilhouetteCost<P, kBetas>::Create(
+                                        evaluator_, vertex_ids, sil_views,
+                                        options_.silhouette_sigma_px));
+      run(&problem, options_.silhouette_iterations);
+    }
+
+    result.params = FromBlocks(b);
+    const HandMesh mesh = PoseHand(model_, result.params);
+    result.vertices = mesh.vertices;
+    result.keypoints = mesh.keypoints;
+    for (const KeypointView& view : input.views) {
+      double sum = 0.0;
+      int n = 0;
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        if (!(view.confidence[k] > 0.0)) continue;
+        Eigen::Vector2d uv;
+        if (!view.camera.ProjectWorld(mesh.keypoints.row(k).transpose(), &uv)) continue;
+        sum += (uv - view.uv_px.row(k).transpose()).squaredNorm();
+        ++n;
+      }
+      result.view_rms_px.push_back(n > 0 ? std::sqrt(sum / n) : kNaN);
+    }
+    result.view_iou.assign(input.views.size(), kNaN);
+    for (size_t v = 0; v < input.masks.size(); ++v) {
+      if (input.masks[v].size() == 0) continue;
+      const RigCamera& camera = input.views[v].camera;
+      const MaskImage rendered = input.pixel_rays != nullptr
+                                     ? RenderHandMask(result.vertices, model_.faces,
+                                                      camera, (*input.pixel_rays)[v])
+                                     : RenderHandMask(result.vertices, model_.faces,
+                                                      camera, PixelRays(camera.camera));
+      result.view_iou[v] = MaskIoU(rendered, input.masks[v]);
+    }
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
+
+  HandParams InitFromKeypoints3d(const Points3d& keypoints,
+                                 const Eigen::VectorXd& weights,
+                                 const Eigen::Vector3d& fallback_position) const {
+    HL_CHECK(keypoints.rows() == kNumHandKeypoints && weights.size() == kNumHandKeypoints,
+             "21 keypoints and weights");
+    Blocks b = ToBlocks(HandParams());
+    double rest[3 * kNumHandKeypoints];
+    evaluator_.Keypoints(b.orient, b.pose.data(), b.betas, b.transl, rest);
+    const Eigen::Vector3d wrist_rest(rest[0], rest[1], rest[2]);
+    std::vector<Eigen::Vector3d> source, target;
+    for (int k : kPalmKeypoints) {
+      if (!(weights[k] > 0.0)) continue;
+      source.emplace_back(rest[3 * k], rest[3 * k + 1], rest[3 * k + 2]);
+      target.push_back(keypoints.row(k).transpose());
+    }
+    Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d t = fallback_position - wrist_rest;
+    int known = 0;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), rest_centroid = centroid;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (!(weights[k] > 0.0)) continue;
+      ++known;
+      centroid += keypoints.row(k).transpose();
+      rest_centroid += Eigen::Vector3d(rest[3 * k], rest[3 * k + 1], rest[3 * k + 2]);
+    }
+    if (source.size() >= 3) {
+      RigidAlign(source, target, &r, &t);
+    } else if (known > 0) {
+      t = centroid / known - rest_centroid / known;
+    }
+    // posed = R (p - J0) + J0 + transl = R p + t  =>  transl = t + R J0 - J0.
+    const Eigen::AngleAxisd aa(r);
+    const Eigen::Vector3d orient = aa.angle() * aa.axis();
+    const Eigen::Vector3d transl = t + r * wrist_rest - wrist_rest;
+    for (int i = 0; i < 3; ++i) {
+      b.orient[i] = orient[i];
+      b.transl[i] = transl[i];
+    }
+    if (known >= 4) {
+      Points3dTargets targets;
+      targets.keypoints = keypoints;
+      targets.keypoint_weights = weights.cwiseMax(0.0);
+      SolvePoints3d(targets, &b, /*full=*/true);
+    }
+    return FromBlocks(b);
+  }
+
+ private:
+  const HandModel& model_;
+  const HandEvaluator& evaluator_;
+  const HandAnatomy& anatomy_;
+  const HandLimits& limits_;
+  const HandFitConfig& config_;
+  const HandFitOptions& options_;
+};
+
+}  // namespace
+
+HandParams CeresHandFitter::InitFromKeypoints3d(const Points3d& keypoints,
+                                                const Eigen::VectorXd& weights) const {
+  const Eigen::Vector3d fallback(0, 0, options_.fallback_depth_m);
+  if (evaluator_.pose_dim() == 12) {
+    return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
+        .InitFromKeypoints3d(keypoints, weights, fallback);
+  }
+  return FitRun<45>(model_, evaluator_, anatomy_, limits_, config_, options_)
+      .InitFromKeypoints3d(keypoints, weights, fallback);
+}
+
+HandParams CeresHandFitter::InitFromViews(const std::vector<KeypointView>& views) const {
+  Rig rig;
+  for (size_t v = 0; v < views.size(); ++v) {
+    RigCamera camera = views[v].camera;
+    camera.name = "view" + std::to_string(v);
+    rig.Add(camera);
+  }
+  RobustTriangulationOptions tri;
+  tri.inlier_threshold_px = options_.triangulation_inlier_px;
+  Points3d keypoints = Points3d::Zero(kNumHandKeypoints, 3);
+  Eigen::VectorXd weights = Eigen::VectorXd::Zero(kNumHandKeypoints);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    std::vector<ViewObservation> observations;
+    for (size_t v = 0; v < views.size(); ++v) {
+      if (!(views[v].confidence[k] > 0.0)) continue;
+      observations.push_back({static_cast<int>(v), views[v].uv_px.row(k).transpose(),
+                              views[v].confidence[k]});
+    }
+    if (observations.size() < 2) continue;
+    const RobustTriangulation t = TriangulateRobust(rig, observations, tri);
+    if (!t.valid) continue;
+    keypoints.row(k) = t.point.transpose();
+    weights[k] = 1.0;
+  }
+  Eigen::Vector3d fallback(0, 0, options_.fallback_depth_m);
+  if (!views.empty()) {
+    fallback = views[0].camera.cam_from_world.Inverse() * fallback;
+  }
+  if (evaluator_.pose_dim() == 12) {
+    return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
+        .InitFromKeypoints3d(keypoints, weights, fallback);
+  }
+  return FitRun<45>(model_, evaluator_, anatomy_, limits_, config_, options_)
+      .InitFromKeypoints3d(keypoints, weights, fallback);
+}
+
+HandFitResult CeresHandFitter::Fit(const HandFitInput& input,
+                                   const HandParams& init) const {
+  if (evaluator_.pose_dim() == 12) {
+    return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
+        .Fit(input, init);
+  }
+  return FitRun<45>(model_, evaluator_, anatomy_, limits_, config_, options_)
+      .Fit(input, init);
+}
+
+}  // namespace handlabel

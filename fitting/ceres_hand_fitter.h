@@ -1,0 +1,158 @@
+#pragma once
+// Fits the hand model to multi-view evidence with Ceres: 2D keypoints (with
+// confidences, robust loss, lens distortion), silhouettes, anatomical joint limits,
+// pose and shape priors, optional 3D targets (the network's keypoints/vertices) and an
+// optional pull towards the previous frame. Staged solve:
+//   1. rigid     global_orient + transl on the keypoints (pose and shape held)
+//   2. keypoints everything on keypoints + limits + priors (+ 3D targets, temporal)
+//   3. silhouette everything, with the silhouette term added; outline samples are
+//                re-matched to the nearest projected vertex before each round.
+// Initialisations: InitFromKeypoints3d (e.g. the network's), InitFromViews (the
+// paper's "Multi-view Fit." baseline: robust triangulation of the 2D keypoints, then an
+// IK-style alignment), or the previous frame's parameters.
+//
+// Parameters are MANO's: global_orient (axis-angle, optimised on SO(3) through
+// AxisAngleManifold), hand_pose (45 axis-angle values, or pose_pca_comps PCA
+// coefficients), the first 10 betas, transl. Units: metres, radians, pixels.
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/distance_transform.h"
+#include "core/hand_anatomy.h"
+#include "core/hand_evaluator.h"
+#include "core/hand_lbs.h"
+#include "core/hand_model.h"
+#include "core/rasterizer.h"
+#include "fitting/keypoint_view.h"
+#include "fitting/points3d_cost.h"
+#include "fitting/robust_loss.h"
+
+namespace handlabel {
+
+// What is optimised and which terms are used (separate from how: HandFitOptions).
+struct HandFitConfig {
+  // 0: hand_pose is 45 axis-angle values; 12 or 45: that many PCA coefficients of the
+  // model's pose basis (the model needs pose_pca_basis). Other values: InputError.
+  int pose_pca_comps = 0;
+  bool optimise_shape = true;    // false: betas stay at their initial values
+  bool use_keypoints = true;     // 2D keypoint reprojection (needs views)
+  bool use_silhouettes = true;   // only where masks are given
+  bool use_joint_limits = true;  // anatomical hinge limits
+  bool use_pose_prior = true;
+  bool use_shape_prior = true;
+  bool use_points3d = true;  // only if HandFitInput::targets3d is set
+  bool use_temporal = true;  // only if HandFitInput::previous is set
+  void Check() const;
+};
+
+// How to optimise; every weight is expressed as the standard deviation that one unit
+// of residual stands for.
+struct HandFitOptions {
+  // Keypoint reprojection: error scale (pixels) and per-keypoint robust loss (its
+  // scale in units of keypoint_sigma_px). Huber at 3 sigma keeps noisy detections
+  // near least squares and caps outliers' pull.
+  double keypoint_sigma_px = 1.0;
+  RobustLoss keypoint_loss{RobustLossType::kHuber, 3.0};
+  // Joint limits: one residual unit per limit_sigma_deg of violation.
+  double limit_sigma_deg = 1.0;
+  // Pose prior: distance of the 45 axis-angle values to the model's pose_mean, per
+  // value (radians). Weak: it only breaks ties the evidence leaves open.
+  double pose_prior_sigma_rad = 1.0;
+  // Shape prior on betas (unit variance by construction).
+  double shape_prior_sigma = 1.0;
+  // 3D targets: metres per residual unit.
+  double points3d_sigma_m = 0.002;
+  // Temporal pull towards HandFitInput::previous (pose: radians, transl: metres).
+  double temporal_pose_sigma_rad = 0.2;
+  double temporal_transl_sigma_m = 0.02;
+  // Silhouettes: pixels per residual unit; vertices used (every n-th); outline
+  // samples per view (evenly spaced along the mask outline); match-and-solve rounds.
+  double silhouette_sigma_px = 2.0;
+  int silhouette_vertex_stride = 2;
+  int silhouette_outline_samples = 120;
+  int silhouette_rounds = 3;
+  // Outline samples match only vertices whose normal makes |cos| below this with the
+  // viewing ray (contour generators).
+  double silhouette_contour_cosine = 0.6;
+  // Ceres iterations per stage (silhouette: per round).
+  int rigid_iterations = 20;
+  int keypoint_iterations = 60;
+  int silhouette_iterations = 10;
+  // Ceres convergence tolerances.
+  double function_tolerance = 1e-8;
+  double parameter_tolerance = 1e-10;
+  // Threads Ceres may use inside one frame (frames run in parallel elsewhere).
+  int num_threads = 1;
+  // Triangulation of the baseline initialisation.
+  double triangulation_inlier_px = 10.0;
+  // Distance from the first camera used when fewer than 3 palm keypoints triangulate.
+  double fallback_depth_m = 0.6;
+  // Throws InputError naming the field.
+  void Check() const;
+};
+
+struct HandFitInput {
+  std::vector<KeypointView> views;  // 2D keypoints per view (may be empty)
+  // Per view: silhouette mask (rows = image height), or empty = none for that view.
+  // Empty vector = no silhouettes. Cameras come from `views`.
+  std::vector<MaskImage> masks;
+  std::optional<Points3dTargets> targets3d;
+  std::optional<HandParams> previous;
+  // Optional per-view pixel rays of the cameras (core/rasterizer.h), for the IoU of
+  // the result; computed per call when absent (costly: cache them per rig).
+  const std::vector<PixelRays>* pixel_rays = nullptr;
+};
+
+struct HandFitResult {
+  HandParams params;
+  Points3d vertices;   // V x 3, world frame
+  Points3d keypoints;  // 21 x 3, SNAP order
+  // Final cost (0.5 sum of squared residuals) per term: "keypoints", "silhouette",
+  // "joint_limits", "pose_prior", "shape_prior", "points3d", "temporal".
+  std::map<std::string, double> term_costs;
+  // Per view: RMS pixel distance of the detected keypoints (confidence > 0) to the
+  // fitted keypoints' projections (NaN without detections); silhouette IoU of the
+  // fitted mesh and the mask (NaN without a mask).
+  std::vector<double> view_rms_px;
+  std::vector<double> view_iou;
+  int iterations = 0;  // Ceres iterations over all stages
+  double seconds = 0.0;
+  bool converged = false;  // the last stage met a Ceres convergence tolerance
+  std::string message;     // Ceres' message of the last stage
+};
+
+class CeresHandFitter {
+ public:
+  // Throws InputError if the options, config or model do not fit together.
+  CeresHandFitter(const HandModel& model, const HandFitConfig& config = {},
+                  const HandFitOptions& options = {});
+
+  const HandEvaluator& evaluator() const { return evaluator_; }
+  const HandFitConfig& config() const { return config_; }
+  const HandFitOptions& options() const { return options_; }
+
+  // IK-style alignment to 3D keypoints (SNAP order; weight 0 = unknown): rigid
+  // alignment of the palm keypoints, then pose and shape on the 3D keypoints with the
+  // limits and priors.
+  HandParams InitFromKeypoints3d(const Points3d& keypoints,
+                                 const Eigen::VectorXd& weights) const;
+  // The baseline's start: each keypoint triangulated robustly over the views
+  // (core/triangulation.h), then InitFromKeypoints3d.
+  HandParams InitFromViews(const std::vector<KeypointView>& views) const;
+
+  // Staged solve from `init`.
+  HandFitResult Fit(const HandFitInput& input, const HandParams& init) const;
+
+ private:
+  HandModel model_;
+  HandFitConfig config_;
+  HandFitOptions options_;
+  HandEvaluator evaluator_;
+  HandAnatomy anatomy_;
+  HandLimits limits_;
+};
+
+}  // namespace handlabel

@@ -1,0 +1,125 @@
+#include "calib/board_calib.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iomanip>
+
+#include "calib/rig_compare.h"
+#include "calib/synthetic_board_capture.h"
+#include "core/errors.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+const BoardSpec kBoard = ParseBoardSpec("charuco:7x5:0.04:0.03");
+// More corners per view pin the principal point (and with it the rotations) down.
+const BoardSpec kDenseBoard = ParseBoardSpec("charuco:11x8:0.03:0.022");
+
+TEST(BoardCalib, DexYcbLikeRigFromNoisyCornersMeetsTheAccuracyTargets) {
+  SyntheticBoardCaptureOptions options;  // 8 cameras, 640x480, 0.3 px noise
+  options.seed = testing::TestSeed();
+  options.num_frames = 40;
+  options.near_frames_per_camera = 16;
+  const SyntheticBoardCapture capture = SynthesizeBoardCapture(kDenseBoard, options);
+  const BoardCalibResult result = CalibrateBoardRig(capture.views, kDenseBoard);
+  const RigDifference d = CompareRigs(result.rig, capture.rig);
+  std::cout << RigDifferenceTable(d) << "rms " << result.rms_px << " px\n";
+  EXPECT_LT(d.worst.focal_rel, 0.005);
+  EXPECT_LT(d.worst.principal_px, 2.0);
+  EXPECT_LT(d.worst.rotation_deg, 0.1);
+  EXPECT_LT(d.worst.centre_m, 0.002);
+  EXPECT_NEAR(result.rms_px, 0.3 * std::sqrt(2.0), 0.05);  // noise-limited
+  EXPECT_EQ(result.world, "camera:cam0");
+  ASSERT_EQ(result.stats.size(), 8u);
+  for (const CameraCalibStats& s : result.stats) EXPECT_GT(s.observations, 100) << s.name;
+}
+
+TEST(BoardCalib, RejectsGrossOutliers) {
+  SyntheticBoardCaptureOptions options;
+  options.seed = testing::TestSeed();
+  options.num_cameras = 4;
+  SyntheticBoardCapture capture = SynthesizeBoardCapture(kBoard, options);
+  int corrupted = 0;
+  for (CameraBoardViews& v : capture.views) {
+    for (auto& [key, obs] : v.frames) {
+      if (obs.size() > 10 && corrupted < 40) {
+        obs.pixels[3] +=
+            Eigen::Vector2d(testing::Uniform(8, 30), testing::Uniform(-30, 30));
+        ++corrupted;
+      }
+    }
+  }
+  const BoardCalibResult result = CalibrateBoardRig(capture.views, kBoard);
+  int outliers = 0;
+  for (const CameraCalibStats& s : result.stats) outliers += s.outliers;
+  EXPECT_GE(outliers, corrupted);
+  EXPECT_LT(outliers, corrupted + 15);
+  // Only 4 cameras and the small board: the outliers must not hurt, the accuracy is
+  // what this data allows.
+  const RigDifference d = CompareRigs(result.rig, capture.rig);
+  EXPECT_LT(d.worst.rotation_deg, 0.5);
+  EXPECT_LT(d.worst.centre_m, 0.005);
+}
+
+TEST(BoardCalib, WorldCanBeTheBoard) {
+  SyntheticBoardCaptureOptions options;
+  options.seed = testing::TestSeed();
+  options.num_cameras = 3;
+  options.corner_noise_px = 0;  // exact data: the frame bookkeeping must be exact too
+  const SyntheticBoardCapture capture = SynthesizeBoardCapture(kBoard, options);
+  BoardCalibOptions calib;
+  calib.world = "board";
+  const BoardCalibResult result = CalibrateBoardRig(capture.views, kBoard, calib);
+  const std::string key = capture.views[0].frames.begin()->first;
+  EXPECT_EQ(result.world, "board:" + key);
+  EXPECT_THAT(result.world_from_board.at(key),
+              testing::Rigid3Near(Rigid3(), 1e-12, 1e-12));
+  // Cameras relative to that board pose match the truth.
+  for (size_t c = 0; c < 3; ++c) {
+    const Rigid3 truth = capture.rig[c].cam_from_world * capture.world_from_board.at(key);
+    EXPECT_THAT(result.rig[c].cam_from_world, testing::Rigid3Near(truth, 1e-7, 1e-7));
+  }
+}
+
+TEST(BoardCalib, UnlinkedCamerasAreNamed) {
+  SyntheticBoardCaptureOptions options;
+  options.seed = testing::TestSeed();
+  options.num_cameras = 4;
+  SyntheticBoardCapture capture = SynthesizeBoardCapture(kBoard, options);
+  // cam2 and cam3 only see frames nobody else sees.
+  for (int c = 2; c < 4; ++c) {
+    std::map<std::string, BoardObservation> renamed;
+    for (auto& [key, obs] : capture.views[c].frames) renamed["other_" + key] = obs;
+    capture.views[c].frames = renamed;
+  }
+  try {
+    CalibrateBoardRig(capture.views, kBoard);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("[cam2, cam3] cannot be linked to [cam0, cam1]"), std::string::npos)
+        << m;
+  }
+}
+
+TEST(BoardCalib, CamerasWithTooFewDetectionsAreNamed) {
+  SyntheticBoardCaptureOptions options;
+  options.seed = testing::TestSeed();
+  options.num_cameras = 2;
+  SyntheticBoardCapture capture = SynthesizeBoardCapture(kBoard, options);
+  capture.views[1].frames.clear();
+  try {
+    CalibrateBoardRig(capture.views, kBoard);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera cam1"), std::string::npos) << e.what();
+  }
+  BoardCalibOptions bad;
+  bad.master = "nope";
+  EXPECT_THROW(CalibrateBoardRig(capture.views, kBoard, bad), InputError);
+}
+
+}  // namespace
+}  // namespace handlabel
