@@ -274,7 +274,7 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
     scene.lighting.lights.push_back(light);
   }
 
-  // Objects: the first one in the hand (in front of the palm, or between thumb and
+  // Objects: the first one in the hand (in front of the palm, or at the thumb and
   // index tips for pinches), the others nearby.
   if (o.objects) {
     const int count = 1 + static_cast<int>(Uniform(rng, 0, o.max_objects));
@@ -290,8 +290,10 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
     for (int i = 0; i < count; ++i) {
       Eigen::Vector3d anchor, away;
       if (i == 0 && scene.pose_kind == "pinch") {
+        // Held at the pinching tips, on the side away from the palm (not swallowing
+        // the fingertips).
         anchor = 0.5 * (k.row(4) + k.row(8)).transpose();
-        away = Eigen::Vector3d::Zero();
+        away = (anchor - palm_centre).normalized();
       } else if (i == 0) {
         anchor = palm_centre + 0.01 * palm_normal;
         away = palm_normal;

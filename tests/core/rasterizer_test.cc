@@ -271,3 +271,60 @@ TEST(Rasterizer, BackgroundPixelsAreLeftAlone) {
 
 }  // namespace
 }  // namespace handlabel
+
+namespace handlabel {
+namespace {
+
+TEST(Rasterizer, TexturesAreSampledAtThePerspectiveCorrectUv) {
+  // An 8x8 texture of four coloured quadrants on a tilted plane: each pixel's colour
+  // must be the quadrant's at the uv of the point its ray hits (computed independently
+  // by ray-plane intersection).
+  const Camera camera = Camera::Pinhole(120, 120, 40, 30, 80, 60);
+  const PixelRays rays(camera);
+  RenderMesh plane = MakePlane(Eigen::Vector2d(1.0, 1.0), 1, 1);  // two triangles
+  auto tex = std::make_shared<ImageU8>(8, 8, 3);
+  const uint8_t colours[4][3] = {{200, 0, 0}, {0, 200, 0}, {0, 0, 200}, {200, 200, 0}};
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) tex->at(x, y, c) = colours[x / 4 + 2 * (y / 4)][c];
+  plane.texture = tex;
+  plane.color = Eigen::Vector3f::Ones();
+  const Rigid3 world_from_plane(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY())),
+      Eigen::Vector3d(0, 0, 1.2));
+  TransformMesh(world_from_plane, &plane);
+  VisibilityBuffer buffer;
+  buffer.Reset(80, 60);
+  RasterizeMesh(plane, 0, Rigid3(), rays, &buffer);
+  ShadingOptions flat;
+  flat.ambient = Eigen::Vector3f::Ones();  // colour = albedo
+  flat.lights.clear();
+  ImageU8 rgb(80, 60, 3);
+  ShadeVisible({&plane}, buffer, Rigid3(), rays, flat, &rgb);
+  const Rigid3 plane_from_world = world_from_plane.Inverse();
+  int checked = 0;
+  for (int y = 0; y < 60; ++y) {
+    for (int x = 0; x < 80; ++x) {
+      if (buffer.mesh_id[buffer.index(x, y)] != 0) continue;
+      // Hit point in plane coordinates -> uv in [0, 1].
+      const Eigen::Vector3d d = camera.Unproject(Eigen::Vector2d(x, y));
+      const Eigen::Vector3d o = plane_from_world.translation;
+      const Eigen::Vector3d dp = plane_from_world.rotation * d;
+      const Eigen::Vector3d hit = o - (o.z() / dp.z()) * dp;
+      const double u = hit.x() + 0.5, v = hit.y() + 0.5;
+      // Bilinear filtering blends within half a texel (1/16) of a quadrant border
+      // (the texture wraps, so also at 0 and 1); skip those.
+      auto inside = [](double t) {
+        return (t > 0.07 && t < 0.43) || (t > 0.57 && t < 0.93);
+      };
+      if (!inside(u) || !inside(v)) continue;
+      const int texel = (u > 0.5 ? 1 : 0) + 2 * (v > 0.5 ? 1 : 0);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(rgb.at(x, y, c), colours[texel][c], 1);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 50);
+}
+
+}  // namespace
+}  // namespace handlabel
