@@ -35,7 +35,7 @@ std::string CeresLabelFitter::Describe() const {
 
 LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
   const FrameInput& frame = *request.frame;
-  FitInput input;
+  HandFitInput input;
   for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
     if (!request.keypoints_2d[v]) continue;
     KeypointView view;
@@ -72,7 +72,7 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
   } else {
     init = fitter_.InitFromViews(input.views);
   }
-  const FitResult fit = fitter_.Fit(input, init);
+  const HandFitResult fit = fitter_.Fit(input, init);
 
   LabelFit out;
   out.params = fit.params;

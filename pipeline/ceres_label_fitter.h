@@ -12,7 +12,7 @@
 #include <string>
 
 #include "core/hand_model.h"
-#include "fitting/hand_fitter.h"
+#include "fitting/ceres_hand_fitter.h"
 #include "pipeline/label_stages.h"
 
 namespace handlabel {
@@ -26,7 +26,7 @@ class CeresLabelFitter : public LabelFitter {
   std::string Describe() const override;
 
  private:
-  HandFitter fitter_;
+  CeresHandFitter fitter_;
   int num_vertices_;
   bool use_masks_;
 };
