@@ -7,8 +7,11 @@
 #include "apps/commands.h"
 #include "calib/board_calib_report.h"
 #include "calib/board_images.h"
+#include "calib/colmap_sfm.h"
 #include "calib/rig_io.h"
 #include "calib/rig_plot.h"
+#include "calib/synthetic_board_capture.h"
+#include "core/errors.h"
 
 namespace handlabel {
 namespace {
@@ -87,9 +90,116 @@ int RunCalibBoard(int argc, char** argv) {
   });
 }
 
+int RunCalibRenderBoard(int argc, char** argv) {
+  CLI::App app(
+      "Render a synthetic board capture on a DexYCB-like rig (cameras on a ring around "
+      "a\n"
+      "table, 640x480), to try `calib board` without a rig. Writes OUT/images/<camera>/\n"
+      "<frame>.png and the true rig OUT/truth.json.\n"
+      "Example: handlabel calib render-board --out synthetic_capture",
+      "calib render-board");
+  std::string out, board_text = "charuco:11x8:0.03:0.022";
+  SyntheticBoardCaptureOptions options;
+  options.num_frames = 40;  // the configuration of the accuracy table in docs/cameras.md
+  options.near_frames_per_camera = 16;
+  BoardRenderOptions render;
+  app.add_option("--out", out, "output folder (created)")->required();
+  app.add_option("--board", board_text, "board spec")->capture_default_str();
+  app.add_option("--cameras", options.num_cameras, "number of cameras")
+      ->capture_default_str();
+  app.add_option("--frames", options.num_frames, "board poses on the table")
+      ->capture_default_str();
+  app.add_option("--near-frames", options.near_frames_per_camera,
+                 "board poses held in front of each camera")
+      ->capture_default_str();
+  app.add_option("--noise", render.noise_sigma, "pixel noise, grey levels")
+      ->capture_default_str();
+  app.add_option("--seed", options.seed, "random seed")->capture_default_str();
+  if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
+  return RunReportingErrors("calib render-board", [&] {
+    namespace fs = std::filesystem;
+    const BoardSpec board = ParseBoardSpec(board_text, "--board");
+    const SyntheticBoardCapture capture = SynthesizeBoardCapture(board, options);
+    const int n = RenderBoardCapture(capture, board, (fs::path(out) / "images").string(),
+                                     render, options.seed);
+    RigFileInfo info;
+    info.world = "table (synthetic truth)";
+    WriteRig(capture.rig, {"json", (fs::path(out) / "truth.json").string()}, info);
+    std::cout << "wrote " << n << " images to " << out << "/images and the true rig to "
+              << out << "/truth.json\n";
+    return 0;
+  });
+}
+
+int RunCalibColmap(int argc, char** argv) {
+  CLI::App app(
+      "Calibrate a static rig by structure from motion with the colmap binary (CPU):\n"
+      "feature_extractor (one camera per folder), exhaustive_matcher, mapper. Needs one\n"
+      "image per camera of a static, well-textured scene: IMAGES/<camera>/<image>.\n"
+      "Scale comes from --scale CAM_A,CAM_B,METRES (the distance of two camera "
+      "centres).\n"
+      "Writes OUT/rig.json, OUT/colmap/ (rig as a text model), OUT/rig.png; COLMAP's "
+      "own\n"
+      "database, logs and model stay in OUT/colmap_work.\n"
+      "Example: handlabel calib colmap --images scene/ --scale cam0,cam1,0.412 --out "
+      "sfm_out",
+      "calib colmap");
+  std::string images, out = "sfm_out", model = "OPENCV", scale;
+  ColmapSfmOptions options;
+  app.add_option("--images", images, "folder with one sub-folder of images per camera")
+      ->required();
+  app.add_option("--out", out, "output folder (created)")->capture_default_str();
+  app.add_option("--model", model, "COLMAP camera model for every camera")
+      ->capture_default_str();
+  app.add_option("--scale", scale,
+                 "CAM_A,CAM_B,METRES: known distance between two camera centres");
+  app.add_option("--master", options.master, "world = this camera (default: the first)");
+  app.add_option("--colmap", options.colmap, "the colmap binary")->capture_default_str();
+  app.add_option("--threads", options.num_threads, "threads for COLMAP")
+      ->capture_default_str();
+  if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
+  return RunReportingErrors("calib colmap", [&] {
+    namespace fs = std::filesystem;
+    options.model = CameraModelFromName(model, "--model");
+    options.work_dir = (fs::path(out) / "colmap_work").string();
+    if (!scale.empty()) {
+      const size_t c1 = scale.find(','), c2 = scale.rfind(',');
+      try {
+        if (c1 == std::string::npos || c1 == c2) throw std::invalid_argument(scale);
+        options.camera_a = scale.substr(0, c1);
+        options.camera_b = scale.substr(c1 + 1, c2 - c1 - 1);
+        options.distance_m = std::stod(scale.substr(c2 + 1));
+      } catch (const std::exception&) {
+        throw InputError("--scale", "CAM_A,CAM_B,METRES", "e.g. cam0,cam1,0.412",
+                         "'" + scale + "'");
+      }
+    }
+    std::cout << "running colmap on " << images << "\n";
+    const ColmapSfmResult result = CalibrateWithColmap(images, options, &std::cout);
+    fs::create_directories(out);
+    RigFileInfo info;
+    info.world = "camera:" + result.rig[0].name;
+    if (!options.master.empty()) info.world = "camera:" + options.master;
+    if (options.camera_a.empty()) info.world += " (COLMAP units, scale unknown)";
+    WriteRig(result.rig, {"json", (fs::path(out) / "rig.json").string()}, info);
+    WriteRig(result.rig, {"colmap-text", (fs::path(out) / "colmap").string()}, info);
+    RigPlotOptions plot;
+    plot.title = "COLMAP rig, world " + info.world;
+    PlotRig(result.rig, (fs::path(out) / "rig.png").string(), plot);
+    std::cout << result.registered << " of " << result.images
+              << " images registered; scale " << result.scale << " m per COLMAP unit\n"
+              << RigTable(result.rig) << "wrote " << out
+              << "/{rig.json, colmap/, rig.png}\n";
+    return 0;
+  });
+}
+
 void PrintCalibUsage(std::ostream& out) {
-  out << "Usage: handlabel calib <board|colmap> [options]\n"
+  out << "Usage: handlabel calib <board|render-board|colmap> [options]\n"
          "  board   --images DIR --board SPEC [--out DIR]   calibrate from board images\n"
+         "  render-board --out DIR                         synthetic board images to try "
+         "it\n"
+         "  colmap  --images DIR [--scale A,B,METRES]      calibrate by SfM with colmap\n"
          "Run 'handlabel calib <board|colmap> --help' for the options. Guide: "
          "docs/cameras.md\n";
 }
@@ -107,6 +217,8 @@ int RunCalib(int argc, char** argv) {
     return 0;
   }
   if (sub == "board") return RunCalibBoard(argc - 1, argv + 1);
+  if (sub == "render-board") return RunCalibRenderBoard(argc - 1, argv + 1);
+  if (sub == "colmap") return RunCalibColmap(argc - 1, argv + 1);
   std::cerr << "handlabel calib: unknown subcommand '" << sub << "'\n";
   PrintCalibUsage(std::cerr);
   return 2;

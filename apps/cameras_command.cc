@@ -3,6 +3,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "calib/rig_compare.h"
 #include "calib/rig_io.h"
 #include "calib/rig_plot.h"
 
@@ -75,14 +76,40 @@ int RunCamerasShow(int argc, char** argv) {
   });
 }
 
+int RunCamerasCompare(int argc, char** argv) {
+  CLI::App app(
+      "Compare two rigs camera by camera (e.g. a calibration against ground truth): "
+      "focal\n"
+      "length, principal point, rotation and camera centre. Both rigs are re-expressed "
+      "with\n"
+      "the world at the same reference camera first.\n"
+      "Example: handlabel cameras compare json:calib_out/rig.json json:truth.json",
+      "cameras compare");
+  std::string a, b, reference;
+  app.add_option("rig", a, "rig to check, FORMAT:PATH")->required();
+  app.add_option("reference_rig", b, "reference rig (e.g. ground truth), FORMAT:PATH")
+      ->required();
+  app.add_option("--camera", reference,
+                 "reference camera (default: the first of the reference rig)");
+  if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
+  return RunReportingErrors("cameras compare", [&] {
+    const Rig rig_a = ReadRig(ParseRigSpec(a, "rig"));
+    const Rig rig_b = ReadRig(ParseRigSpec(b, "reference_rig"));
+    std::cout << RigDifferenceTable(CompareRigs(rig_a, rig_b, reference));
+    return 0;
+  });
+}
+
 void PrintCamerasUsage(std::ostream& out) {
-  out << "Usage: handlabel cameras <convert|show> [options]\n"
+  out << "Usage: handlabel cameras <convert|show|compare> [options]\n"
          "  convert  --from FORMAT:PATH --to FORMAT:PATH   convert a rig between "
          "formats\n"
          "  show     FORMAT:PATH [--plot PNG]             table and picture of a rig\n"
+         "  compare  FORMAT:PATH FORMAT:PATH              per-camera differences of two "
+         "rigs\n"
          "Formats: "
       << FormatList(ReadableRigFormats())
-      << "\nRun 'handlabel cameras <convert|show> --help' for the options. "
+      << "\nRun 'handlabel cameras <convert|show|compare> --help' for the options. "
          "Guide: docs/cameras.md\n";
 }
 
@@ -100,6 +127,7 @@ int RunCameras(int argc, char** argv) {
   }
   if (sub == "convert") return RunCamerasConvert(argc - 1, argv + 1);
   if (sub == "show") return RunCamerasShow(argc - 1, argv + 1);
+  if (sub == "compare") return RunCamerasCompare(argc - 1, argv + 1);
   std::cerr << "handlabel cameras: unknown subcommand '" << sub << "'\n";
   PrintCamerasUsage(std::cerr);
   return 2;

@@ -9,6 +9,7 @@
 #include "apps/commands.h"
 #include "core/errors.h"
 #include "core/hand_model_io.h"
+#include "core/image.h"
 #include "pipeline/hand_preview.h"
 #include "pipeline/mesh_checks.h"
 #include "pipeline/open_hand_builder.h"
@@ -106,7 +107,7 @@ int RunModelRender(int argc, char** argv) {
                          name);
     }
     if (chosen.empty()) chosen = all;
-    WritePngRgb(out, RenderHandSheet(model, chosen, options));
+    WritePng(out, RenderHandSheet(model, chosen, options));
     std::cout << "wrote " << out << " (" << chosen.size() << " poses x "
               << options.views.size() << " views)\n";
     return 0;

@@ -1,14 +1,301 @@
 #include "calib/dataset_calib.h"
 
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
 #include "core/errors.h"
+#include "core/pickle_reader.h"
 
 namespace handlabel {
+namespace {
 
-std::vector<std::string> DatasetRigFormats() { return {}; }
+namespace fs = std::filesystem;
+
+YAML::Node LoadYaml(const fs::path& path) {
+  if (!fs::is_regular_file(path)) {
+    throw InputError(path.string(), "(file)", "an existing YAML file", "not found");
+  }
+  try {
+    return YAML::LoadFile(path.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string(), "(YAML syntax)", "valid YAML", e.what());
+  }
+}
+
+double YamlNumber(const YAML::Node& node, const std::string& path,
+                  const std::string& field) {
+  if (!node || !node.IsScalar()) throw InputError(path, field, "a number", "missing");
+  try {
+    return node.as<double>();
+  } catch (const YAML::Exception&) {
+    throw InputError(path, field, "a number", "'" + node.as<std::string>() + "'");
+  }
+}
+
+Rigid3 CamFromCommon(const std::vector<double>& v, const std::string& path,
+                     const std::string& field) {
+  Matrix3x4d m;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) m(r, c) = v[4 * r + c];
+  }
+  if (std::abs(m.leftCols<3>().determinant() - 1) > 1e-3) {
+    throw InputError(path, field, "a rotation (determinant 1) in the left 3x3",
+                     "determinant " + std::to_string(m.leftCols<3>().determinant()));
+  }
+  return Rigid3::FromMatrix(m).Inverse();
+}
+
+// ---------------------------------------------------------------------------- DexYCB
+
+Camera DexYcbIntrinsics(const fs::path& folder, const std::string& serial) {
+  // <serial>_<W>x<H>.yml; the size comes from the name.
+  const std::regex name(std::regex_replace(serial, std::regex("[^0-9A-Za-z]"), "") +
+                        "_([0-9]+)x([0-9]+)\\.yml");
+  if (fs::is_directory(folder)) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(folder)) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const fs::path& file : files) {
+      std::smatch m;
+      const std::string filename = file.filename().string();
+      if (!std::regex_match(filename, m, name)) continue;
+      const YAML::Node color = LoadYaml(file)["color"];
+      const std::string p = file.string();
+      if (!color) throw InputError(p, "color", "a map with fx, fy, ppx, ppy", "missing");
+      return Camera(
+          CameraModelId::kPinhole, std::stoi(m[1]), std::stoi(m[2]),
+          {YamlNumber(color["fx"], p, "color.fx"), YamlNumber(color["fy"], p, "color.fy"),
+           YamlNumber(color["ppx"], p, "color.ppx"),
+           YamlNumber(color["ppy"], p, "color.ppy")},
+          p);
+    }
+  }
+  throw InputError(folder.string(), serial + "_<W>x<H>.yml",
+                   "an intrinsics file for camera " + serial, "not found");
+}
+
+Rig ReadDexYcb(const fs::path& path, RigFileInfo* info) {
+  fs::path extrinsics_file = path;
+  std::vector<std::string> serials;  // from meta.yml, if given
+  if (path.filename() == "meta.yml") {
+    const YAML::Node meta = LoadYaml(path);
+    const std::string p = path.string();
+    if (!meta["extrinsics"])
+      throw InputError(p, "extrinsics", "a calibration id", "missing");
+    if (meta["serials"] && meta["serials"].IsSequence()) {
+      for (const YAML::Node& s : meta["serials"]) serials.push_back(s.as<std::string>());
+    }
+    // <root>/<subject>/<sequence>/meta.yml -> <root>/calibration/extrinsics_<id>/
+    const fs::path root = fs::absolute(path).parent_path().parent_path().parent_path();
+    extrinsics_file = root / "calibration" /
+                      ("extrinsics_" + meta["extrinsics"].as<std::string>()) /
+                      "extrinsics.yml";
+  } else if (fs::is_directory(path)) {
+    extrinsics_file = path / "extrinsics.yml";
+  }
+  const YAML::Node extr = LoadYaml(extrinsics_file);
+  const std::string p = extrinsics_file.string();
+  const YAML::Node map = extr["extrinsics"];
+  if (!map || !map.IsMap())
+    throw InputError(p, "extrinsics", "a map serial -> 12 numbers", "missing");
+  std::string master;
+  if (extr["master"]) master = extr["master"].as<std::string>();
+  if (serials.empty()) {
+    for (const auto& kv : map) serials.push_back(kv.first.as<std::string>());
+  }
+  const fs::path intrinsics_folder =
+      fs::absolute(extrinsics_file).parent_path().parent_path() / "intrinsics";
+  Rig rig;
+  for (const std::string& serial : serials) {
+    const YAML::Node values = map[serial];
+    const std::string field = "extrinsics." + serial;
+    if (!values || !values.IsSequence() || values.size() != 12) {
+      throw InputError(p, field, "12 numbers (3x4 camera -> common, row-major)",
+                       values ? std::to_string(values.size()) + " values" : "missing");
+    }
+    std::vector<double> v;
+    for (const YAML::Node& x : values) v.push_back(YamlNumber(x, p, field));
+    rig.Add({serial, DexYcbIntrinsics(intrinsics_folder, serial),
+             CamFromCommon(v, p, field)});
+  }
+  if (info) info->world = "DexYCB common frame (master camera " + master + ")";
+  return rig;
+}
+
+// ---------------------------------------------------------------------------- HO3D
+
+std::vector<double> ReadNumbers(const fs::path& path, char separator_to_space = ' ') {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string(), "(file)", "a readable text file", "not found");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  std::string text = buffer.str();
+  std::replace(text.begin(), text.end(), separator_to_space, ' ');
+  std::istringstream parse(text);
+  std::vector<double> out;
+  std::string token;
+  while (parse >> token) {
+    try {
+      size_t used = 0;
+      out.push_back(std::stod(token, &used));
+      if (used != token.size()) throw std::invalid_argument(token);
+    } catch (const std::exception&) {
+      throw InputError(path.string(), "(numbers)", "numbers", "'" + token + "'");
+    }
+  }
+  return out;
+}
+
+Camera Ho3dIntrinsics(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in)
+    throw InputError(path.string(), "(file)", "fx:..., fy:..., ppx:..., ppy:...",
+                     "not found");
+  std::string line;
+  std::getline(in, line);
+  double values[4];
+  const char* keys[4] = {"fx", "fy", "ppx", "ppy"};
+  for (int k = 0; k < 4; ++k) {
+    const std::regex re(std::string("(^|[ ,])") + keys[k] + "\\s*:\\s*([-+0-9.eE]+)");
+    std::smatch m;
+    if (!std::regex_search(line, m, re)) {
+      throw InputError(path.string(), keys[k], "fx:..., fy:..., ppx:..., ppy:...",
+                       "'" + line + "'");
+    }
+    values[k] = std::stod(m[2]);
+  }
+  return Camera(CameraModelId::kPinhole, 640, 480,
+                {values[0], values[1], values[2], values[3]}, path.string());
+}
+
+Rig ReadHo3d(const fs::path& folder, RigFileInfo* info) {
+  if (!fs::is_directory(folder)) {
+    throw InputError(folder.string(), "(folder)", "calibration/<SEQ>/calibration",
+                     "not a folder");
+  }
+  // calibration/<SEQ>/calibration: cameras are named <SEQ><i> like the image folders.
+  const fs::path abs = fs::absolute(folder).lexically_normal();
+  const fs::path dir = abs.filename().empty() ? abs.parent_path() : abs;
+  const std::string seq = dir.parent_path().filename().string();
+  std::vector<int> order;
+  if (fs::exists(dir / "cam_orders.txt")) {
+    for (double v : ReadNumbers(dir / "cam_orders.txt", ','))
+      order.push_back(static_cast<int>(v));
+  } else {
+    for (int i = 0; fs::exists(dir / ("trans_" + std::to_string(i) + ".txt")); ++i)
+      order.push_back(i);
+  }
+  if (order.empty()) {
+    throw InputError(dir.string(), "cam_orders.txt / trans_<i>.txt", "HO3D camera files",
+                     "none");
+  }
+  Rig rig;
+  for (int i : order) {
+    const fs::path trans = dir / ("trans_" + std::to_string(i) + ".txt");
+    const std::vector<double> v = ReadNumbers(trans);
+    if (v.size() != 16) {
+      throw InputError(trans.string(), "(matrix)", "16 numbers (4x4 camera -> common)",
+                       std::to_string(v.size()));
+    }
+    rig.Add({seq + std::to_string(i),
+             Ho3dIntrinsics(dir / ("cam_" + std::to_string(i) + "_intrinsics.txt")),
+             CamFromCommon(std::vector<double>(v.begin(), v.begin() + 12), trans.string(),
+                           "(matrix)")});
+  }
+  if (info) info->world = "HO3D common frame of sequence " + seq;
+  return rig;
+}
+
+// ---------------------------------------------------------------------------- OakInk
+
+std::vector<double> PickleMatrix(const PickleValue& root, const char* key, int rows,
+                                 int cols, const std::string& path) {
+  const PickleValue* v = root.Find(key);
+  if (!v) throw InputError(path, key, "an array", "missing");
+  if (v->kind != PickleValue::Kind::kArray ||
+      v->array->shape != std::vector<int64_t>{rows, cols}) {
+    throw InputError(path, key,
+                     "a " + std::to_string(rows) + "x" + std::to_string(cols) + " array",
+                     v->Describe());
+  }
+  return v->array->ToDoubles();
+}
+
+Rig ReadOakInk(const fs::path& path, RigFileInfo* info) {
+  // <seq>__<ts>__<sbj>__<frame>__<cam>.pkl: the group is everything before <cam>.
+  const auto split = [](const std::string& stem, std::string* group, std::string* cam) {
+    const size_t last = stem.rfind("__");
+    if (last == std::string::npos) return false;
+    *group = stem.substr(0, last);
+    *cam = stem.substr(last + 2);
+    return !cam->empty();
+  };
+  std::string group, cam;
+  fs::path folder = path;
+  if (fs::is_regular_file(path)) {
+    folder = path.parent_path();
+    if (!split(path.stem().string(), &group, &cam)) {
+      throw InputError(path.string(), "(file name)",
+                       "<seq>__<ts>__<sbj>__<frame>__<cam>.pkl",
+                       path.filename().string());
+    }
+  } else if (!fs::is_directory(path)) {
+    throw InputError(path.string(), "(path)", "an OakInk general_info folder or pickle",
+                     "not found");
+  }
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(folder.empty() ? "." : folder)) {
+    if (e.path().extension() == ".pkl") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  if (group.empty()) {  // a folder: the first frame in name order
+    for (const fs::path& f : files) {
+      if (split(f.stem().string(), &group, &cam)) break;
+    }
+  }
+  Rig rig;
+  for (const fs::path& f : files) {
+    std::string g, c;
+    if (!split(f.stem().string(), &g, &c) || g != group) continue;
+    const PickleValue root = ReadPickleFile(f.string());
+    if (root.kind != PickleValue::Kind::kDict) {
+      throw InputError(f.string(), "(pickle)", "a dict with cam_intr and cam_extr",
+                       root.Describe());
+    }
+    const std::vector<double> k = PickleMatrix(root, "cam_intr", 3, 3, f.string());
+    const std::vector<double> e = PickleMatrix(root, "cam_extr", 4, 4, f.string());
+    Matrix3x4d m;
+    for (int r = 0; r < 3; ++r) {
+      for (int col = 0; col < 4; ++col) m(r, col) = e[4 * r + col];
+    }
+    rig.Add(
+        {c,
+         Camera(CameraModelId::kPinhole, 848, 480, {k[0], k[4], k[2], k[5]}, f.string()),
+         Rigid3::FromMatrix(m)});
+  }
+  if (rig.empty()) {
+    throw InputError(path.string(), "(pickles)", "OakInk general_info pickles",
+                     "none found");
+  }
+  if (info) info->world = "OakInk world frame of " + group;
+  return rig;
+}
+
+}  // namespace
+
+std::vector<std::string> DatasetRigFormats() { return {"dexycb", "ho3d", "oakink"}; }
 
 Rig ReadDatasetRig(const std::string& format, const std::string& path,
                    RigFileInfo* info) {
-  throw InputError(path, "FORMAT", "a dataset format", "'" + format + "'");
+  if (format == "dexycb") return ReadDexYcb(path, info);
+  if (format == "ho3d") return ReadHo3d(path, info);
+  if (format == "oakink") return ReadOakInk(path, info);
+  throw InputError(path, "FORMAT", "dexycb, ho3d or oakink", "'" + format + "'");
 }
 
 }  // namespace handlabel

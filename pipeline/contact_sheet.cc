@@ -46,9 +46,18 @@ void DrawDot(ImageU8* img, double x, double y, int r, const uint8_t* c, bool fil
 
 }  // namespace
 
+void ContactSheetOptions::Check() const {
+  if (columns < 1)
+    throw InputError("contact sheet options", "columns", ">= 1", std::to_string(columns));
+  if (tile_width < 16 || tile_width > 4096) {
+    throw InputError("contact sheet options", "tile_width", "16..4096",
+                     std::to_string(tile_width));
+  }
+}
+
 ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
                          const ContactSheetOptions& o) {
-  HL_CHECK(o.columns >= 1 && o.tile_width >= 16, "bad contact sheet options");
+  o.Check();
   const int n = capture.num_cameras();
   // Tiles share the largest aspect ratio of the rig.
   double aspect = 0;

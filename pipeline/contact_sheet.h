@@ -18,6 +18,8 @@ struct ContactSheetOptions {
   bool crop_to_hand = false;
   bool keypoints = true;    // draw keypoints and skeleton
   bool detections = false;  // also draw simulated detections (crosses), if present
+  // Throws InputError naming the field.
+  void Check() const;
 };
 
 ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,

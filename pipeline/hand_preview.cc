@@ -90,13 +90,13 @@ Eigen::Vector3d JointColor(int joint) {
   return Eigen::Vector3d(kColors[joint][0], kColors[joint][1], kColors[joint][2]);
 }
 
-RgbImage RenderHandSheet(const HandModel& model, const std::vector<NamedHandPose>& poses,
-                         const HandPreviewOptions& options) {
+ImageU8 RenderHandSheet(const HandModel& model, const std::vector<NamedHandPose>& poses,
+                        const HandPreviewOptions& options) {
   options.Check();
   const int tile = options.tile_size;
   const int cols = static_cast<int>(options.views.size());
   const int rows = static_cast<int>(poses.size());
-  RgbImage sheet(cols * tile, std::max(rows, 1) * tile, 255);
+  ImageU8 sheet(cols * tile, std::max(rows, 1) * tile, 3, 255);
   std::vector<Eigen::Vector3d> colors;
   if (options.coloring == HandPreviewColoring::kSkinningWeights) {
     colors.assign(model.num_vertices(), Eigen::Vector3d::Zero());
@@ -129,8 +129,9 @@ RgbImage RenderHandSheet(const HandModel& model, const std::vector<NamedHandPose
       if (name == "tip") dir = Eigen::Vector3d(1, 0, 0), up = Eigen::Vector3d(0, 1, 0);
       dir.x() *= mirror;  // the left hand is the mirror image: mirror the camera too
       up.x() *= mirror;
-      RgbImage tile_image(tile, tile, 255);
-      RenderMesh(vertices, faces, colors, LookAlong(dir, up, centre, ppm), &tile_image);
+      ImageU8 tile_image(tile, tile, 3, 255);
+      DrawMeshOrthographic(vertices, faces, colors, LookAlong(dir, up, centre, ppm),
+                           &tile_image);
       Paste(tile_image, c * tile, r * tile, &sheet);
     }
   }

@@ -32,8 +32,8 @@ struct HandPreviewOptions {
 };
 
 // One row per pose; every tile uses the same scale so sizes compare.
-RgbImage RenderHandSheet(const HandModel& model, const std::vector<NamedHandPose>& poses,
-                         const HandPreviewOptions& options);
+ImageU8 RenderHandSheet(const HandModel& model, const std::vector<NamedHandPose>& poses,
+                        const HandPreviewOptions& options);
 
 // One colour per joint (16), for weight pictures.
 Eigen::Vector3d JointColor(int joint);

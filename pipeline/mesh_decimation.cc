@@ -19,6 +19,46 @@ struct DoubleTraits : public OpenMesh::DefaultTraits {
 };
 using OMesh = OpenMesh::TriMesh_ArrayKernelT<DoubleTraits>;
 
+double MinAngle(const OMesh::Point& a, const OMesh::Point& b, const OMesh::Point& c) {
+  auto angle = [](const OMesh::Point& p, const OMesh::Point& q, const OMesh::Point& r) {
+    const OMesh::Point u = (q - p).normalized(), v = (r - p).normalized();
+    return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
+  };
+  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
+// Flips edges between nearly coplanar triangles when that raises the smaller of their
+// minimum angles (towards a Delaunay triangulation); the shape barely changes.
+void ImproveByFlips(OMesh* om) {
+  const double kMaxDihedral = 20.0 * M_PI / 180.0;
+  for (int sweep = 0; sweep < 10; ++sweep) {
+    int flips = 0;
+    for (const auto eh : om->edges()) {
+      if (!om->is_flip_ok(eh)) continue;
+      const auto h0 = om->halfedge_handle(eh, 0), h1 = om->halfedge_handle(eh, 1);
+      const OMesh::Point a = om->point(om->to_vertex_handle(h0));
+      const OMesh::Point b = om->point(om->to_vertex_handle(h1));
+      const OMesh::Point c =
+          om->point(om->to_vertex_handle(om->next_halfedge_handle(h0)));
+      const OMesh::Point d =
+          om->point(om->to_vertex_handle(om->next_halfedge_handle(h1)));
+      // Faces (b, a, c) and (a, b, d) now; (c, d, a) and (d, c, b) after the flip.
+      const OMesh::Point n0 = (a - b).cross(c - b).normalized();
+      const OMesh::Point n1 = (b - a).cross(d - a).normalized();
+      if (std::acos(std::clamp(n0.dot(n1), -1.0, 1.0)) > kMaxDihedral) continue;
+      const OMesh::Point m0 = (d - c).cross(a - c), m1 = (c - d).cross(b - d);
+      if (m0.dot(n0) <= 0 || m1.dot(n0) <= 0) continue;  // would fold over
+      const double before = std::min(MinAngle(b, a, c), MinAngle(a, b, d));
+      const double after = std::min(MinAngle(c, d, a), MinAngle(d, c, b));
+      if (after > before + 1e-3) {
+        om->flip(eh);
+        ++flips;
+      }
+    }
+    if (flips == 0) break;
+  }
+}
+
 }  // namespace
 
 void DecimationOptions::Check() const {
@@ -70,6 +110,7 @@ TriangleMesh DecimateMesh(const TriangleMesh& mesh, const DecimationOptions& opt
   HL_CHECK(decimater.initialize(), "OpenMesh decimater did not initialise");
   decimater.decimate_to(static_cast<size_t>(options.target_vertices));
   om.garbage_collection();
+  if (options.improve_by_flips) ImproveByFlips(&om);
 
   TriangleMesh out;
   out.vertices.reserve(om.n_vertices());

@@ -12,6 +12,9 @@ struct DecimationOptions {
   int target_vertices = 778;               // stop at this many vertices (MANO has 778)
   double max_normal_deviation_deg = 45.0;  // forbid collapses that turn a face more
   double min_aspect_ratio = 0.0;           // 0: off; else forbid faces thinner than this
+  // Afterwards, flip edges between nearly coplanar faces (dihedral < 20 degrees) when
+  // that raises their minimum angle.
+  bool improve_by_flips = false;
   void Check() const;
 };
 

@@ -1,11 +1,8 @@
 #include "pipeline/mesh_render.h"
 
-#include <zlib.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <limits>
 
 #include "core/errors.h"
@@ -26,10 +23,10 @@ MeshView LookAlong(const Eigen::Vector3d& direction, const Eigen::Vector3d& up,
   return view;
 }
 
-void RenderMesh(const std::vector<Eigen::Vector3d>& vertices,
-                const std::vector<Eigen::Vector3i>& faces,
-                const std::vector<Eigen::Vector3d>& colors, const MeshView& view,
-                RgbImage* image) {
+void DrawMeshOrthographic(const std::vector<Eigen::Vector3d>& vertices,
+                          const std::vector<Eigen::Vector3i>& faces,
+                          const std::vector<Eigen::Vector3d>& colors,
+                          const MeshView& view, ImageU8* image) {
   HL_CHECK(colors.empty() || colors.size() == vertices.size(), "one colour per vertex");
   const int w = image->width, h = image->height;
   std::vector<double> depth(static_cast<size_t>(w) * h,
@@ -85,76 +82,23 @@ void RenderMesh(const std::vector<Eigen::Vector3d>& vertices,
         d = z;
         const Eigen::Vector3d rgb =
             l0 * shade[f[0]] + l1 * shade[f[1]] + l2 * shade[f[2]];
-        uint8_t* px = image->at(x, y);
         for (int k = 0; k < 3; ++k) {
-          px[k] = static_cast<uint8_t>(std::clamp(rgb[k], 0.0, 1.0) * 255.0 + 0.5);
+          image->at(x, y, k) =
+              static_cast<uint8_t>(std::clamp(rgb[k], 0.0, 1.0) * 255.0 + 0.5);
         }
       }
     }
   }
 }
 
-void Paste(const RgbImage& tile, int x0, int y0, RgbImage* sheet) {
+void Paste(const ImageU8& tile, int x0, int y0, ImageU8* sheet) {
   for (int y = 0; y < tile.height; ++y) {
     for (int x = 0; x < tile.width; ++x) {
       if (x0 + x < 0 || y0 + y < 0 || x0 + x >= sheet->width || y0 + y >= sheet->height)
         continue;
-      const uint8_t* src = &tile.data[3 * (static_cast<size_t>(y) * tile.width + x)];
-      std::copy(src, src + 3, sheet->at(x0 + x, y0 + y));
+      for (int k = 0; k < 3; ++k) sheet->at(x0 + x, y0 + y, k) = tile.at(x, y, k);
     }
   }
-}
-
-namespace {
-
-void AppendU32(uint32_t v, std::string* out) {
-  for (int s = 24; s >= 0; s -= 8) out->push_back(static_cast<char>((v >> s) & 0xff));
-}
-
-void AppendChunk(const char* type, const std::string& payload, std::string* out) {
-  AppendU32(static_cast<uint32_t>(payload.size()), out);
-  const std::string body = std::string(type, 4) + payload;
-  out->append(body);
-  AppendU32(static_cast<uint32_t>(
-                crc32(0, reinterpret_cast<const Bytef*>(body.data()), body.size())),
-            out);
-}
-
-}  // namespace
-
-std::string EncodePngRgb(const RgbImage& image) {
-  HL_CHECK(image.width > 0 && image.height > 0, "empty image");
-  std::string raw;
-  raw.reserve((3 * static_cast<size_t>(image.width) + 1) * image.height);
-  for (int y = 0; y < image.height; ++y) {
-    raw.push_back(0);  // filter: none
-    raw.append(reinterpret_cast<const char*>(
-                   &image.data[3 * static_cast<size_t>(y) * image.width]),
-               3 * static_cast<size_t>(image.width));
-  }
-  uLongf size = compressBound(raw.size());
-  std::string packed(size, '\0');
-  HL_CHECK(compress2(reinterpret_cast<Bytef*>(&packed[0]), &size,
-                     reinterpret_cast<const Bytef*>(raw.data()), raw.size(), 9) == Z_OK,
-           "zlib compress2 failed");
-  packed.resize(size);
-  std::string png("\x89PNG\r\n\x1a\n", 8);
-  std::string header;
-  AppendU32(static_cast<uint32_t>(image.width), &header);
-  AppendU32(static_cast<uint32_t>(image.height), &header);
-  header += std::string("\x08\x02\x00\x00\x00", 5);  // 8 bit, RGB, deflate, no interlace
-  AppendChunk("IHDR", header, &png);
-  AppendChunk("IDAT", packed, &png);
-  AppendChunk("IEND", "", &png);
-  return png;
-}
-
-void WritePngRgb(const std::string& path, const RgbImage& image) {
-  const std::string bytes = EncodePngRgb(image);
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw Error("cannot write " + path);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (!out) throw Error("cannot write " + path);
 }
 
 }  // namespace handlabel

@@ -1,23 +1,15 @@
 #pragma once
 // A small software rasteriser for pictures of meshes (docs, `handlabel model render`):
-// orthographic projection, z-buffer, Gouraud-shaded Lambert lighting with per-vertex
+// orthographic projection (core/rasterizer.h is the camera-model one for synthetic
+// captures), z-buffer, Gouraud-shaded Lambert lighting with per-vertex
 // colours. Deterministic: the same mesh and view give the same pixels.
 
 #include <Eigen/Core>
-#include <cstdint>
-#include <string>
 #include <vector>
 
-namespace handlabel {
+#include "core/image.h"
 
-struct RgbImage {
-  int width = 0;
-  int height = 0;
-  std::vector<uint8_t> data;  // row-major RGB, pixel (x, y) at 3 * (y * width + x)
-  RgbImage() = default;
-  RgbImage(int w, int h, uint8_t fill) : width(w), height(h), data(3 * w * h, fill) {}
-  uint8_t* at(int x, int y) { return &data[3 * (static_cast<size_t>(y) * width + x)]; }
-};
+namespace handlabel {
 
 struct MeshView {
   // Rows are the image axes in model coordinates: row 0 = image right, row 1 = image
@@ -30,10 +22,10 @@ struct MeshView {
 // Draws the mesh into `image` (on top of what is there). `colors` has one RGB (0..1)
 // per vertex, or is empty for a skin tone. Faces facing away are still drawn (the mesh
 // is closed, so the z-buffer hides them).
-void RenderMesh(const std::vector<Eigen::Vector3d>& vertices,
-                const std::vector<Eigen::Vector3i>& faces,
-                const std::vector<Eigen::Vector3d>& colors, const MeshView& view,
-                RgbImage* image);
+void DrawMeshOrthographic(const std::vector<Eigen::Vector3d>& vertices,
+                          const std::vector<Eigen::Vector3i>& faces,
+                          const std::vector<Eigen::Vector3d>& colors,
+                          const MeshView& view, ImageU8* image);
 
 // Looking along -y at the palm side or +y at the back etc.: a view whose image axes
 // are made from a viewing direction (model coordinates) and an image-up direction.
@@ -41,10 +33,6 @@ MeshView LookAlong(const Eigen::Vector3d& direction, const Eigen::Vector3d& up,
                    const Eigen::Vector3d& centre, double pixels_per_metre);
 
 // Copies `tile` into `sheet` with its top-left corner at (x0, y0).
-void Paste(const RgbImage& tile, int x0, int y0, RgbImage* sheet);
-
-// PNG (8-bit RGB, zlib level 9, no timestamps: the same image gives the same bytes).
-std::string EncodePngRgb(const RgbImage& image);
-void WritePngRgb(const std::string& path, const RgbImage& image);
+void Paste(const ImageU8& tile, int x0, int y0, ImageU8* sheet);
 
 }  // namespace handlabel

@@ -181,6 +181,7 @@ HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions
   report->fine_faces = static_cast<int>(fine.faces.size());
   DecimationOptions decimation;
   decimation.target_vertices = options.target_vertices;
+  decimation.improve_by_flips = true;
   TriangleMesh mesh = DecimateMesh(fine, decimation);
   RelaxWithoutIntersections(&mesh, options.relax_iterations, shape);
   const int nv = static_cast<int>(mesh.vertices.size());

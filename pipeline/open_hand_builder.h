@@ -1,8 +1,8 @@
 #pragma once
 // Builds the project's open hand model (a MANO-compatible HandModel) from a design:
 //   1. implicit surface of the design (open_hand_design.h), meshed by marching
-//      tetrahedra on a fine grid, decimated with OpenMesh to ~MANO's resolution and
-//      relaxed onto the surface for even triangles;
+//      tetrahedra on a fine grid, decimated with OpenMesh to ~MANO's resolution, edges
+//      flipped towards Delaunay, and relaxed onto the surface for even triangles;
 //   2. skinning weights from the skeleton (open_hand_skinning.h);
 //   3. a 10-component shape space by PCA of sampled designs (open_hand_shape_space.h);
 //   4. a sparse joint regressor: each joint is a convex combination of the vertices

@@ -20,7 +20,7 @@ Rig SmallRig() {
     const Eigen::Vector3d eye(std::sin(a), -0.3, -std::cos(a));
     rig.Add({"cam" + std::to_string(i),
              Camera(CameraModelId::kOpenCV, 640, 480,
-                    {500 + i, 501 + i, 320, 240, 0.01 * i, -0.002, 0.001, 0}),
+                    {500.0 + i, 501.0 + i, 320, 240, 0.01 * i, -0.002, 0.001, 0}),
              LookAt(eye, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, -1, 0))});
   }
   return rig;
