@@ -232,7 +232,7 @@ JobConfig LoadJobConfig(const std::string& path) {
 
   job.input_path = Resolve(job.input_path, base);
   job.cameras_file = Resolve(job.cameras_file, base);
-  job.hand_model = Resolve(job.hand_model, base);
+  if (job.hand_model != "capsule") job.hand_model = Resolve(job.hand_model, base);  // built-in
   job.network_weights = Resolve(job.network_weights, base);
   job.output_dir = Resolve(job.output_dir, base);
   job.Check();

@@ -42,7 +42,9 @@ struct JobConfig {
   std::string cameras_source = "capture";  // capture | file
   std::string cameras_file;
 
-  std::string hand_model;  // .npz / .pkl; empty = the shipped open hand
+  // .npz / .pkl, or "capsule" (the built-in capsule hand); empty = $HANDLABEL_HAND_MODEL,
+  // else the shipped open hand (pipeline/hand_model_source.h).
+  std::string hand_model;
 
   // network
   std::string network_weights;  // empty = no network: every frame is fitted

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <memory>
 #include <set>
+#include <sstream>
 
 #include "core/errors.h"
 #include "pipeline/atomic_file.h"

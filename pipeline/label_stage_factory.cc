@@ -5,6 +5,7 @@
 #include "pipeline/hand_model_source.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/native_frame_source.h"
+#include "pipeline/poem_mesh_predictor.h"
 
 namespace handlabel {
 
@@ -44,10 +45,8 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   }
   built.hand_model = ResolveHandModel(job.hand_model, side).model;
   if (!job.network_weights.empty()) {
-    throw InputError(job.source_file, "network.weights",
-                     "empty: this build has no network predictor yet (use refine.mode "
-                     "always with evidence.keypoints_2d files)",
-                     "'" + job.network_weights + "'");
+    built.predictor = std::make_unique<PoemMeshPredictor>(job.network_weights,
+                                                          job.batch_size, job.threads);
   }
   if (job.refine_mode != RefineMode::kOff || job.baseline) {
     HandFitOptions options;

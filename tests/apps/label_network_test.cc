@@ -1,0 +1,79 @@
+// End-to-end tests of every refine mode with the real stages: the POEM network (a tiny
+// configuration with random weights: the plumbing, not the accuracy, is under test),
+// the quality checks and the Ceres fitter, on a synthetic capture.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "network/hand_mesh_predictor.h"
+#include "network/poem_config.h"
+#include "pipeline/label_record.h"
+#include "pipeline/sha256.h"
+#include "tests/apps/label_test_capture.h"
+#include "tests/apps/run_command.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::RunHandlabelCommand;
+
+std::string NetworkJob(const std::string& dir, const std::string& mode) {
+  const std::string path = dir + "/" + mode + ".yaml";
+  std::ofstream(path) << "name: net\nseed: 3\nhand_model: capsule\n"
+                      << "input: {format: native, path: capture}\n"
+                      << "network: {weights: tiny.pt, threads: 2, batch_size: 2}\n"
+                      << "refine: {mode: " << mode << "}\n"
+                      << "evidence: {keypoints_2d: both, masks: none}\n"
+                      << "output: {dir: " << mode << ", overlays: false}\n";
+  return path;
+}
+
+class LabelNetwork : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = testing::ScratchDir();
+    testing::WriteTestCapture(dir_ + "/capture", 2, 9);
+    WriteRandomPoemCheckpoint(PoemConfigByName("tiny", 8), 4, dir_ + "/tiny.pt");
+  }
+  std::string dir_;
+};
+
+TEST_F(LabelNetwork, RefineOffLabelsEveryFrameWithTheNetworkAndItsQualityFlags) {
+  const auto r = RunHandlabelCommand({"label", "--job", NetworkJob(dir_, "off")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("2 labelled (network 2)"));
+  const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/off", "000000"));
+  EXPECT_EQ(label.path, LabelPath::kNetwork);
+  EXPECT_EQ(label.quality.flags.size(), 5u);
+  EXPECT_EQ(label.mesh.vertices.rows(), 778);
+  EXPECT_EQ(label.provenance.weights_sha256, Sha256OfFile(dir_ + "/tiny.pt"));
+  EXPECT_THAT(label.provenance.network_model, HasSubstr("poem"));
+  EXPECT_FALSE(label.params.has_value());
+}
+
+TEST_F(LabelNetwork, FallbackFitsWhereTheRandomNetworkFailsItsChecks) {
+  const auto r = RunHandlabelCommand({"label", "--job", NetworkJob(dir_, "fallback")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  // Random weights never pass the checks: every frame falls back to the fit.
+  EXPECT_THAT(r.err, HasSubstr("2 labelled (fallback_fit 2)"));
+  const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/fallback", "000001"));
+  EXPECT_FALSE(label.quality.Passed());
+  EXPECT_THAT(label.fit.at("why").get<std::string>(), HasSubstr("quality checks failed"));
+  EXPECT_THAT(r.err, HasSubstr("network_raw (2 frames)"));
+}
+
+TEST_F(LabelNetwork, AlwaysRefinesTheNetworkAnswer) {
+  const auto r = RunHandlabelCommand({"label", "--job", NetworkJob(dir_, "always")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("2 labelled (refined 2)"));
+  const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/always", "000000"));
+  EXPECT_EQ(label.fit.at("init"), "network");
+  ASSERT_TRUE(label.params.has_value());
+}
+
+}  // namespace
+}  // namespace handlabel
