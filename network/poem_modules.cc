@@ -1,0 +1,195 @@
+#include "network/poem_modules.h"
+
+#include "network/point_ops.h"
+
+#include <cmath>
+
+namespace handlabel {
+
+namespace F = torch::nn::functional;
+
+FrozenBatchNorm2dImpl::FrozenBatchNorm2dImpl(int64_t channels) {
+  weight = register_buffer("weight", torch::ones({channels}));
+  bias = register_buffer("bias", torch::zeros({channels}));
+  running_mean = register_buffer("running_mean", torch::zeros({channels}));
+  running_var = register_buffer("running_var", torch::ones({channels}));
+}
+
+torch::Tensor FrozenBatchNorm2dImpl::forward(const torch::Tensor& x) {
+  const torch::Tensor w = weight.reshape({1, -1, 1, 1});
+  const torch::Tensor b = bias.reshape({1, -1, 1, 1});
+  const torch::Tensor rv = running_var.reshape({1, -1, 1, 1});
+  const torch::Tensor rm = running_mean.reshape({1, -1, 1, 1});
+  const torch::Tensor scale = w * (rv + 1e-5).rsqrt();
+  const torch::Tensor shift = b - rm * scale;
+  return x * scale + shift;
+}
+
+namespace {
+
+torch::nn::AnyModule MakeNorm(int64_t channels, bool frozen) {
+  if (frozen) return torch::nn::AnyModule(FrozenBatchNorm2d(channels));
+  return torch::nn::AnyModule(torch::nn::BatchNorm2d(channels));
+}
+
+torch::nn::Conv2d Conv(int64_t in, int64_t out, int64_t kernel, int64_t stride,
+                       int64_t padding, bool bias) {
+  return torch::nn::Conv2d(torch::nn::Conv2dOptions(in, out, kernel)
+                               .stride(stride)
+                               .padding(padding)
+                               .bias(bias));
+}
+
+void KaimingFanOut(torch::nn::Conv2d& conv) {
+  torch::NoGradGuard no_grad;
+  torch::nn::init::kaiming_normal_(conv->weight, 0.0, torch::kFanOut, torch::kReLU);
+}
+
+}  // namespace
+
+BasicBlockImpl::BasicBlockImpl(int64_t inplanes, int64_t planes, int64_t stride,
+                               bool frozen_bn) {
+  conv1 = register_module("conv1", Conv(inplanes, planes, 3, stride, 1, false));
+  bn1 = MakeNorm(planes, frozen_bn);
+  register_module("bn1", bn1.ptr());
+  conv2 = register_module("conv2", Conv(planes, planes, 3, 1, 1, false));
+  bn2 = MakeNorm(planes, frozen_bn);
+  register_module("bn2", bn2.ptr());
+  if (stride != 1 || inplanes != planes) {
+    torch::nn::Sequential ds;
+    ds->push_back(Conv(inplanes, planes, 1, stride, 0, false));
+    ds->push_back(MakeNorm(planes, frozen_bn));
+    downsample = register_module("downsample", ds);
+  }
+  KaimingFanOut(conv1);
+  KaimingFanOut(conv2);
+}
+
+torch::Tensor BasicBlockImpl::forward(const torch::Tensor& x) {
+  torch::Tensor out = torch::relu(bn1.forward(conv1(x)));
+  out = bn2.forward(conv2(out));
+  const torch::Tensor residual = downsample ? downsample->forward(x) : x;
+  return torch::relu(out + residual);
+}
+
+ResNetImpl::ResNetImpl(const std::array<int, 4>& blocks, int width) {
+  conv1 = register_module("conv1", Conv(3, width, 7, 2, 3, false));
+  KaimingFanOut(conv1);
+  bn1 = register_module("bn1", FrozenBatchNorm2d(width));
+  int64_t inplanes = width;
+  for (int s = 0; s < 4; ++s) {
+    const int64_t planes = static_cast<int64_t>(width) << s;
+    torch::nn::Sequential layer;
+    for (int b = 0; b < blocks[s]; ++b) {
+      // Only the first block of each stage uses frozen batch norm (reference).
+      layer->push_back(BasicBlock(inplanes, planes, b == 0 && s > 0 ? 2 : 1, b == 0));
+      inplanes = planes;
+    }
+    layers[s] = register_module("layer" + std::to_string(s + 1), layer);
+  }
+  fc = register_module("fc", torch::nn::Linear(8 * width, 1000));
+}
+
+std::array<torch::Tensor, 4> ResNetImpl::forward(const torch::Tensor& image) {
+  torch::Tensor x = torch::relu(bn1(conv1(image)));
+  x = F::max_pool2d(x, F::MaxPool2dFuncOptions(3).stride(2).padding(1));
+  std::array<torch::Tensor, 4> out;
+  for (int s = 0; s < 4; ++s) {
+    x = layers[s]->forward(x);
+    out[s] = x;
+  }
+  return out;
+}
+
+ConvBlockImpl::ConvBlockImpl(int64_t in, int64_t out, int64_t kernel, bool use_norm,
+                             bool use_relu)
+    : relu(use_relu) {
+  conv = register_module("conv", Conv(in, out, kernel, 1, kernel / 2, true));
+  KaimingFanOut(conv);
+  if (use_norm) norm = register_module("norm", torch::nn::BatchNorm2d(out));
+}
+
+torch::Tensor ConvBlockImpl::forward(const torch::Tensor& x) {
+  torch::Tensor y = conv(x);
+  if (norm) y = norm(y);
+  return relu ? torch::relu(y) : y;
+}
+
+torch::nn::ModuleList MakeUDecoder(int width) {
+  const int c0 = 8 * width, c1 = 4 * width, c2 = 2 * width, c3 = width;
+  torch::nn::ModuleList list;
+  list->push_back(ConvBlock(c1 + c0, c1, 3, true, true));
+  list->push_back(ConvBlock(c2 + c1, c2, 3, true, true));
+  list->push_back(ConvBlock(c3 + c2, c3, 3, true, true));
+  return list;
+}
+
+torch::Tensor UDecode(torch::nn::ModuleList& delayer,
+                      const std::array<torch::Tensor, 4>& f) {
+  torch::Tensor x = f[3];
+  for (int i = 0; i < 3; ++i) {
+    x = F::interpolate(x, F::InterpolateFuncOptions()
+                              .scale_factor(std::vector<double>{2.0, 2.0})
+                              .mode(torch::kBilinear)
+                              .align_corners(false));
+    x = torch::cat({x, f[2 - i]}, 1);
+    x = delayer[i]->as<ConvBlock>()->forward(x);
+  }
+  return F::max_pool2d(x, F::MaxPool2dFuncOptions(2).stride(2));
+}
+
+torch::nn::Sequential Mlp(int64_t in, int64_t hidden, int64_t out) {
+  return torch::nn::Sequential(torch::nn::Linear(in, hidden), torch::nn::ReLU(),
+                               torch::nn::Linear(hidden, out));
+}
+
+VectorAttentionImpl::VectorAttentionImpl(int64_t d_points, int64_t d_model_in, bool cross)
+    : d_model(d_model_in) {
+  fc1 = register_module("fc1", torch::nn::Linear(d_points, d_model));
+  fc2 = register_module("fc2", torch::nn::Linear(d_model, d_points));
+  fc_delta = register_module("fc_delta", Mlp(3, d_model, d_model));
+  fc_gamma = register_module("fc_gamma", Mlp(d_model, d_model, d_model));
+  auto nobias = [](int64_t in, int64_t out) {
+    return torch::nn::Linear(torch::nn::LinearOptions(in, out).bias(false));
+  };
+  w_qs = register_module("w_qs", nobias(cross ? d_points : d_model, d_model));
+  w_ks = register_module("w_ks", nobias(d_model, d_model));
+  w_vs = register_module("w_vs", nobias(d_model, d_model));
+}
+
+torch::Tensor VectorAttentionImpl::Attend(const torch::Tensor& q, const torch::Tensor& k,
+                                          const torch::Tensor& v,
+                                          const torch::Tensor& rel_xyz) {
+  const torch::Tensor pos = fc_delta->forward(rel_xyz);              // (B, Q, k, d)
+  torch::Tensor attn = fc_gamma->forward(q.unsqueeze(2) - k + pos);  // (B, Q, k, d)
+  attn = torch::softmax(attn / std::sqrt(static_cast<double>(d_model)), -2);
+  return (attn * (v + pos)).sum(2);  // (B, Q, d)
+}
+
+torch::Tensor VectorAttentionImpl::SelfAttention(const torch::Tensor& xyz,
+                                                 const torch::Tensor& features,
+                                                 const torch::Tensor& knn) {
+  const torch::Tensor x = fc1(features);
+  const torch::Tensor q = w_qs(x);
+  const torch::Tensor k = GatherNeighbors(w_ks(x), knn);
+  const torch::Tensor v = GatherNeighbors(w_vs(x), knn);
+  const torch::Tensor rel = xyz.unsqueeze(2) - GatherNeighbors(xyz, knn);
+  return fc2(Attend(q, k, v, rel)) + features;
+}
+
+torch::Tensor VectorAttentionImpl::CrossAttention(const torch::Tensor& query_xyz,
+                                                  const torch::Tensor& query_features,
+                                                  const torch::Tensor& point_xyz,
+                                                  const torch::Tensor& point_features,
+                                                  const torch::Tensor& knn) {
+  const torch::Tensor q = w_qs(query_features);
+  // fc1, w_ks and w_vs are linear, so they run on the P points before the gather
+  // instead of on the Q*k gathered rows (same result, fewer FLOPs when P < Q*k).
+  const torch::Tensor x = fc1(point_features);
+  const torch::Tensor k = GatherNeighbors(w_ks(x), knn);
+  const torch::Tensor v = GatherNeighbors(w_vs(x), knn);
+  const torch::Tensor rel = query_xyz.unsqueeze(2) - GatherNeighbors(point_xyz, knn);
+  return fc2(Attend(q, k, v, rel)) + query_features;
+}
+
+}  // namespace handlabel

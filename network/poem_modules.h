@@ -1,0 +1,90 @@
+#pragma once
+// The building blocks of POEM as LibTorch modules, registered under the names of the
+// reference implementation so that state_dict keys and shapes match the released
+// checkpoint (docs/network.md). Internal to network/ (includes LibTorch).
+
+#include <torch/torch.h>
+
+#include <array>
+
+namespace handlabel {
+
+// Batch norm with fixed statistics and affine parameters, all buffers (not trained):
+// y = x * w / sqrt(var + 1e-5) + (b - mean * w / sqrt(var + 1e-5)).
+struct FrozenBatchNorm2dImpl : torch::nn::Module {
+  explicit FrozenBatchNorm2dImpl(int64_t channels);
+  torch::Tensor forward(const torch::Tensor& x);
+  torch::Tensor weight, bias, running_mean, running_var;
+};
+TORCH_MODULE(FrozenBatchNorm2d);
+
+// ResNet basic block; `frozen_bn` selects FrozenBatchNorm2d (first block of a stage in
+// the reference) or BatchNorm2d (the others).
+struct BasicBlockImpl : torch::nn::Module {
+  BasicBlockImpl(int64_t inplanes, int64_t planes, int64_t stride, bool frozen_bn);
+  torch::Tensor forward(const torch::Tensor& x);
+  torch::nn::Conv2d conv1{nullptr}, conv2{nullptr};
+  torch::nn::AnyModule bn1, bn2;
+  torch::nn::Sequential downsample{nullptr};
+};
+TORCH_MODULE(BasicBlock);
+
+// ResNet18/34 trunk (keys conv1, bn1, layer1..4, fc). forward() returns the outputs of
+// layer1..layer4 (strides 4, 8, 16, 32). `fc` exists only for checkpoint keys.
+struct ResNetImpl : torch::nn::Module {
+  ResNetImpl(const std::array<int, 4>& blocks, int width);
+  std::array<torch::Tensor, 4> forward(const torch::Tensor& x);
+  torch::nn::Conv2d conv1{nullptr};
+  FrozenBatchNorm2d bn1{nullptr};
+  std::array<torch::nn::Sequential, 4> layers{nullptr, nullptr, nullptr, nullptr};
+  torch::nn::Linear fc{nullptr};
+};
+TORCH_MODULE(ResNet);
+
+// Conv2d (with bias) + optional BatchNorm2d + optional ReLU (keys conv, norm).
+struct ConvBlockImpl : torch::nn::Module {
+  ConvBlockImpl(int64_t in, int64_t out, int64_t kernel, bool norm, bool relu);
+  torch::Tensor forward(const torch::Tensor& x);
+  torch::nn::Conv2d conv{nullptr};
+  torch::nn::BatchNorm2d norm{nullptr};
+  bool relu;
+};
+TORCH_MODULE(ConvBlock);
+
+// Three steps of (bilinear x2, concat skip, 3x3 ConvBlock), then 2x2 max-pool:
+// the reference's `uv_delayer` / `feat_delayer` (keys 0, 1, 2).
+torch::Tensor UDecode(torch::nn::ModuleList& delayer,
+                      const std::array<torch::Tensor, 4>& f);
+torch::nn::ModuleList MakeUDecoder(int width);
+
+// Linear(in, hidden), ReLU, Linear(hidden, out) as a Sequential (keys 0, 2).
+torch::nn::Sequential Mlp(int64_t in, int64_t hidden, int64_t out);
+
+// Point Transformer vector attention without heads (keys fc1, fc2, fc_delta, fc_gamma,
+// w_qs, w_ks, w_vs). Self-attention: neighbours among the same points. Cross
+// attention: queries attend to point features (fc1 applies to the point features, w_qs
+// directly to the query features).
+struct VectorAttentionImpl : torch::nn::Module {
+  VectorAttentionImpl(int64_t d_points, int64_t d_model, bool cross);
+  // xyz (B, P, 3), features (B, P, d_points), knn (B, P, k) -> (B, P, d_points).
+  torch::Tensor SelfAttention(const torch::Tensor& xyz, const torch::Tensor& features,
+                              const torch::Tensor& knn);
+  // query_xyz (B, Q, 3), query_features (B, Q, d_points), point_xyz (B, P, 3),
+  // point_features (B, P, d_points), knn (B, Q, k) into the points -> (B, Q, d_points).
+  torch::Tensor CrossAttention(const torch::Tensor& query_xyz,
+                               const torch::Tensor& query_features,
+                               const torch::Tensor& point_xyz,
+                               const torch::Tensor& point_features,
+                               const torch::Tensor& knn);
+  torch::nn::Linear fc1{nullptr}, fc2{nullptr}, w_qs{nullptr}, w_ks{nullptr},
+      w_vs{nullptr};
+  torch::nn::Sequential fc_delta{nullptr}, fc_gamma{nullptr};
+  int64_t d_model;
+
+ private:
+  torch::Tensor Attend(const torch::Tensor& q, const torch::Tensor& k,
+                       const torch::Tensor& v, const torch::Tensor& rel_xyz);
+};
+TORCH_MODULE(VectorAttention);
+
+}  // namespace handlabel
