@@ -99,6 +99,10 @@ def random_state_dict(cfg, gen):
     conv(h + "input_proj", 2 * w, E, 1, True)
     for i in range(cfg["num_decoder_blocks"]):
         mlp(h + "reg_branches.%d" % i, E, E, 3)
+        # Small updates, as in a trained model: coordinates stay inside the position
+        # range instead of saturating the sigmoid at its edges.
+        sd[h + "reg_branches.%d.2.weight" % i] *= 0.02
+        sd[h + "reg_branches.%d.2.bias" % i] *= 0.02
     conv(h + "adapt_pos3d", 3 * E // 2, E, 1, True)
     conv(h + "position_encoder.0", 3 * D, 2 * E, 1, True)
     conv(h + "position_encoder.2", 2 * E, E, 1, True)

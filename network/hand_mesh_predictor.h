@@ -1,0 +1,83 @@
+#pragma once
+// A network that predicts a hand mesh from calibrated multi-view crops, behind an
+// abstract, torch-free interface (pipeline code includes only this header). POEM is
+// the one implementation today; CreateHandMeshPredictor picks it by name.
+//
+// Frames are validated when they are passed in (view count, crop size, finite
+// cameras) and the model is validated once when it is loaded (config vs weights).
+// Inference runs in batches under torch::NoGradGuard with the intra-op thread count
+// set from the machine (or the options).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/rigid3.h"
+#include "network/poem_config.h"
+
+namespace handlabel {
+
+struct HandMeshViewInput {
+  // crop_size x crop_size RGB crop, channels first, normalised (hand_crop.h WarpCrop).
+  std::vector<float> pixels;
+  Eigen::Matrix3d intrinsics = Eigen::Matrix3d::Identity();  // crop intrinsics
+  Rigid3 cam_from_master;  // view 0 is the master: identity
+  // Triangulation weight of this view (0 = the hand is not visible in it).
+  double weight = 1.0;
+};
+
+struct HandMeshInput {
+  std::vector<HandMeshViewInput> views;  // exactly num_views(), master first
+};
+
+using Keypoints3 = Eigen::Matrix<double, 21, 3, Eigen::RowMajor>;
+using Keypoints2 = Eigen::Matrix<double, 21, 2, Eigen::RowMajor>;
+
+struct HandMeshPrediction {
+  Keypoints3 joints;  // master frame, metres, SNAP/OpenPose order (last decoder layer)
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> vertices;  // 778 x 3
+  Keypoints3 triangulated_joints;     // from the per-view 2D joints (DLT)
+  std::vector<Keypoints2> joints_2d;  // per view, crop pixels
+  // Per view and joint: the heatmap's peak value (sigmoid output, 0..1).
+  std::vector<Eigen::Matrix<double, 21, 1>> joint_confidence;
+  int64_t points_inside_ball = 0;  // frustum points near the initial mesh
+};
+
+class HandMeshPredictor {
+ public:
+  virtual ~HandMeshPredictor() = default;
+  virtual std::string name() const = 0;
+  virtual int num_views() const = 0;
+  virtual int crop_size() const = 0;
+  // One prediction per frame. Throws InputError naming the frame, view and field of
+  // the first invalid input, before any inference runs.
+  virtual std::vector<HandMeshPrediction> Predict(
+      const std::vector<HandMeshInput>& frames) = 0;
+};
+
+struct HandMeshPredictorOptions {
+  std::string model = "poem";  // the only one today
+  // Weights: a handlabel POEM checkpoint (config embedded) or, with `config` set to a
+  // released-* name, the released PtEmbedMultiviewStereo.pth.tar. Empty: random
+  // weights from `config` and `random_seed` (tests and benchmarks only).
+  std::string weights;
+  // PoemConfigByName name ("released-dexycb", "small", ...); empty for own checkpoints.
+  std::string config;
+  int num_views = 0;         // for "small" / "tiny"
+  int num_threads = 0;       // intra-op threads; 0 = the machine's hardware threads
+  int batch_size = 4;        // frames per forward pass
+  uint64_t random_seed = 0;  // random weights only
+  void Check() const;        // throws InputError naming the field
+};
+
+// Loads the model and validates it; throws InputError naming the file or option.
+std::unique_ptr<HandMeshPredictor> CreateHandMeshPredictor(
+    const HandMeshPredictorOptions& options);
+
+// Writes a handlabel POEM checkpoint with random weights (tests and benchmarks).
+void WriteRandomPoemCheckpoint(const PoemConfig& config, uint64_t seed,
+                               const std::string& path);
+
+}  // namespace handlabel

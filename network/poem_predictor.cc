@@ -1,0 +1,193 @@
+// The POEM implementation of HandMeshPredictor (hand_mesh_predictor.h).
+
+#include <ATen/Parallel.h>
+
+#include <algorithm>
+#include <thread>
+
+#include "core/errors.h"
+#include "network/hand_mesh_predictor.h"
+#include "network/poem_checkpoint.h"
+#include "network/poem_import.h"
+#include "network/poem_model.h"
+
+namespace handlabel {
+namespace {
+
+std::string FrameView(size_t f, size_t v) {
+  return "frame " + std::to_string(f) + " view " + std::to_string(v);
+}
+
+class PoemPredictor : public HandMeshPredictor {
+ public:
+  PoemPredictor(PoemModel model, int batch_size)
+      : model_(std::move(model)), batch_size_(batch_size) {
+    model_->eval();
+  }
+
+  std::string name() const override { return "poem"; }
+  int num_views() const override { return model_->config().num_views; }
+  int crop_size() const override { return model_->config().crop_size; }
+
+  std::vector<HandMeshPrediction> Predict(
+      const std::vector<HandMeshInput>& frames) override {
+    for (size_t f = 0; f < frames.size(); ++f) Validate(frames[f], f);
+    std::vector<HandMeshPrediction> out;
+    out.reserve(frames.size());
+    torch::NoGradGuard no_grad;
+    for (size_t begin = 0; begin < frames.size(); begin += batch_size_) {
+      const size_t end = std::min(frames.size(), begin + batch_size_);
+      RunBatch(frames, begin, end, &out);
+    }
+    return out;
+  }
+
+ private:
+  void Validate(const HandMeshInput& frame, size_t f) const {
+    const PoemConfig& c = model_->config();
+    const size_t pixels = 3 * static_cast<size_t>(c.crop_size) * c.crop_size;
+    if (frame.views.size() != static_cast<size_t>(c.num_views)) {
+      throw InputError("frame " + std::to_string(f), "views",
+                       std::to_string(c.num_views) + " views (the model's view count)",
+                       std::to_string(frame.views.size()));
+    }
+    int weighted = 0;
+    for (size_t v = 0; v < frame.views.size(); ++v) {
+      const HandMeshViewInput& in = frame.views[v];
+      if (in.pixels.size() != pixels) {
+        throw InputError(FrameView(f, v), "pixels",
+                         "3 x " + std::to_string(c.crop_size) + " x " +
+                             std::to_string(c.crop_size) + " floats",
+                         std::to_string(in.pixels.size()));
+      }
+      if (!in.intrinsics.allFinite() || !(in.intrinsics(0, 0) > 0) ||
+          !(in.intrinsics(1, 1) > 0)) {
+        throw InputError(FrameView(f, v), "intrinsics", "finite, positive focal lengths");
+      }
+      if (!in.cam_from_master.translation.allFinite() ||
+          !in.cam_from_master.rotation.coeffs().allFinite()) {
+        throw InputError(FrameView(f, v), "cam_from_master", "a finite transform");
+      }
+      if (!(in.weight >= 0)) {
+        throw InputError(FrameView(f, v), "weight", ">= 0", std::to_string(in.weight));
+      }
+      weighted += in.weight > 0;
+    }
+    if (weighted < 2) {
+      throw InputError("frame " + std::to_string(f), "views",
+                       "at least 2 views with weight > 0 (triangulation)",
+                       std::to_string(weighted));
+    }
+  }
+
+  void RunBatch(const std::vector<HandMeshInput>& frames, size_t begin, size_t end,
+                std::vector<HandMeshPrediction>* out) {
+    const PoemConfig& c = model_->config();
+    const int64_t B = end - begin, N = c.num_views, S = c.crop_size;
+    PoemBatch batch;
+    batch.images = torch::empty({B, N, 3, S, S});
+    batch.intrinsics = torch::empty({B, N, 3, 3});
+    batch.master_from_cam = torch::empty({B, N, 4, 4});
+    batch.view_weights = torch::empty({B, N});
+    float* img = batch.images.data_ptr<float>();
+    auto K = batch.intrinsics.accessor<float, 4>();
+    auto T = batch.master_from_cam.accessor<float, 4>();
+    auto W = batch.view_weights.accessor<float, 2>();
+    for (int64_t b = 0; b < B; ++b) {
+      for (int64_t n = 0; n < N; ++n) {
+        const HandMeshViewInput& v = frames[begin + b].views[n];
+        std::copy(v.pixels.begin(), v.pixels.end(), img + (b * N + n) * 3 * S * S);
+        const Matrix3x4d m = v.cam_from_master.Inverse().ToMatrix();
+        for (int i = 0; i < 3; ++i) {
+          for (int j = 0; j < 3; ++j)
+            K[b][n][i][j] = static_cast<float>(v.intrinsics(i, j));
+          for (int j = 0; j < 4; ++j) T[b][n][i][j] = static_cast<float>(m(i, j));
+        }
+        for (int j = 0; j < 4; ++j) T[b][n][3][j] = j == 3 ? 1.0f : 0.0f;
+        W[b][n] = static_cast<float>(v.weight);
+      }
+    }
+    const PoemOutputs o = model_->forward(batch);
+    const torch::Tensor joints = o.joints().to(torch::kFloat64).contiguous();
+    const torch::Tensor verts = o.vertices().to(torch::kFloat64).contiguous();
+    const torch::Tensor tri = o.triangulated_joints.to(torch::kFloat64).contiguous();
+    const torch::Tensor uv = o.joints_2d.to(torch::kFloat64).contiguous();
+    const torch::Tensor peak =
+        std::get<0>(o.heatmaps.flatten(3).max(-1)).to(torch::kFloat64).contiguous();
+    for (int64_t b = 0; b < B; ++b) {
+      HandMeshPrediction p;
+      p.joints = Eigen::Map<const Keypoints3>(joints[b].data_ptr<double>());
+      p.vertices =
+          Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+              verts[b].data_ptr<double>(), PoemConfig::kNumVertices, 3);
+      p.triangulated_joints = Eigen::Map<const Keypoints3>(tri[b].data_ptr<double>());
+      for (int64_t n = 0; n < N; ++n) {
+        p.joints_2d.push_back(Eigen::Map<const Keypoints2>(uv[b][n].data_ptr<double>()));
+        p.joint_confidence.push_back(Eigen::Map<const Eigen::Matrix<double, 21, 1>>(
+            peak[b][n].data_ptr<double>()));
+      }
+      p.points_inside_ball = o.points_inside_ball.empty() ? 0 : o.points_inside_ball[b];
+      out->push_back(std::move(p));
+    }
+  }
+
+  PoemModel model_;
+  int batch_size_;
+};
+
+PoemModel LoadModel(const HandMeshPredictorOptions& o) {
+  if (o.weights.empty()) {
+    return MakeRandomPoemModel(PoemConfigByName(o.config, o.num_views), o.random_seed);
+  }
+  if (o.config.rfind("released-", 0) == 0) {
+    return ImportReleasedPoemCheckpoint(o.weights,
+                                        PoemConfigByName(o.config, o.num_views));
+  }
+  PoemModel model = LoadPoemCheckpoint(o.weights);
+  if (!o.config.empty()) {
+    PoemConfig wanted = PoemConfigByName(o.config, o.num_views);
+    const auto diff = wanted.Differences(model->config());
+    if (!diff.empty()) {
+      std::string got;
+      for (const auto& d : diff) got += (got.empty() ? "" : "; ") + d;
+      throw InputError(o.weights, "config", "a checkpoint for config '" + o.config + "'",
+                       "other sizes (requested vs file: " + got + ")");
+    }
+  }
+  return model;
+}
+
+}  // namespace
+
+void HandMeshPredictorOptions::Check() const {
+  const std::string src = "hand mesh predictor options";
+  if (model != "poem") throw InputError(src, "model", "poem", model);
+  if (weights.empty() && config.empty()) {
+    throw InputError(src, "config", "a config name when no weights are given", "empty");
+  }
+  if (num_threads < 0) {
+    throw InputError(src, "num_threads", ">= 0 (0 = all hardware threads)",
+                     std::to_string(num_threads));
+  }
+  if (batch_size < 1) {
+    throw InputError(src, "batch_size", ">= 1", std::to_string(batch_size));
+  }
+}
+
+std::unique_ptr<HandMeshPredictor> CreateHandMeshPredictor(
+    const HandMeshPredictorOptions& options) {
+  options.Check();
+  const int threads = options.num_threads > 0
+                          ? options.num_threads
+                          : std::max(1u, std::thread::hardware_concurrency());
+  at::set_num_threads(threads);
+  return std::make_unique<PoemPredictor>(LoadModel(options), options.batch_size);
+}
+
+void WriteRandomPoemCheckpoint(const PoemConfig& config, uint64_t seed,
+                               const std::string& path) {
+  PoemModel model = MakeRandomPoemModel(config, seed);
+  SavePoemCheckpoint(model, path);
+}
+
+}  // namespace handlabel
