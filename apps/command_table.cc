@@ -31,6 +31,9 @@ const std::vector<Command>& AllCommands() {
       {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",
        RunCameras},
       {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
+      {"train", "train the POEM network on synthetic captures (resumable)", RunTrain},
+      {"eval-network", "MPJPE / MPVPE / AUC of POEM weights on held-out synthetic frames",
+       RunEvalNetwork},
   };
   return commands;
 }

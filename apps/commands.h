@@ -25,5 +25,7 @@ int RunLabel(int argc, char** argv);
 int RunMerge(int argc, char** argv);
 int RunCameras(int argc, char** argv);
 int RunSynth(int argc, char** argv);
+int RunTrain(int argc, char** argv);
+int RunEvalNetwork(int argc, char** argv);
 
 }  // namespace handlabel
