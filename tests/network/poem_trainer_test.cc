@@ -111,9 +111,10 @@ TEST(PoemTrainer, OverfitsAFixedBatch) {
   const PoemConfig c = TinyPoemConfig(2);
   const FakeSamples fixed(c, 7, /*fixed=*/true);
   PoemTrainerOptions o = TinyOptions(testing::ScratchDir() + "/run");
-  o.steps = 25;
+  o.steps = 12;
+  o.learning_rate = 2e-3;
   o.validate_every = 0;
-  o.checkpoint_every = 25;
+  o.checkpoint_every = 12;
   std::vector<double> losses;
   PoemTrainerHooks hooks;
   hooks.progress = [&](const std::string& line) {
@@ -121,8 +122,8 @@ TEST(PoemTrainer, OverfitsAFixedBatch) {
   };
   PoemTrainer trainer(c, MakeRegressorModel(), fixed, nullptr, o, hooks);
   const PoemTrainSummary s = trainer.Run(false);
-  EXPECT_EQ(s.end_step, 25);
-  ASSERT_EQ(losses.size(), 25u);
+  EXPECT_EQ(s.end_step, 12);
+  ASSERT_EQ(losses.size(), 12u);
   EXPECT_LT(losses.back(), 0.7 * losses.front());
 }
 
