@@ -33,6 +33,9 @@ const std::vector<Command>& AllCommands() {
       {"calib", "calibrate a camera rig from board images or with COLMAP", RunCalib},
       {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
       {"fit", "fit the hand model to a capture's 2D keypoints and masks (Ceres)", RunFit},
+      {"train", "train the POEM network on synthetic captures (resumable)", RunTrain},
+      {"eval-network", "MPJPE / MPVPE / AUC of POEM weights on held-out synthetic frames",
+       RunEvalNetwork},
   };
   return commands;
 }

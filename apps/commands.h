@@ -30,5 +30,7 @@ int RunCameras(int argc, char** argv);
 int RunCalib(int argc, char** argv);
 int RunSynth(int argc, char** argv);
 int RunFit(int argc, char** argv);
+int RunTrain(int argc, char** argv);
+int RunEvalNetwork(int argc, char** argv);
 
 }  // namespace handlabel

@@ -1,0 +1,58 @@
+#pragma once
+// One multi-view training (or evaluation) sample for POEM, in plain C++ (no LibTorch),
+// and the interface of whatever makes them. The trainer (poem_trainer.h) only sees this
+// interface; pipeline/training_samples.h implements it with synthetic captures made on
+// the fly, so network/ never depends on pipeline/.
+//
+// Frames: the master frame is camera 0's (after augmentation); pixels are crop pixels
+// of the S x S crop (centre of the top-left pixel at (0, 0)).
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace handlabel {
+
+struct TrainingView {
+  // 3 x S x S (channel-major, RGB), values RGB / 255 - 0.5 (the network's input).
+  std::vector<float> image;
+  // S x S hand mask in [0, 1], or empty when masks were not requested.
+  std::vector<float> mask;
+  // Pinhole crop intrinsics (fx = fy, no skew) of the (augmented) view camera.
+  Eigen::Matrix3d intrinsics = Eigen::Matrix3d::Identity();
+  // Camera -> master frame (metres); identity for view 0.
+  Eigen::Matrix4d master_from_cam = Eigen::Matrix4d::Identity();
+  // The 21 keypoints (SNAP order) in crop pixels: exactly the projection of
+  // TrainingSample::joints_3d through intrinsics and master_from_cam.
+  Eigen::Matrix<double, 21, 2, Eigen::RowMajor> joints_2d =
+      Eigen::Matrix<double, 21, 2, Eigen::RowMajor>::Zero();
+  // Weight of each 2D keypoint in the losses (0 = behind the camera).
+  std::array<float, 21> joints_2d_weight{};
+};
+
+struct TrainingSample {
+  int64_t index = 0;  // sample index it was made for
+  int64_t frame = 0;  // index of the synthetic frame it was cut from
+  std::vector<TrainingView> views;
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> joints_3d;    // 21 x 3
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> vertices_3d;  // V x 3
+};
+
+// A network's answer for one sample (master frame, metres).
+struct PoemPrediction {
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> joints_3d;    // 21 x 3
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> vertices_3d;  // V x 3
+};
+
+// Makes samples; Sample(i) must depend only on i (and the source's settings) and be
+// callable from any thread.
+class TrainingSampleSource {
+ public:
+  virtual ~TrainingSampleSource() = default;
+  virtual int num_views() const = 0;
+  virtual int crop_size() const = 0;
+  virtual TrainingSample Sample(int64_t index) const = 0;
+};
+
+}  // namespace handlabel

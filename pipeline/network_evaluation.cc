@@ -1,0 +1,96 @@
+#include "pipeline/network_evaluation.h"
+
+#include <chrono>
+
+#include "core/errors.h"
+#include "network/poem_sample_predictor.h"
+#include "pipeline/line_plot.h"
+
+namespace handlabel {
+
+void NetworkEvalOptions::Check() const {
+  if (weights.empty()) throw InputError("eval-network", "--weights", "a checkpoint", "");
+  if (frames < 1)
+    throw InputError("eval-network", "--frames", ">= 1", std::to_string(frames));
+  if (batch_size < 1) {
+    throw InputError("eval-network", "--batch", ">= 1", std::to_string(batch_size));
+  }
+  if (threads < 1) {
+    throw InputError("eval-network", "--threads", ">= 1", std::to_string(threads));
+  }
+  synth.Check();
+  pck.Check();
+}
+
+NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOptions& o,
+                                      const std::function<void(int, int)>& progress) {
+  o.Check();
+  PoemSamplePredictor predictor(o.weights, o.threads);
+  TrainingSampleOptions so;
+  so.crop_size = predictor.config().crop_size;
+  so.box_scale = o.box_scale;
+  so.augment.enabled = false;
+  so.augment_seed = o.synth.seed;
+  const SynthTrainingSamples source(hand, o.synth, so);
+  if (source.num_views() != predictor.config().num_views) {
+    throw InputError(o.weights, "num_views",
+                     std::to_string(source.num_views()) + " (the rig's views)",
+                     std::to_string(predictor.config().num_views));
+  }
+  NetworkEvalResult r;
+  Eigen::MatrixXd joint_errors(o.frames, 21), vertex_errors;
+  for (int first = 0; first < o.frames; first += o.batch_size) {
+    std::vector<TrainingSample> samples;
+    for (int i = first; i < std::min(o.frames, first + o.batch_size); ++i) {
+      samples.push_back(source.Sample(i));
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<PoemPrediction> pred = predictor.Predict(samples);
+    r.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (size_t i = 0; i < samples.size(); ++i) {
+      const int f = first + static_cast<int>(i);
+      const TrainingSample& s = samples[i];
+      if (vertex_errors.size() == 0) vertex_errors.resize(o.frames, s.vertices_3d.rows());
+      joint_errors.row(f) = PointErrors(pred[i].joints_3d, s.joints_3d).transpose();
+      vertex_errors.row(f) = PointErrors(pred[i].vertices_3d, s.vertices_3d).transpose();
+      r.pa_mpjpe_mm += 1000 * ProcrustesMeanPointError(pred[i].joints_3d, s.joints_3d);
+      r.pa_mpvpe_mm +=
+          1000 * ProcrustesMeanPointError(pred[i].vertices_3d, s.vertices_3d);
+    }
+    r.frames += static_cast<int>(samples.size());
+    if (progress) progress(r.frames, o.frames);
+  }
+  r.mpjpe_mm = 1000 * joint_errors.mean();
+  r.mpvpe_mm = 1000 * vertex_errors.mean();
+  r.pa_mpjpe_mm /= r.frames;
+  r.pa_mpvpe_mm /= r.frames;
+  r.joint_pck = ComputePck(joint_errors, o.pck);
+  r.vertex_pck = ComputePck(vertex_errors, o.pck);
+  r.frames_per_second = r.seconds > 0 ? r.frames / r.seconds : 0;
+  return r;
+}
+
+void WritePckPlot(const NetworkEvalResult& r, const std::string& png_path,
+                  const std::string& title) {
+  auto mm = [](std::vector<double> v) {
+    for (double& x : v) x *= 1000;
+    return v;
+  };
+  char jn[64], vn[64];
+  std::snprintf(jn, sizeof(jn), "joints AUC %.3f", r.joint_pck.auc);
+  std::snprintf(vn, sizeof(vn), "vertices AUC %.3f", r.vertex_pck.auc);
+  PlotSeries joints{jn, mm(r.joint_pck.thresholds), r.joint_pck.pck, PlotColor(0)};
+  PlotSeries verts{vn, mm(r.vertex_pck.thresholds), r.vertex_pck.pck, PlotColor(1)};
+  PlotOptions o;
+  o.width = 640;
+  o.height = 420;
+  o.title = title;
+  o.x_label = "error threshold (mm)";
+  o.y_label = "PCK";
+  o.y_min = 0;
+  o.y_max = 1;
+  WritePng(png_path, DrawLinePlot({joints, verts}, o));
+}
+
+}  // namespace handlabel

@@ -1,0 +1,46 @@
+#pragma once
+// Accuracy of POEM weights on held-out synthetic frames (`handlabel eval-network`):
+// frames from the synthetic generator with a chosen seed, plain crops around the true
+// 2D keypoint box (no augmentation), one forward pass per batch, and the POEM paper's
+// metrics (core/metrics.h) on the last decoder layer in the master frame.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "core/hand_model.h"
+#include "core/metrics.h"
+#include "pipeline/synth_capture.h"
+#include "pipeline/training_samples.h"
+
+namespace handlabel {
+
+struct NetworkEvalOptions {
+  std::string weights;        // own POEM checkpoint
+  int frames = 500;           // held-out frames (>= 1)
+  int batch_size = 4;         // frames per forward pass (>= 1)
+  int threads = 1;            // LibTorch threads (>= 1)
+  SynthCaptureOptions synth;  // rig preset, seed, scene settings
+  double box_scale = 2.0;     // crop side / keypoint box side
+  PckOptions pck;             // thresholds of the PCK curve (POEM: 0-20 mm, 20 steps)
+  void Check() const;
+};
+
+struct NetworkEvalResult {
+  int frames = 0;
+  double mpjpe_mm = 0, mpvpe_mm = 0;        // mean over frames
+  double pa_mpjpe_mm = 0, pa_mpvpe_mm = 0;  // Procrustes-aligned
+  PckCurve joint_pck, vertex_pck;           // thresholds in metres
+  double seconds = 0;                       // wall time of the forward passes
+  double frames_per_second = 0;             // network only (crops excluded)
+};
+
+// progress(done, total) after every batch.
+NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOptions& o,
+                                      const std::function<void(int, int)>& progress = {});
+
+// PNG of the joint and vertex PCK curves (threshold in mm).
+void WritePckPlot(const NetworkEvalResult& result, const std::string& png_path,
+                  const std::string& title);
+
+}  // namespace handlabel

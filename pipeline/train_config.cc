@@ -1,0 +1,233 @@
+#include "pipeline/train_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "core/errors.h"
+#include "core/hand_model_io.h"
+#include "pipeline/build_config.h"
+#include "pipeline/open_hand_builder.h"
+
+namespace handlabel {
+namespace {
+
+// One YAML mapping; remembers the keys read so unknown ones are reported.
+class Section {
+ public:
+  Section(const YAML::Node& node, std::string file, std::string prefix)
+      : node_(node), file_(std::move(file)), prefix_(std::move(prefix)) {
+    if (node_ && !node_.IsMap()) {
+      throw InputError(file_, prefix_.empty() ? "(top level)" : prefix_, "a mapping");
+    }
+  }
+  template <typename T>
+  void Read(const char* key, T* value) {
+    seen_.insert(key);
+    if (!node_ || !node_[key]) return;
+    try {
+      *value = node_[key].as<T>();
+    } catch (const YAML::Exception&) {
+      YAML::Emitter out;
+      out << node_[key];
+      throw InputError(file_, Name(key), "a value of the right type",
+                       std::string("'") + out.c_str() + "'");
+    }
+  }
+  Section Child(const char* key) {
+    seen_.insert(key);
+    return Section(node_ ? node_[key] : YAML::Node(), file_, Name(key));
+  }
+  YAML::Node Raw(const char* key) {
+    seen_.insert(key);
+    return node_ ? node_[key] : YAML::Node();
+  }
+  void RejectUnknownKeys() const {
+    if (!node_) return;
+    for (const auto& entry : node_) {
+      const std::string key = entry.first.as<std::string>();
+      if (!seen_.count(key)) {
+        std::string known;
+        for (const std::string& k : seen_) known += (known.empty() ? "" : ", ") + k;
+        throw InputError(file_, Name(key.c_str()), "a known key (" + known + ")",
+                         "unknown key");
+      }
+    }
+  }
+  std::string Name(const char* key) const {
+    return prefix_.empty() ? key : prefix_ + "." + key;
+  }
+
+ private:
+  YAML::Node node_;
+  std::string file_, prefix_;
+  std::set<std::string> seen_;
+};
+
+// Scalars of a YAML mapping as JSON numbers, booleans or strings; lists as arrays.
+nlohmann::json ToJson(const YAML::Node& node) {
+  if (node.IsSequence()) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const auto& item : node) a.push_back(ToJson(item));
+    return a;
+  }
+  if (node.IsMap()) {
+    nlohmann::json o = nlohmann::json::object();
+    for (const auto& e : node) o[e.first.as<std::string>()] = ToJson(e.second);
+    return o;
+  }
+  const std::string text = node.as<std::string>();
+  try {
+    size_t used = 0;
+    const long long i = std::stoll(text, &used);
+    if (used == text.size()) return i;
+  } catch (const std::exception&) {
+  }
+  try {
+    size_t used = 0;
+    const double d = std::stod(text, &used);
+    if (used == text.size()) return d;
+  } catch (const std::exception&) {
+  }
+  if (text == "true") return true;
+  if (text == "false") return false;
+  return text;
+}
+
+}  // namespace
+
+TrainConfig LoadTrainConfig(const std::string& path) {
+  if (!std::filesystem::exists(path)) {
+    throw InputError(path, "", "an existing training config (YAML)", "no such file");
+  }
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path, "", "valid YAML", e.what());
+  }
+  TrainConfig c;
+  c.source_file = path;
+  Section top(root, path, "");
+  top.Read("network", &c.network_name);
+  top.Read("hand_model", &c.hand_model);
+
+  Section data = top.Child("data");
+  bool objects = c.synth.scene.objects, clutter = c.synth.view.background.clutter;
+  data.Read("preset", &c.synth.rig.preset);
+  data.Read("width", &c.synth.rig.width);
+  data.Read("height", &c.synth.rig.height);
+  data.Read("seed", &c.synth.seed);
+  data.Read("validation_seed", &c.validation_seed);
+  data.Read("objects", &objects);
+  data.Read("max_objects", &c.synth.scene.max_objects);
+  data.Read("clutter", &clutter);
+  data.Read("frame_reuse", &c.samples.frame_reuse);
+  data.Read("box_scale", &c.samples.box_scale);
+  data.Read("generator_threads", &c.synth.num_threads);
+  data.RejectUnknownKeys();
+  c.synth.scene.objects = objects;
+  c.synth.view.background.clutter = clutter;
+
+  Section aug = top.Child("augment");
+  TrainingAugmentOptions& a = c.samples.augment;
+  aug.Read("enabled", &a.enabled);
+  aug.Read("scale_sigma", &a.scale_sigma);
+  aug.Read("rotation_probability", &a.rotation_probability);
+  aug.Read("rotation_sigma_deg", &a.rotation_sigma_deg);
+  aug.Read("gain_min", &a.gain_min);
+  aug.Read("gain_max", &a.gain_max);
+  aug.Read("noise_rect_probability", &a.noise_rect_probability);
+  aug.Read("noise_rect_max_side", &a.noise_rect_max_side);
+  aug.RejectUnknownKeys();
+
+  Section train = top.Child("train");
+  PoemTrainerOptions& t = c.trainer;
+  t.steps = 20000;
+  train.Read("steps", &t.steps);
+  train.Read("batch_size", &t.batch_size);
+  train.Read("learning_rate", &t.learning_rate);
+  train.Read("warmup_steps", &t.warmup_steps);
+  train.Read("decay_at", &t.decay_at);
+  train.Read("decay_factor", &t.decay_factor);
+  train.Read("grad_clip_norm", &t.grad_clip_norm);
+  train.Read("checkpoint_every", &t.checkpoint_every);
+  train.Read("keep_checkpoints", &t.keep_checkpoints);
+  train.Read("log_every", &t.log_every);
+  train.Read("validate_every", &t.validate_every);
+  train.Read("validation_samples", &t.validation_samples);
+  train.Read("seed", &t.seed);
+  train.Read("threads", &t.threads);
+  train.Read("prefetch_batches", &t.prefetch_batches);
+  train.Read("out_dir", &t.out_dir);
+  train.RejectUnknownKeys();
+
+  Section loss = top.Child("loss");
+  loss.Read("heatmap_weight", &t.heatmap_weight);
+  loss.Read("triangulation_weight", &t.triangulation_weight);
+  loss.Read("joints_weight", &t.joints_weight);
+  loss.Read("vertices_weight", &t.vertices_weight);
+  loss.Read("joints_2d_weight", &t.joints_2d_weight);
+  loss.RejectUnknownKeys();
+
+  const YAML::Node overrides = top.Raw("network_overrides");
+  top.RejectUnknownKeys();
+
+  c.synth.Check();
+  const int views = static_cast<int>(MakePresetRig(c.synth.rig, c.synth.seed).size());
+  c.network = PoemConfigByName(c.network_name, views);
+  if (overrides && !overrides.IsNull()) {
+    if (!overrides.IsMap()) throw InputError(path, "network_overrides", "a mapping");
+    nlohmann::json j = nlohmann::json::parse(c.network.ToJson());
+    for (const auto& [key, value] : ToJson(overrides).items()) j[key] = value;
+    c.network = PoemConfig::FromJson(j.dump(), path + " (network_overrides)");
+  }
+  if (c.network.num_views != views) {
+    throw InputError(path, "network", std::to_string(views) + " views (the rig's)",
+                     std::to_string(c.network.num_views));
+  }
+  c.samples.crop_size = c.network.crop_size;
+  c.samples.reuse_group = c.trainer.batch_size;
+  c.samples.augment_seed = c.synth.seed;
+  c.samples.Check(path);
+  if (!c.trainer.out_dir.empty()) c.trainer.Check(path);
+  return c;
+}
+
+HandModel LoadTrainingHandModel(const TrainConfig& config, std::string* source) {
+  if (!config.hand_model.empty()) {
+    if (!std::filesystem::exists(config.hand_model)) {
+      throw InputError(config.source_file, "hand_model", "an existing model file",
+                       config.hand_model);
+    }
+    *source = config.hand_model;
+    return LoadHandModel(config.hand_model);
+  }
+  const std::string shipped =
+      std::string(HANDLABEL_SOURCE_DIR) + "/models/open_hand_right.npz";
+  if (std::filesystem::exists(shipped)) {
+    *source = shipped;
+    return LoadHandModel(shipped);
+  }
+  *source = "builtin:open_hand_right (built in memory)";
+  return BuildOpenHand(DefaultOpenHandDesign(), OpenHandBuildOptions());
+}
+
+SynthCaptureOptions ValidationSynthOptions(const TrainConfig& config) {
+  SynthCaptureOptions o = config.synth;
+  o.seed = config.validation_seed;
+  return o;
+}
+
+TrainingSampleOptions ValidationSampleOptions(const TrainConfig& config) {
+  TrainingSampleOptions o = config.samples;
+  o.augment.enabled = false;
+  o.frame_reuse = 1;
+  o.reuse_group = 1;
+  o.augment_seed = config.validation_seed;
+  return o;
+}
+
+}  // namespace handlabel

@@ -1,0 +1,262 @@
+#include "pipeline/training_samples.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.h"
+
+namespace handlabel {
+namespace {
+
+constexpr uint64_t kAugmentStream = 0xA06E;
+
+using Affine2 = Eigen::Matrix<double, 2, 3>;  // crop pixel = A * (x, y, 1)
+
+std::string Str(double v) { return std::to_string(v); }
+
+void InRange(const std::string& source, const char* field, double v, double lo,
+             double hi) {
+  if (!(v >= lo && v <= hi)) {
+    throw InputError(source, field, Str(lo) + ".." + Str(hi), Str(v));
+  }
+}
+
+Eigen::Matrix4d ToMatrix4(const Rigid3& t) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() = t.rotation.toRotationMatrix();
+  m.topRightCorner<3, 1>() = t.translation;
+  return m;
+}
+
+// Bilinear sample of channel c at (x, y) with zero outside the image.
+float Bilinear(const ImageU8& img, double x, double y, int c) {
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const double ax = x - x0, ay = y - y0;
+  auto at = [&](int xi, int yi) -> double {
+    return img.Contains(xi, yi) ? img.at(xi, yi, c) : 0.0;
+  };
+  const double top = (1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0);
+  const double bottom = (1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1);
+  return static_cast<float>((1 - ay) * top + ay * bottom);
+}
+
+}  // namespace
+
+void TrainingAugmentOptions::Check(const std::string& source) const {
+  InRange(source, "scale_sigma", scale_sigma, 0, 0.4);
+  InRange(source, "rotation_probability", rotation_probability, 0, 1);
+  InRange(source, "rotation_sigma_deg", rotation_sigma_deg, 0, 90);
+  if (!(gain_min > 0 && gain_max >= gain_min)) {
+    throw InputError(source, "gain_min/gain_max", "0 < gain_min <= gain_max",
+                     Str(gain_min) + "/" + Str(gain_max));
+  }
+  InRange(source, "noise_rect_probability", noise_rect_probability, 0, 1);
+  InRange(source, "noise_rect_max_side", noise_rect_max_side, 0.01, 1);
+}
+
+void TrainingSampleOptions::Check(const std::string& source) const {
+  if (crop_size < 32 || crop_size % 32 != 0) {
+    throw InputError(source, "crop_size", "a positive multiple of 32",
+                     std::to_string(crop_size));
+  }
+  if (!(box_scale > 0)) throw InputError(source, "box_scale", "> 0", Str(box_scale));
+  if (!(min_box_px > 0)) throw InputError(source, "min_box_px", "> 0", Str(min_box_px));
+  if (frame_reuse < 1) {
+    throw InputError(source, "frame_reuse", ">= 1", std::to_string(frame_reuse));
+  }
+  if (reuse_group < 1) {
+    throw InputError(source, "reuse_group", ">= 1", std::to_string(reuse_group));
+  }
+  augment.Check(source + " augmentation");
+}
+
+int64_t TrainingFrameOf(int64_t index, const TrainingSampleOptions& o) {
+  const int64_t group = o.reuse_group, block = group * o.frame_reuse;
+  return (index / block) * group + index % group;
+}
+
+ViewAugmentation DrawViewAugmentation(const TrainingAugmentOptions& o, int crop_size,
+                                      std::mt19937_64& rng) {
+  ViewAugmentation a;
+  if (!o.enabled) return a;
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  a.scale = 1.0 + o.scale_sigma * std::clamp(normal(rng), -2.0, 2.0);
+  const bool rotate = unit(rng) < o.rotation_probability;
+  const double angle = o.rotation_sigma_deg * M_PI / 180.0 * normal(rng);
+  if (rotate) a.rotation_rad = angle;
+  for (double& g : a.gain) g = o.gain_min + (o.gain_max - o.gain_min) * unit(rng);
+  a.noise_rect = unit(rng) < o.noise_rect_probability;
+  const double max_side = o.noise_rect_max_side * crop_size;
+  const int w = std::max(1, static_cast<int>(std::lround(max_side * unit(rng))));
+  const int h = std::max(1, static_cast<int>(std::lround(max_side * unit(rng))));
+  a.rect_x0 = static_cast<int>(unit(rng) * (crop_size - w + 1));
+  a.rect_y0 = static_cast<int>(unit(rng) * (crop_size - h + 1));
+  a.rect_x1 = a.rect_x0 + w;
+  a.rect_y1 = a.rect_y0 + h;
+  a.noise_seed = rng();
+  if (!a.noise_rect) a.rect_x0 = a.rect_y0 = a.rect_x1 = a.rect_y1 = 0;
+  return a;
+}
+
+TrainingSample MakeTrainingSample(const SynthFrame& frame, const Rig& rig,
+                                  const TrainingSampleOptions& o,
+                                  const std::vector<ViewAugmentation>& augmentations) {
+  const int N = static_cast<int>(rig.size());
+  const int S = o.crop_size;
+  HL_CHECK(static_cast<int>(frame.views.size()) == N, "one rendered view per camera");
+  HL_CHECK(static_cast<int>(augmentations.size()) == N, "one augmentation per view");
+  const Points3d& keypoints = frame.scene.hand.keypoints;  // world, SNAP order
+  const Points3d& vertices = frame.scene.hand.vertices;
+
+  TrainingSample sample;
+  sample.frame = frame.index;
+  sample.views.resize(N);
+  std::vector<Eigen::Matrix4d> cam_from_world(N);
+  for (int c = 0; c < N; ++c) {
+    const RigCamera& cam = rig[c];
+    const CameraModelId model = cam.camera.model();
+    if (model != CameraModelId::kPinhole && model != CameraModelId::kSimplePinhole) {
+      throw InputError("training samples", "camera " + cam.name,
+                       "a pinhole camera (crops assume no lens distortion)",
+                       CameraModelName(model));
+    }
+    const ViewAugmentation& aug = augmentations[c];
+    const double fx = cam.camera.fx(), fy = cam.camera.fy();
+    const double cx = cam.camera.cx(), cy = cam.camera.cy();
+    const Eigen::Matrix4d original = ToMatrix4(cam.cam_from_world);
+
+    // Keypoint box from the exact projections (points behind the camera are skipped).
+    Eigen::Matrix<double, 21, 2, Eigen::RowMajor> uv;
+    std::array<float, 21> weight{};
+    Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+    for (int k = 0; k < 21; ++k) {
+      const Eigen::Vector3d p =
+          (original * keypoints.row(k).transpose().homogeneous()).head<3>();
+      const double z = std::max(p.z(), 1e-6);
+      uv.row(k) << fx * p.x() / z + cx, fy * p.y() / z + cy;
+      weight[k] = p.z() > 1e-6 ? 1.0f : 0.0f;
+      if (weight[k] > 0) {
+        lo = lo.cwiseMin(uv.row(k).transpose());
+        hi = hi.cwiseMax(uv.row(k).transpose());
+      }
+    }
+    if (lo.x() > hi.x()) lo = hi = Eigen::Vector2d(cx, cy);  // hand behind the camera
+    // Crop affine: square pixels (f / fx, f / fy), turn, scale to the crop. The box is
+    // measured in square pixels.
+    const double f = 0.5 * (fx + fy);
+    const Eigen::Vector2d center = 0.5 * (lo + hi);
+    const double box =
+        std::max({(hi.x() - lo.x()) * f / fx, (hi.y() - lo.y()) * f / fy, o.min_box_px});
+    const double side = box * o.box_scale * aug.scale;
+    const double s = S / side;
+    const double co = std::cos(aug.rotation_rad), si = std::sin(aug.rotation_rad);
+    Eigen::Matrix2d rot;
+    rot << co, -si, si, co;
+    const Eigen::Matrix2d lin = s * rot * Eigen::Vector2d(f / fx, f / fy).asDiagonal();
+    Affine2 A;
+    A.leftCols<2>() = lin;
+    A.col(2) =
+        Eigen::Vector2d::Constant(0.5 * S) - lin * center;  // as network/hand_crop.h
+
+    TrainingView& view = sample.views[c];
+    const Eigen::Vector2d pp = lin * Eigen::Vector2d(cx, cy) + A.col(2);
+    view.intrinsics << s * f, 0, pp.x(), 0, s * f, pp.y(), 0, 0, 1;
+    Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+    turn.topLeftCorner<2, 2>() = rot;  // cam' = turn * cam
+    cam_from_world[c] = turn * original;
+    for (int k = 0; k < 21; ++k) {
+      view.joints_2d.row(k) = (lin * uv.row(k).transpose() + A.col(2)).transpose();
+    }
+    view.joints_2d_weight = weight;
+
+    // Resample the image (and mask) through the inverse affine.
+    const Eigen::Matrix2d inv = lin.inverse();
+    const Eigen::Vector2d inv_t = -inv * A.col(2);
+    const SynthView& src = frame.views[c];
+    view.image.assign(3 * S * S, 0.0f);
+    if (o.masks) view.mask.assign(S * S, 0.0f);
+    std::mt19937_64 noise_rng(aug.noise_seed);
+    std::uniform_real_distribution<float> noise(0.0f, 255.0f);
+    for (int y = 0; y < S; ++y) {
+      for (int x = 0; x < S; ++x) {
+        const Eigen::Vector2d p = inv * Eigen::Vector2d(x, y) + inv_t;
+        const bool in_rect = aug.noise_rect && x >= aug.rect_x0 && x < aug.rect_x1 &&
+                             y >= aug.rect_y0 && y < aug.rect_y1;
+        for (int ch = 0; ch < 3; ++ch) {
+          float v =
+              static_cast<float>(Bilinear(src.rgb, p.x(), p.y(), ch) * aug.gain[ch]);
+          v = std::min(255.0f, v);
+          if (in_rect) v = noise(noise_rng);
+          view.image[(ch * S + y) * S + x] = v / 255.0f - 0.5f;
+        }
+        if (o.masks)
+          view.mask[y * S + x] = Bilinear(src.hand_mask, p.x(), p.y(), 0) / 255.0f;
+      }
+    }
+  }
+
+  // Master frame = the (turned) camera 0.
+  const Eigen::Matrix4d master_from_world = cam_from_world[0];
+  for (int c = 0; c < N; ++c) {
+    sample.views[c].master_from_cam = master_from_world * cam_from_world[c].inverse();
+  }
+  sample.views[0].master_from_cam = Eigen::Matrix4d::Identity();
+  auto to_master = [&](const Points3d& world) {
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> out(world.rows(), 3);
+    const Eigen::Matrix3d R = master_from_world.topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = master_from_world.topRightCorner<3, 1>();
+    for (Eigen::Index i = 0; i < world.rows(); ++i) {
+      out.row(i) = (R * world.row(i).transpose() + t).transpose();
+    }
+    return out;
+  };
+  sample.joints_3d = to_master(keypoints);
+  sample.vertices_3d = to_master(vertices);
+  return sample;
+}
+
+SynthTrainingSamples::SynthTrainingSamples(const HandModel& model,
+                                           const SynthCaptureOptions& synth,
+                                           const TrainingSampleOptions& options)
+    : generator_(model, MakePresetRig(synth.rig, synth.seed),
+                 [&] {
+                   SynthCaptureOptions s = synth;
+                   s.view.depth = false;
+                   s.write_detections = false;
+                   return s;
+                 }()),
+      options_(options) {
+  options_.Check();
+}
+
+std::shared_ptr<const SynthFrame> SynthTrainingSamples::Frame(int64_t frame_index) const {
+  {
+    std::lock_guard<std::mutex> lock(cache_mutex_);
+    for (const auto& [index, frame] : cache_) {
+      if (index == frame_index) return frame;
+    }
+  }
+  auto frame = std::make_shared<const SynthFrame>(
+      generator_.Generate(static_cast<int>(frame_index)));
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  cache_.emplace_back(frame_index, frame);
+  const size_t keep = 2 * static_cast<size_t>(options_.reuse_group);
+  if (cache_.size() > keep) cache_.erase(cache_.begin(), cache_.end() - keep);
+  return frame;
+}
+
+TrainingSample SynthTrainingSamples::Sample(int64_t index) const {
+  const std::shared_ptr<const SynthFrame> frame = Frame(TrainingFrameOf(index, options_));
+  std::mt19937_64 rng(MixSeed(options_.augment_seed, index, kAugmentStream));
+  std::vector<ViewAugmentation> augs;
+  for (int c = 0; c < num_views(); ++c) {
+    augs.push_back(DrawViewAugmentation(options_.augment, options_.crop_size, rng));
+  }
+  TrainingSample sample = MakeTrainingSample(*frame, generator_.rig(), options_, augs);
+  sample.index = index;
+  return sample;
+}
+
+}  // namespace handlabel

@@ -1,0 +1,108 @@
+#pragma once
+// POEM training samples cut from synthetic captures made on the fly
+// (pipeline/synth_capture.h): per-view hand crops with their crop intrinsics, the
+// camera -> master extrinsics, and exact targets (21 keypoints and all vertices in the
+// master frame, 2D keypoints per view in crop pixels).
+//
+// Crop: a square of side box_scale x the larger side of the hand's 2D keypoint box,
+// centred on the box, resampled bilinearly to crop_size x crop_size (zero border).
+// Augmentation (the reference recipe, docs/training.md), per view:
+//   scale      crop side x s, s ~ N(1, scale_sigma) clipped to 1 +- 2 scale_sigma
+//   rotation   with probability rotation_probability the crop turns by
+//              N(0, rotation_sigma_deg) about its centre; the turn is folded into the
+//              extrinsic (a rotation of the camera about its optical axis) so that the
+//              crop intrinsics stay pinhole and the 3D targets project exactly onto the
+//              2D targets. Turning view 0 turns the master frame with it.
+//   colour     per-channel gain U(gain_min, gain_max)
+//   noise      with probability noise_rect_probability a rectangle of uniform noise
+// Crops always have fx = fy: the box is resampled anisotropically by f / fx, f / fy
+// (f = mean focal) first, which is exact and a no-op for square pixels.
+//
+// Sample i is cut from frame FrameOf(i): `frame_reuse` consecutive groups of
+// `reuse_group` samples share the same `reuse_group` frames (with fresh augmentation),
+// so rendering costs 1 / frame_reuse of a frame per sample. Everything random derives
+// from (seed, i), so Sample(i) is the same on every call and every thread.
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/hand_model.h"
+#include "network/training_sample.h"
+#include "pipeline/synth_capture.h"
+
+namespace handlabel {
+
+struct TrainingAugmentOptions {
+  bool enabled = true;                // false: plain crops (validation, evaluation)
+  double scale_sigma = 0.06;          // relative crop size jitter (>= 0)
+  double rotation_probability = 0.5;  // chance of an in-plane rotation (0..1)
+  double rotation_sigma_deg = 5.0;    // its standard deviation, degrees (>= 0)
+  double gain_min = 0.7;              // per-channel colour gain range (0 < min <= max)
+  double gain_max = 1.3;
+  double noise_rect_probability = 0.2;  // chance of one noise rectangle per view (0..1)
+  double noise_rect_max_side = 0.4;     // its largest side, fraction of the crop (0..1]
+  void Check(const std::string& source = "augmentation") const;
+};
+
+struct TrainingSampleOptions {
+  int crop_size = 128;        // output crop side in pixels (multiple of 32)
+  double box_scale = 2.0;     // crop side / larger side of the 2D keypoint box (> 0)
+  double min_box_px = 16;     // smallest keypoint box side used, pixels (> 0)
+  bool masks = false;         // also crop the hand masks
+  int frame_reuse = 1;        // samples cut from each rendered frame (>= 1)
+  int reuse_group = 1;        // samples per reuse group, e.g. the batch size (>= 1)
+  uint64_t augment_seed = 0;  // mixed with the sample index for the augmentation
+  TrainingAugmentOptions augment;
+  void Check(const std::string& source = "training samples") const;
+};
+
+// The synthetic frame that sample `index` is cut from.
+int64_t TrainingFrameOf(int64_t index, const TrainingSampleOptions& options);
+
+// The random choices of one view's augmentation (identity when disabled).
+struct ViewAugmentation {
+  double scale = 1.0;
+  double rotation_rad = 0.0;
+  std::array<double, 3> gain = {1.0, 1.0, 1.0};
+  bool noise_rect = false;
+  int rect_x0 = 0, rect_y0 = 0, rect_x1 = 0, rect_y1 = 0;  // half-open, crop pixels
+  uint64_t noise_seed = 0;
+};
+ViewAugmentation DrawViewAugmentation(const TrainingAugmentOptions& options,
+                                      int crop_size, std::mt19937_64& rng);
+
+// Cuts one sample out of a frame. `rig` is the generator's rig (pinhole cameras).
+// Throws InputError if a camera has lens distortion.
+TrainingSample MakeTrainingSample(const SynthFrame& frame, const Rig& rig,
+                                  const TrainingSampleOptions& options,
+                                  const std::vector<ViewAugmentation>& augmentations);
+
+// TrainingSampleSource over a SynthGenerator. Keeps the frames of the last reuse group
+// so consecutive samples do not render them again.
+class SynthTrainingSamples : public TrainingSampleSource {
+ public:
+  // Depth rendering and detections are switched off in `synth` (not needed).
+  SynthTrainingSamples(const HandModel& model, const SynthCaptureOptions& synth,
+                       const TrainingSampleOptions& options);
+  int num_views() const override { return static_cast<int>(generator_.rig().size()); }
+  int crop_size() const override { return options_.crop_size; }
+  TrainingSample Sample(int64_t index) const override;
+
+  const SynthGenerator& generator() const { return generator_; }
+  const TrainingSampleOptions& options() const { return options_; }
+
+ private:
+  std::shared_ptr<const SynthFrame> Frame(int64_t frame_index) const;
+
+  SynthGenerator generator_;
+  TrainingSampleOptions options_;
+  mutable std::mutex cache_mutex_;
+  mutable std::vector<std::pair<int64_t, std::shared_ptr<const SynthFrame>>> cache_;
+};
+
+}  // namespace handlabel

@@ -1,0 +1,217 @@
+#include "network/poem_trainer.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "core/errors.h"
+#include "core/rigid3.h"
+#include "network/poem_checkpoint.h"
+#include "network/poem_training_batch.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+// A HandModel with 778 vertices whose regressor averages a few vertices per joint.
+HandModel MakeRegressorModel() {
+  HandModel m;
+  m.v_template = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>::Zero(778, 3);
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < kNumHandJoints; ++j)
+    for (int k = 0; k < 4; ++k) t.emplace_back(j, (j * 37 + k * 11) % 778, 0.25);
+  m.joint_regressor.resize(kNumHandJoints, 778);
+  m.joint_regressor.setFromTriplets(t.begin(), t.end());
+  return m;
+}
+
+// Samples of a 2-camera rig around a hand-sized blob 0.6 m in front of camera 0;
+// sample i depends only on (seed, i), or on seed alone when `fixed`.
+class FakeSamples : public TrainingSampleSource {
+ public:
+  FakeSamples(const PoemConfig& c, uint64_t seed, bool fixed)
+      : c_(c), seed_(seed), fixed_(fixed) {}
+  int num_views() const override { return c_.num_views; }
+  int crop_size() const override { return c_.crop_size; }
+  TrainingSample Sample(int64_t index) const override {
+    std::mt19937_64 rng(seed_ * 1000003 + (fixed_ ? 0 : index));
+    std::normal_distribution<double> normal(0, 1);
+    const int S = c_.crop_size;
+    TrainingSample s;
+    s.index = index;
+    const Eigen::Vector3d center(0.02 * normal(rng), 0.02 * normal(rng), 0.6);
+    s.joints_3d.resize(21, 3);
+    s.vertices_3d.resize(778, 3);
+    for (int i = 0; i < 21; ++i)
+      s.joints_3d.row(i) =
+          center.transpose() +
+          0.04 * Eigen::RowVector3d(normal(rng), normal(rng), normal(rng));
+    for (int i = 0; i < 778; ++i)
+      s.vertices_3d.row(i) =
+          center.transpose() +
+          0.04 * Eigen::RowVector3d(normal(rng), normal(rng), normal(rng));
+    for (int n = 0; n < c_.num_views; ++n) {
+      TrainingView v;
+      Rigid3 cam_from_master;
+      if (n > 0) {
+        const double a = 2 * M_PI * n / (c_.num_views + 1);
+        const Eigen::Vector3d eye = Eigen::Vector3d(0, 0, 0.6) +
+                                    0.6 * Eigen::Vector3d(std::sin(a), 0.1, -std::cos(a));
+        cam_from_master =
+            LookAt(eye, Eigen::Vector3d(0, 0, 0.6), Eigen::Vector3d(0, -1, 0));
+      }
+      const Rigid3 master_from_cam = cam_from_master.Inverse();
+      v.master_from_cam.setIdentity();
+      v.master_from_cam.topRows<3>() = master_from_cam.ToMatrix();
+      const double f = 2.0 * S;
+      v.intrinsics << f, 0, S / 2.0, 0, f, S / 2.0, 0, 0, 1;
+      for (int k = 0; k < 21; ++k) {
+        const Eigen::Vector3d p = cam_from_master * Eigen::Vector3d(s.joints_3d.row(k));
+        v.joints_2d.row(k) << f * p.x() / p.z() + S / 2.0, f * p.y() / p.z() + S / 2.0;
+        v.joints_2d_weight[k] = 1;
+      }
+      v.image.resize(3 * S * S);
+      std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+      for (float& x : v.image) x = u(rng);
+      s.views.push_back(std::move(v));
+    }
+    return s;
+  }
+
+ private:
+  PoemConfig c_;
+  uint64_t seed_;
+  bool fixed_;
+};
+
+PoemTrainerOptions TinyOptions(const std::string& dir) {
+  PoemTrainerOptions o;
+  o.steps = 6;
+  o.batch_size = 2;
+  o.learning_rate = 1e-3;
+  o.warmup_steps = 2;
+  o.checkpoint_every = 2;
+  o.log_every = 1;
+  o.validate_every = 3;
+  o.validation_samples = 2;
+  o.seed = 3;
+  o.threads = 1;
+  o.out_dir = dir;
+  return o;
+}
+
+std::map<std::string, torch::Tensor> Weights(const std::string& run) {
+  PoemModel m = LoadPoemCheckpoint(LatestPoemCheckpointModel(run));
+  return PoemStateDict(m);
+}
+
+TEST(PoemTrainer, OverfitsAFixedBatch) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const FakeSamples fixed(c, 7, /*fixed=*/true);
+  PoemTrainerOptions o = TinyOptions(testing::ScratchDir() + "/run");
+  o.steps = 12;
+  o.learning_rate = 2e-3;
+  o.validate_every = 0;
+  o.checkpoint_every = 12;
+  std::vector<double> losses;
+  PoemTrainerHooks hooks;
+  hooks.progress = [&](const std::string& line) {
+    losses.push_back(std::stod(line.substr(line.find("loss ") + 5)));
+  };
+  PoemTrainer trainer(c, MakeRegressorModel(), fixed, nullptr, o, hooks);
+  const PoemTrainSummary s = trainer.Run(false);
+  EXPECT_EQ(s.end_step, 12);
+  ASSERT_EQ(losses.size(), 12u);
+  EXPECT_LT(losses.back(), 0.7 * losses.front());
+}
+
+TEST(PoemTrainer, ResumeContinuesBitIdentically) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const FakeSamples train(c, 11, false), validation(c, 12, false);
+  const HandModel hand = MakeRegressorModel();
+  const std::string a = testing::ScratchDir() + "/a", b = testing::ScratchDir() + "/b";
+  {
+    PoemTrainer t(c, hand, train, &validation, TinyOptions(a));
+    EXPECT_EQ(t.Run(false).end_step, 6);
+  }
+  {
+    PoemTrainer t(c, hand, train, &validation, TinyOptions(b));
+    EXPECT_EQ(t.Run(false, /*stop_at_step=*/3).end_step, 3);
+  }
+  EXPECT_EQ(LatestPoemCheckpointStep(b), 3);
+  {
+    // A fresh process would do the same: a new trainer, starting from random weights.
+    PoemTrainer t(c, hand, train, &validation, TinyOptions(b));
+    const PoemTrainSummary s = t.Run(/*resume=*/true);
+    EXPECT_EQ(s.start_step, 3);
+    EXPECT_EQ(s.end_step, 6);
+  }
+  const auto wa = Weights(a), wb = Weights(b);
+  ASSERT_EQ(wa.size(), wb.size());
+  for (const auto& [key, value] : wa) {
+    EXPECT_TRUE(torch::equal(value, wb.at(key))) << key;
+  }
+  // The loss logs agree row for row (no duplicated rows after the resume).
+  auto read = [](const std::string& p) {
+    std::ifstream in(p);
+    std::vector<std::string> cols;
+    std::string line;
+    while (std::getline(in, line)) {
+      // Drop samples/s and wall time (the last two columns).
+      for (int k = 0; k < 2; ++k) line = line.substr(0, line.rfind(','));
+      cols.push_back(line);
+    }
+    return cols;
+  };
+  EXPECT_EQ(read(a + "/loss.csv"), read(b + "/loss.csv"));
+  EXPECT_EQ(read(a + "/validation.csv"), read(b + "/validation.csv"));
+}
+
+TEST(PoemTrainer, RefusesToOverwriteARunWithoutResume) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const FakeSamples train(c, 1, false);
+  PoemTrainerOptions o = TinyOptions(testing::ScratchDir() + "/run");
+  o.steps = 1;
+  PoemTrainer(c, MakeRegressorModel(), train, nullptr, o).Run(false);
+  PoemTrainer again(c, MakeRegressorModel(), train, nullptr, o);
+  EXPECT_THROW(again.Run(false), InputError);
+}
+
+TEST(PoemTrainer, LearningRateScheduleWarmsUpAndDecays) {
+  PoemTrainerOptions o;
+  o.steps = 1000;
+  o.learning_rate = 1e-3;
+  o.warmup_steps = 100;
+  o.decay_at = 0.7;
+  o.decay_factor = 0.1;
+  EXPECT_DOUBLE_EQ(PoemLearningRate(o, 0), 1e-4);
+  EXPECT_DOUBLE_EQ(PoemLearningRate(o, 50), 1e-3 * (0.1 + 0.9 * 0.5));
+  EXPECT_DOUBLE_EQ(PoemLearningRate(o, 100), 1e-3);
+  EXPECT_DOUBLE_EQ(PoemLearningRate(o, 699), 1e-3);
+  EXPECT_DOUBLE_EQ(PoemLearningRate(o, 700), 1e-4);
+}
+
+TEST(PoemTrainer, HalfCheckpointLoadsCloseToTheOriginal) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const FakeSamples train(c, 5, false);
+  const std::string dir = testing::ScratchDir();
+  PoemTrainerOptions o = TinyOptions(dir + "/run");
+  o.steps = 1;
+  PoemTrainer t(c, MakeRegressorModel(), train, nullptr, o);
+  t.Run(false);
+  ConvertPoemCheckpointToHalf(LatestPoemCheckpointModel(dir + "/run"), dir + "/half.pt");
+  PoemModel full = LoadPoemCheckpoint(LatestPoemCheckpointModel(dir + "/run"));
+  PoemModel half = LoadPoemCheckpoint(dir + "/half.pt");
+  const auto fw = PoemStateDict(full), hw = PoemStateDict(half);
+  for (const auto& [key, value] : fw) {
+    if (!value.is_floating_point()) continue;
+    EXPECT_TRUE(torch::allclose(value, hw.at(key), 2e-3, 1e-4)) << key;
+  }
+  EXPECT_LT(std::filesystem::file_size(dir + "/half.pt"),
+            0.7 * std::filesystem::file_size(LatestPoemCheckpointModel(dir + "/run")));
+}
+
+}  // namespace
+}  // namespace handlabel

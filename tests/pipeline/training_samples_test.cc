@@ -1,0 +1,122 @@
+#include "pipeline/training_samples.h"
+
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "pipeline/capsule_hand.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+SynthCaptureOptions SmallSynth(uint64_t seed) {
+  SynthCaptureOptions o;
+  o.rig.preset = "dexycb";
+  o.rig.width = 320;  // intrinsics scaled: fx != fy is fine, crops stay square-pixel
+  o.rig.height = 200;
+  o.seed = seed;
+  return o;
+}
+
+TrainingSampleOptions StrongAugmentation() {
+  TrainingSampleOptions o;
+  o.crop_size = 64;
+  o.augment.rotation_probability = 1.0;
+  o.augment.rotation_sigma_deg = 30.0;
+  o.augment.scale_sigma = 0.1;
+  o.augment.noise_rect_probability = 0.5;
+  return o;
+}
+
+// The 3D targets seen through each view's (augmented) extrinsic and crop intrinsics
+// land exactly on the 2D targets, whatever the rotation folded into the extrinsic.
+TEST(TrainingSamples, FoldedAugmentationKeepsProjectionsOnThe2dTargets) {
+  const SynthTrainingSamples source(MakeCapsuleHand(HandSide::kRight), SmallSynth(3),
+                                    StrongAugmentation());
+  for (int64_t index : {0, 5}) {
+    const TrainingSample s = source.Sample(index);
+    ASSERT_EQ(s.views.size(), 8u);
+    EXPECT_TRUE(s.views[0].master_from_cam.isIdentity(0));
+    for (const TrainingView& v : s.views) {
+      EXPECT_DOUBLE_EQ(v.intrinsics(0, 0), v.intrinsics(1, 1));  // square pixels
+      EXPECT_EQ(v.intrinsics(0, 1), 0.0);                        // no skew
+      const Eigen::Matrix4d cam_from_master = v.master_from_cam.inverse();
+      EXPECT_NEAR((v.master_from_cam.topLeftCorner<3, 3>().determinant()), 1.0, 1e-12);
+      for (int k = 0; k < 21; ++k) {
+        const Eigen::Vector3d p =
+            (cam_from_master * s.joints_3d.row(k).transpose().homogeneous()).head<3>();
+        const Eigen::Vector3d uvw = v.intrinsics * p;
+        EXPECT_NEAR(uvw.x() / uvw.z(), v.joints_2d(k, 0), 1e-6);
+        EXPECT_NEAR(uvw.y() / uvw.z(), v.joints_2d(k, 1), 1e-6);
+      }
+    }
+  }
+}
+
+// Crops around the 2D box (side 2x the box) hold every keypoint, even after scale and
+// rotation jitter; without augmentation the box is centred.
+TEST(TrainingSamples, CropsHoldTheHand) {
+  const SynthTrainingSamples augmented(MakeCapsuleHand(HandSide::kRight), SmallSynth(4),
+                                       StrongAugmentation());
+  TrainingSampleOptions plain = StrongAugmentation();
+  plain.augment.enabled = false;
+  const SynthTrainingSamples clean(MakeCapsuleHand(HandSide::kRight), SmallSynth(4),
+                                   plain);
+  for (const SynthTrainingSamples* src : {&augmented, &clean}) {
+    const TrainingSample s = src->Sample(2);
+    for (const TrainingView& v : s.views) {
+      if (v.joints_2d_weight[0] == 0) continue;
+      EXPECT_GE(v.joints_2d.minCoeff(), 0.0);
+      EXPECT_LE(v.joints_2d.maxCoeff(), 64.0);
+    }
+  }
+  const TrainingSample s = clean.Sample(2);
+  for (const TrainingView& v : s.views) {
+    const Eigen::Vector2d lo = v.joints_2d.colwise().minCoeff(),
+                          hi = v.joints_2d.colwise().maxCoeff();
+    EXPECT_NEAR(0.5 * (lo + hi).x(), 32.0, 1e-6);
+    EXPECT_NEAR(std::max(hi.x() - lo.x(), hi.y() - lo.y()), 32.0, 1e-6);
+  }
+}
+
+TEST(TrainingSamples, SameIndexSameSampleAndReuseGroups) {
+  TrainingSampleOptions o = StrongAugmentation();
+  o.frame_reuse = 3;
+  o.reuse_group = 2;
+  const SynthTrainingSamples a(MakeCapsuleHand(HandSide::kRight), SmallSynth(5), o);
+  const SynthTrainingSamples b(MakeCapsuleHand(HandSide::kRight), SmallSynth(5), o);
+  const TrainingSample s1 = a.Sample(7), s2 = b.Sample(7), s3 = a.Sample(7);
+  EXPECT_EQ(s1.views[3].image, s2.views[3].image);
+  EXPECT_EQ(s1.views[3].image, s3.views[3].image);
+  EXPECT_EQ(s1.joints_3d, s2.joints_3d);
+  // Samples 0, 1 | 2, 3 | 4, 5 use frames 0, 1; samples 6, 7 use frames 2, 3.
+  const std::vector<int64_t> frames = {0, 1, 0, 1, 0, 1, 2, 3};
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(TrainingFrameOf(i, o), frames[i]) << i;
+  EXPECT_EQ(a.Sample(2).frame, 0);
+  EXPECT_NE(a.Sample(2).views[1].image, a.Sample(0).views[1].image);  // new augmentation
+}
+
+TEST(TrainingSamples, ImagesAreNormalisedAndGainStaysInRange) {
+  const SynthTrainingSamples source(MakeCapsuleHand(HandSide::kRight), SmallSynth(6),
+                                    StrongAugmentation());
+  const TrainingSample s = source.Sample(1);
+  for (const TrainingView& v : s.views) {
+    ASSERT_EQ(v.image.size(), 3u * 64 * 64);
+    for (float x : v.image) {
+      ASSERT_GE(x, -0.5f);
+      ASSERT_LE(x, 0.5f);
+    }
+  }
+}
+
+TEST(TrainingSamples, OptionsRejectBadValues) {
+  TrainingSampleOptions o;
+  o.crop_size = 100;
+  EXPECT_THROW(o.Check(), InputError);
+  o = TrainingSampleOptions();
+  o.augment.gain_min = 1.5;
+  EXPECT_THROW(o.Check(), InputError);
+}
+
+}  // namespace
+}  // namespace handlabel
