@@ -306,5 +306,25 @@ TEST(TorchArchive, RefusesViewsOutsideTheirStorage) {
   EXPECT_NE(error.find("stride"), std::string::npos) << error;
 }
 
+// Python 2 protocol 0 (text) forms that Python 3 never writes: STRING with repr
+// escapes, INT booleans, LONG with the L suffix, FLOAT, UNICODE raw escapes.
+TEST(PickleReader, ReadsPython2TextProtocol) {
+  const std::string p0 =
+      "(dp0\nS'str'\np1\nS'a\\x00b\\n\\'c\\\\'\np2\nsS'flag'\np3\nI01\nsS'long'\np4\n"
+      "L12345678901L\nsS'float'\np5\nF0.25\nsS'uni'\np6\nVh\\u00e9\\u2603\np7\ns"
+      "S'list'\np8\n(lp9\nI1\naI-2\nag1\nas.";
+  const PickleValue v = ReadPickle(p0, "p0.pkl");
+  ASSERT_EQ(v.kind, K::kDict) << v.Describe();
+  EXPECT_EQ(v.Find("str")->text, std::string("a\0b\n'c\\", 7));
+  EXPECT_TRUE(v.Find("flag")->boolean);
+  EXPECT_EQ(v.Find("long")->integer, 12345678901);
+  EXPECT_EQ(v.Find("float")->real, 0.25);
+  EXPECT_EQ(v.Find("uni")->text, "h\xc3\xa9\xe2\x98\x83");
+  const PickleValue* list = v.Find("list");
+  ASSERT_EQ(list->items.size(), 3u);
+  EXPECT_EQ(list->items[1].integer, -2);
+  EXPECT_EQ(list->items[2].text, "str");  // GET of the memoised key
+}
+
 }  // namespace
 }  // namespace handlabel
