@@ -6,73 +6,12 @@
 #include <set>
 
 #include "core/errors.h"
+#include "pipeline/yaml_section.h"
 
 namespace handlabel {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Walks one YAML mapping, remembering which keys were read so unknown ones are reported.
-class Section {
- public:
-  Section(const YAML::Node& node, std::string file, std::string prefix)
-      : node_(node), file_(std::move(file)), prefix_(std::move(prefix)) {
-    if (node_ && !node_.IsMap()) {
-      throw InputError(file_, prefix_.empty() ? "(top level)" : prefix_, "a mapping");
-    }
-  }
-
-  template <typename T>
-  void Read(const char* key, T* value) {
-    seen_.insert(key);
-    if (!node_ || !node_[key]) return;
-    try {
-      *value = node_[key].as<T>();
-    } catch (const YAML::Exception&) {
-      throw InputError(file_, Name(key), TypeName(value), "'" + Text(key) + "'");
-    }
-  }
-
-  Section Child(const char* key) {
-    seen_.insert(key);
-    return Section(node_ ? node_[key] : YAML::Node(), file_, Name(key));
-  }
-
-  void RejectUnknownKeys() const {
-    if (!node_) return;
-    for (const auto& entry : node_) {
-      const std::string key = entry.first.as<std::string>();
-      if (!seen_.count(key)) {
-        std::string known;
-        for (const std::string& k : seen_) known += (known.empty() ? "" : ", ") + k;
-        throw InputError(file_, Name(key.c_str()), "a known key (" + known + ")",
-                         "unknown key");
-      }
-    }
-  }
-
-  std::string Name(const char* key) const {
-    return prefix_.empty() ? key : prefix_ + "." + key;
-  }
-
- private:
-  std::string Text(const char* key) const {
-    YAML::Emitter out;
-    out << node_[key];
-    return out.c_str();
-  }
-  static const char* TypeName(std::string*) { return "a string"; }
-  static const char* TypeName(int*) { return "an integer"; }
-  static const char* TypeName(uint64_t*) { return "a non-negative integer"; }
-  static const char* TypeName(double*) { return "a number"; }
-  static const char* TypeName(bool*) { return "true or false"; }
-  static const char* TypeName(std::vector<std::string>*) { return "a list of strings"; }
-
-  YAML::Node node_;
-  std::string file_;
-  std::string prefix_;
-  std::set<std::string> seen_;
-};
 
 template <typename E>
 E ParseEnum(const std::string& text,
@@ -232,7 +171,8 @@ JobConfig LoadJobConfig(const std::string& path) {
 
   job.input_path = Resolve(job.input_path, base);
   job.cameras_file = Resolve(job.cameras_file, base);
-  if (job.hand_model != "capsule") job.hand_model = Resolve(job.hand_model, base);  // built-in
+  if (job.hand_model != "capsule")
+    job.hand_model = Resolve(job.hand_model, base);  // built-in
   job.network_weights = Resolve(job.network_weights, base);
   job.output_dir = Resolve(job.output_dir, base);
   job.Check();

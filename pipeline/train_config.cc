@@ -10,61 +10,10 @@
 #include "core/hand_model_io.h"
 #include "pipeline/build_config.h"
 #include "pipeline/open_hand_builder.h"
+#include "pipeline/yaml_section.h"
 
 namespace handlabel {
 namespace {
-
-// One YAML mapping; remembers the keys read so unknown ones are reported.
-class Section {
- public:
-  Section(const YAML::Node& node, std::string file, std::string prefix)
-      : node_(node), file_(std::move(file)), prefix_(std::move(prefix)) {
-    if (node_ && !node_.IsMap()) {
-      throw InputError(file_, prefix_.empty() ? "(top level)" : prefix_, "a mapping");
-    }
-  }
-  template <typename T>
-  void Read(const char* key, T* value) {
-    seen_.insert(key);
-    if (!node_ || !node_[key]) return;
-    try {
-      *value = node_[key].as<T>();
-    } catch (const YAML::Exception&) {
-      YAML::Emitter out;
-      out << node_[key];
-      throw InputError(file_, Name(key), "a value of the right type",
-                       std::string("'") + out.c_str() + "'");
-    }
-  }
-  Section Child(const char* key) {
-    seen_.insert(key);
-    return Section(node_ ? node_[key] : YAML::Node(), file_, Name(key));
-  }
-  YAML::Node Raw(const char* key) {
-    seen_.insert(key);
-    return node_ ? node_[key] : YAML::Node();
-  }
-  void RejectUnknownKeys() const {
-    if (!node_) return;
-    for (const auto& entry : node_) {
-      const std::string key = entry.first.as<std::string>();
-      if (!seen_.count(key)) {
-        std::string known;
-        for (const std::string& k : seen_) known += (known.empty() ? "" : ", ") + k;
-        throw InputError(file_, Name(key.c_str()), "a known key (" + known + ")",
-                         "unknown key");
-      }
-    }
-  }
-  std::string Name(const char* key) const {
-    return prefix_.empty() ? key : prefix_ + "." + key;
-  }
-
- private:
-  YAML::Node node_;
-  std::string file_, prefix_;
-  std::set<std::string> seen_;
-};
 
 // Scalars of a YAML mapping as JSON numbers, booleans or strings; lists as arrays.
 nlohmann::json ToJson(const YAML::Node& node) {
