@@ -24,6 +24,7 @@ int RunModel(int argc, char** argv);
 // `model build` / `model render` (apps/model_build_command.cc).
 int RunModelBuild(int argc, char** argv);
 int RunModelRender(int argc, char** argv);
+int RunModelExport(int argc, char** argv);
 int RunLabel(int argc, char** argv);
 int RunMerge(int argc, char** argv);
 int RunCameras(int argc, char** argv);

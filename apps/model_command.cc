@@ -155,6 +155,8 @@ const std::vector<ModelSubcommand>& ModelSubcommands() {
       {"build", "build the open hand model (ours, MANO-compatible)", RunModelBuild},
       {"render", "render a preview sheet (PNG) of a model in several poses",
        RunModelRender},
+      {"export", "write the mesh in a named pose and shape as PLY or OBJ",
+       RunModelExport},
   };
   return table;
 }
