@@ -50,7 +50,7 @@ def main():
         "kintree_table": np.array([[4294967295, 0], [0, 1]], dtype=np.int64),
         "bs_style": "lbs",
     }
-    save("mano_py2_tiny.pkl", dumps(tiny, fx.Py2Pickler, 2))
+    save("fixture_py2_tiny.pkl", dumps(tiny, fx.Py2Pickler, 2))
     plain = {k: v for k, v in tiny.items() if isinstance(v, (np.ndarray, str))}
     plain["scalar"] = np.float32(1.5)
     plain["fortran"] = np.asfortranarray(rng.normal(size=(2, 2)))
