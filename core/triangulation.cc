@@ -21,31 +21,63 @@ void RobustTriangulationOptions::Check() const {
     throw InputError(src, "max_pairs", ">= 1", std::to_string(max_pairs));
 }
 
-std::optional<Eigen::Vector3d> TriangulateWeighted(
-    const Rig& rig, const std::vector<ViewObservation>& observations) {
-  Eigen::Matrix<double, Eigen::Dynamic, 4> a(2 * observations.size(), 4);
-  int rows = 0;
-  for (const ViewObservation& obs : observations) {
-    HL_CHECK(obs.camera >= 0 && obs.camera < static_cast<int>(rig.size()),
-             "observation camera index");
-    if (!(obs.confidence > 0)) continue;
-    const RigCamera& cam = rig[obs.camera];
-    const Eigen::Vector2d xy = cam.camera.NormalizedFromImage(obs.uv_px);
-    const Matrix3x4d p = cam.cam_from_world.ToMatrix();
-    a.row(rows++) = obs.confidence * (xy.x() * p.row(2) - p.row(0));
-    a.row(rows++) = obs.confidence * (xy.y() * p.row(2) - p.row(1));
+namespace {
+
+// An observation with its undistorted normalised coordinates and its camera's projection
+// matrix worked out once: RANSAC reuses each observation in many hypotheses.
+struct PreparedObservation {
+  Eigen::Vector2d xy;
+  Matrix3x4d cam_from_world;
+  double confidence = 0;
+};
+
+PreparedObservation Prepare(const Rig& rig, const ViewObservation& obs) {
+  HL_CHECK(obs.camera >= 0 && obs.camera < static_cast<int>(rig.size()),
+           "observation camera index");
+  const RigCamera& cam = rig[obs.camera];
+  return {cam.camera.NormalizedFromImage(obs.uv_px), cam.cam_from_world.ToMatrix(),
+          obs.confidence};
+}
+
+// DLT through the 4x4 normal matrix A^T A: its eigenvector of the smallest eigenvalue is
+// A's last right singular vector, at a fixed size whatever the number of views.
+std::optional<Eigen::Vector3d> TriangulatePrepared(
+    const std::vector<const PreparedObservation*>& observations) {
+  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+  int used = 0;
+  for (const PreparedObservation* obs : observations) {
+    if (!(obs->confidence > 0)) continue;
+    const Matrix3x4d& p = obs->cam_from_world;
+    const Eigen::RowVector4d rx = obs->confidence * (obs->xy.x() * p.row(2) - p.row(0));
+    const Eigen::RowVector4d ry = obs->confidence * (obs->xy.y() * p.row(2) - p.row(1));
+    normal.noalias() += rx.transpose() * rx + ry.transpose() * ry;
+    ++used;
   }
-  if (rows < 4) return std::nullopt;
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(a.topRows(rows), Eigen::ComputeFullV);
+  if (used < 2) return std::nullopt;
+  const Eigen::JacobiSVD<Eigen::Matrix4d> svd(normal, Eigen::ComputeFullV);
   const Eigen::Vector4d h = svd.matrixV().col(3);
   if (std::abs(h[3]) < 1e-12) return std::nullopt;
   const Eigen::Vector3d point = h.head<3>() / h[3];
-  for (const ViewObservation& obs : observations) {
-    if (obs.confidence > 0 && (rig[obs.camera].cam_from_world * point).z() <= 0) {
+  for (const PreparedObservation* obs : observations) {
+    if (obs->confidence > 0 && obs->cam_from_world.row(2).dot(point.homogeneous()) <= 0) {
       return std::nullopt;
     }
   }
   return point;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> TriangulateWeighted(
+    const Rig& rig, const std::vector<ViewObservation>& observations) {
+  std::vector<PreparedObservation> prepared;
+  std::vector<const PreparedObservation*> pointers;
+  prepared.reserve(observations.size());
+  for (const ViewObservation& obs : observations) {
+    prepared.push_back(Prepare(rig, obs));
+    pointers.push_back(&prepared.back());
+  }
+  return TriangulatePrepared(pointers);
 }
 
 double ReprojectionErrorPx(const Rig& rig, const ViewObservation& observation,
@@ -79,10 +111,13 @@ RobustTriangulation TriangulateRobust(const Rig& rig,
     pairs.resize(options.max_pairs);
   }
 
+  std::vector<PreparedObservation> prepared(observations.size());
+  for (int k : usable) prepared[k] = Prepare(rig, observations[k]);
+
   double best_score = -1;
   double best_error = std::numeric_limits<double>::infinity();
   for (const auto& [i, j] : pairs) {
-    const auto hypothesis = TriangulateWeighted(rig, {observations[i], observations[j]});
+    const auto hypothesis = TriangulatePrepared({&prepared[i], &prepared[j]});
     if (!hypothesis) continue;
     double score = 0;
     double error_sum = 0;
@@ -106,9 +141,9 @@ RobustTriangulation TriangulateRobust(const Rig& rig,
     best.valid = false;
     return best;
   }
-  std::vector<ViewObservation> inlier_obs;
-  for (int k : best.inliers) inlier_obs.push_back(observations[k]);
-  if (const auto refined = TriangulateWeighted(rig, inlier_obs)) best.point = *refined;
+  std::vector<const PreparedObservation*> inlier_obs;
+  for (int k : best.inliers) inlier_obs.push_back(&prepared[k]);
+  if (const auto refined = TriangulatePrepared(inlier_obs)) best.point = *refined;
   best.valid = true;
   return best;
 }

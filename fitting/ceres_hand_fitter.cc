@@ -160,6 +160,7 @@ void HandFitOptions::Check() const {
   RequirePositive(silhouette_contour_cosine, "silhouette_contour_cosine");
   RequireNonNegative(rigid_iterations, "rigid_iterations");
   RequireNonNegative(keypoint_iterations, "keypoint_iterations");
+  RequireNonNegative(init_iterations, "init_iterations");
   RequireNonNegative(silhouette_iterations, "silhouette_iterations");
   RequirePositive(function_tolerance, "function_tolerance");
   RequirePositive(parameter_tolerance, "parameter_tolerance");
@@ -287,7 +288,7 @@ class FitRun {
         if (!config_.optimise_shape) problem.Hold(b->betas);
       }
       problem.Solve(SolverOptions(options_, stage == 0 ? options_.rigid_iterations
-                                                       : options_.keypoint_iterations));
+                                                       : options_.init_iterations));
     }
   }
 

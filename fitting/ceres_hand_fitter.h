@@ -83,8 +83,11 @@ struct HandFitOptions {
   int rigid_iterations = 20;
   int keypoint_iterations = 60;
   int silhouette_iterations = 10;
+  // Pose-and-shape iterations of the 3D initialisation (InitFromKeypoints3d/Views): it
+  // must land in the keypoint stages' basin; fewer iterations miss it (tested).
+  int init_iterations = 60;
   // Ceres convergence tolerances.
-  double function_tolerance = 1e-8;
+  double function_tolerance = 1e-6;
   double parameter_tolerance = 1e-10;
   // Threads Ceres may use inside one frame (frames run in parallel elsewhere).
   int num_threads = 1;
