@@ -37,6 +37,8 @@ struct Batch {
   std::vector<std::optional<FrameInput>> inputs;
   std::vector<std::optional<MeshPrediction>> predictions;
   std::vector<std::string> errors;  // non-empty: the frame failed in an earlier stage
+  // Non-empty: the network failed on this frame; in fallback mode the fitter takes over.
+  std::vector<std::string> network_errors;
   std::vector<double> seconds;
 };
 
@@ -221,6 +223,10 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
     FrameRecord record;
     record.frame = batch.ids[i];
     std::string error = batch.errors[i];
+    const std::string& network_error = batch.network_errors[i];
+    const bool fit_instead =
+        job.refine_mode == RefineMode::kFallback && context.fitter != nullptr;
+    if (error.empty() && !network_error.empty() && !fit_instead) error = network_error;
     if (error.empty()) {
       try {
         const FrameInput& frame = *batch.inputs[i];
@@ -228,6 +234,7 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
             batch.predictions[i] ? &*batch.predictions[i] : nullptr;
         FrameOutcome outcome =
             LabelFrame(context, frame, prediction, FrameSeed(job.seed, frame.id));
+        if (!network_error.empty()) outcome.label.fit["why"] = network_error;
         if (stages.overlays && job.overlays)
           stages.overlays->Write(out, frame, outcome.label);
         WriteLabelFiles(out, outcome.label, stages.faces, job.meshes);
@@ -236,6 +243,7 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
         record.metrics = std::move(outcome.metrics);
       } catch (...) {
         error = Describe(std::current_exception());
+        if (!network_error.empty()) error = network_error + "; fallback fit: " + error;
       }
     }
     if (!error.empty()) {
@@ -272,6 +280,7 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
               batch->inputs.resize(n);
               batch->predictions.resize(n);
               batch->errors.resize(n);
+              batch->network_errors.resize(n);
               batch->seconds.assign(n, 0.0);
               return batch;
             }) &
@@ -322,8 +331,8 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
                         HL_CHECK(single.size() == 1, "one prediction per frame");
                         batch->predictions[ready[k]] = std::move(single[0]);
                       } catch (...) {
-                        batch->errors[ready[k]] =
-                            "network: " + Describe(std::current_exception());
+                        batch->network_errors[ready[k]] =
+                            "network failed: " + Describe(std::current_exception());
                       }
                     }
                   }

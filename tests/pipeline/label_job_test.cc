@@ -163,6 +163,28 @@ TEST(LabelJob, AFailingFrameIsRecordedWithItsReasonAndTheJobGoesOn) {
   EXPECT_EQ(again.skipped, 9);
 }
 
+TEST(LabelJob, InFallbackModeAFrameTheNetworkFailsOnIsFitFromFileEvidence) {
+  Stages s;
+  s.predictor.throws = {"000004"};
+  const std::string scratch = testing::ScratchDir();
+  const std::string out = scratch + "/out";
+  JobConfig job = MakeJob(out, RefineMode::kFallback);
+  job.keypoints = KeypointSource::kBoth;  // files where present, else the network's
+  const LabelSummary summary = RunLabelJob(job, s.Set(), {});
+  EXPECT_EQ(summary.ok, 12);
+  EXPECT_EQ(summary.by_path.at("fallback_fit"), 1);
+  const LabelRecord label = ReadLabelFile(LabelFilePath(out, "000004"));
+  EXPECT_EQ(label.path, LabelPath::kFallbackFit);
+  EXPECT_THAT(label.fit.at("why").get<std::string>(), HasSubstr("network exploded"));
+  EXPECT_TRUE(label.quality.flags.empty());  // no network answer to check
+
+  // refine off cannot fit: the frame fails with the network's reason.
+  const std::string out_off = scratch + "/out_off";
+  const LabelSummary off = RunLabelJob(MakeJob(out_off, RefineMode::kOff), s.Set(), {});
+  EXPECT_EQ(off.failed, 1);
+  EXPECT_THAT(off.failures.at(0).second, HasSubstr("network exploded"));
+}
+
 TEST(LabelJob, ResumeRedoesExactlyTheUnfinishedFramesAndGivesIdenticalLabels) {
   Stages s;
   const std::string out = testing::ScratchDir() + "/out";
