@@ -4,6 +4,7 @@
 #include "pipeline/ceres_label_fitter.h"
 #include "pipeline/dexycb_frame_source.h"
 #include "pipeline/hand_model_source.h"
+#include "pipeline/ho3d_frame_source.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/native_frame_source.h"
 #include "pipeline/poem_mesh_predictor.h"
@@ -32,10 +33,12 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
   if (job.input_format == "dexycb") {
     return std::make_unique<DexYcbFrameSource>(job.input_path, cameras);
   }
-  // HO3D / OakInk layouts: convert to the native layout first (their readers plug in
-  // here).
+  if (job.input_format == "ho3d") {
+    return std::make_unique<Ho3dFrameSource>(job.input_path, cameras);
+  }
+  // OakInk: convert to the native layout first (its reader plugs in here).
   throw InputError(job.source_file, "input.format",
-                   "a format this build reads directly (native, dexycb)",
+                   "a format this build reads directly (native, dexycb, ho3d)",
                    "'" + job.input_format + "'");
 }
 
