@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/image_file.h"
 #include "core/rasterizer.h"
 #include "pipeline/atomic_file.h"
 #include "pipeline/label_outputs.h"
@@ -90,7 +91,7 @@ void RasterOverlayWriter::Write(const std::string& output_dir, const FrameInput&
     const RigCamera& camera = frame.rig[v];
     ImageU8 rgb;
     try {
-      if (v < frame.image_paths.size()) rgb = ReadPng(frame.image_paths[v]);
+      if (v < frame.image_paths.size()) rgb = ReadImageFile(frame.image_paths[v]);
     } catch (const std::exception&) {
       rgb = ImageU8();
     }

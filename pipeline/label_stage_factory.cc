@@ -2,7 +2,9 @@
 
 #include "core/errors.h"
 #include "pipeline/ceres_label_fitter.h"
+#include "pipeline/dexycb_frame_source.h"
 #include "pipeline/hand_model_source.h"
+#include "pipeline/ho3d_frame_source.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/native_frame_source.h"
 #include "pipeline/poem_mesh_predictor.h"
@@ -28,21 +30,22 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
   if (job.input_format == "native") {
     return std::make_unique<NativeFrameSource>(job.input_path, cameras);
   }
-  // DexYCB / HO3D / OakInk layouts: convert to the native layout first (their readers
-  // plug in here).
+  if (job.input_format == "dexycb") {
+    return std::make_unique<DexYcbFrameSource>(job.input_path, cameras);
+  }
+  if (job.input_format == "ho3d") {
+    return std::make_unique<Ho3dFrameSource>(job.input_path, cameras);
+  }
+  // OakInk: convert to the native layout first (its reader plugs in here).
   throw InputError(job.source_file, "input.format",
-                   "a format this build reads directly (native)",
+                   "a format this build reads directly (native, dexycb, ho3d)",
                    "'" + job.input_format + "'");
 }
 
 BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   BuiltLabelStages built;
   built.source = BuildFrameSource(job);
-  HandSide side = HandSide::kRight;
-  if (const auto* native = dynamic_cast<const NativeFrameSource*>(built.source.get())) {
-    side = native->reader().manifest().hand_side == "left" ? HandSide::kLeft
-                                                           : HandSide::kRight;
-  }
+  const HandSide side = built.source->Side().value_or(HandSide::kRight);
   built.hand_model = ResolveHandModel(job.hand_model, side).model;
   if (!job.network_weights.empty()) {
     built.predictor = std::make_unique<PoemMeshPredictor>(job.network_weights,

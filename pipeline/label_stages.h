@@ -64,6 +64,9 @@ class FrameSource {
   virtual FrameInput Load(const std::string& id) const = 0;
   // One line for logs ("native capture /data/cap1, 8 cameras, 1200 frames").
   virtual std::string Describe() const = 0;
+  // Which hand the capture shows, when it says (the hand model is built for it);
+  // nullopt: the right hand.
+  virtual std::optional<HandSide> Side() const { return std::nullopt; }
 };
 
 class MeshPredictor {

@@ -53,6 +53,10 @@ std::string NativeFrameSource::Describe() const {
          ", ground truth: " + (reader_.Has(kFileGroundTruth) ? "yes" : "no") + ")";
 }
 
+std::optional<HandSide> NativeFrameSource::Side() const {
+  return reader_.manifest().hand_side == "left" ? HandSide::kLeft : HandSide::kRight;
+}
+
 FrameInput NativeFrameSource::Load(const std::string& id) const {
   const int f = reader_.FrameIndex(id);
   if (f < 0)

@@ -4,6 +4,7 @@
 
 #include "core/errors.h"
 #include "core/image.h"
+#include "core/image_file.h"
 #include "pipeline/sha256.h"
 
 namespace handlabel {
@@ -39,7 +40,7 @@ std::vector<MeshPrediction> PoemMeshPredictor::Predict(
     HandMeshInput input;
     crops.emplace_back();
     for (size_t v = 0; v < rig.size(); ++v) {
-      const ImageU8 image = ReadPng(frame->image_paths.at(v));
+      const ImageU8 image = ReadImageFile(frame->image_paths.at(v));
       if (image.channels != 3) {
         throw InputError(frame->image_paths[v], "channels", "an RGB image",
                          std::to_string(image.channels));

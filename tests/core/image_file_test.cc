@@ -1,0 +1,111 @@
+// JPEG files through libjpeg, and reading PNG or JPEG by content.
+#include "core/image_file.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "core/errors.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Smooth gradients with a sharp-edged block in a different colour: every channel and
+// both axes differ, so swapped channels, rows or a wrong stride show as large errors.
+ImageU8 TestImage(int w, int h, int channels) {
+  ImageU8 image(w, h, channels);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool block = x > w / 3 && x < w / 2 && y > h / 4 && y < h / 2;
+      for (int c = 0; c < channels; ++c) {
+        const double v = c == 0   ? 255.0 * x / w
+                         : c == 1 ? 255.0 * y / h
+                                  : 128 + 60 * std::sin(0.1 * (x + y));
+        image.at(x, y, c) = block ? (c == 0 ? 20 : 230) : static_cast<uint8_t>(v);
+      }
+    }
+  }
+  return image;
+}
+
+std::pair<double, int> Difference(const ImageU8& a, const ImageU8& b) {
+  double sum = 0;
+  int worst = 0;
+  for (size_t i = 0; i < a.data.size(); ++i) {
+    const int d = std::abs(int(a.data[i]) - int(b.data[i]));
+    sum += d;
+    worst = std::max(worst, d);
+  }
+  return {sum / a.data.size(), worst};
+}
+
+std::string ErrorOf(const std::string& path) {
+  try {
+    ReadImageFile(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+TEST(ImageFile, JpegRoundTripKeepsSizeLayoutAndPixelsWithinQuality) {
+  const std::string dir = testing::ScratchDir();
+  for (int channels : {1, 3}) {
+    const ImageU8 image = TestImage(37, 23, channels);  // not a multiple of 8 or 16
+    JpegWriteOptions best;
+    best.quality = 100;
+    WriteJpeg(dir + "/sub/a.jpg", image, best);
+    const ImageU8 back = ReadJpeg(dir + "/sub/a.jpg");
+    ASSERT_EQ(back.width, 37);
+    ASSERT_EQ(back.height, 23);
+    ASSERT_EQ(back.channels, channels);
+    const auto [mean, worst] = Difference(back, image);
+    EXPECT_LT(mean, 1.0) << channels;
+    EXPECT_LE(worst, 4) << channels;
+    // Lower quality is lossier, but still the same picture.
+    JpegWriteOptions low;
+    low.quality = 60;
+    low.full_chroma = false;
+    WriteJpeg(dir + "/b.jpg", image, low);
+    const auto [low_mean, low_worst] = Difference(ReadJpeg(dir + "/b.jpg"), image);
+    EXPECT_GT(low_mean, mean);
+    EXPECT_LT(low_mean, 8.0);
+    EXPECT_LT(std::filesystem::file_size(dir + "/b.jpg"),
+              std::filesystem::file_size(dir + "/sub/a.jpg"));
+  }
+}
+
+TEST(ImageFile, ReadsByContentNotByName) {
+  const std::string dir = testing::ScratchDir();
+  const ImageU8 image = TestImage(20, 10, 3);
+  WritePng(dir + "/png.jpg", image);  // misnamed on purpose
+  WriteJpeg(dir + "/jpeg.png", image);
+  const ImageU8 png = ReadImageFile(dir + "/png.jpg");
+  EXPECT_EQ(png.data, image.data);  // lossless
+  EXPECT_EQ(ReadImageFile(dir + "/jpeg.png").data, ReadJpeg(dir + "/jpeg.png").data);
+}
+
+TEST(ImageFile, BadFilesNameThePath) {
+  const std::string dir = testing::ScratchDir();
+  EXPECT_THAT(ErrorOf(dir + "/none.jpg"), HasSubstr(dir + "/none.jpg"));
+  std::ofstream(dir + "/text.jpg") << "not an image";
+  EXPECT_THAT(ErrorOf(dir + "/text.jpg"), HasSubstr("PNG or JPEG"));
+  EXPECT_THROW(ReadJpeg(dir + "/text.jpg"), InputError);
+  // A truncated JPEG is an error, not an image with a grey bottom.
+  WriteJpeg(dir + "/full.jpg", TestImage(64, 64, 3));
+  std::ifstream in(dir + "/full.jpg", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  std::ofstream(dir + "/cut.jpg", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  const std::string error = ErrorOf(dir + "/cut.jpg");
+  EXPECT_THAT(error, HasSubstr(dir + "/cut.jpg"));
+  EXPECT_THAT(error, HasSubstr("valid JPEG"));
+}
+
+}  // namespace
+}  // namespace handlabel

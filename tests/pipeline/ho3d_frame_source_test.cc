@@ -1,0 +1,270 @@
+// The HO3D v3 multi-camera frame source against a fixture written in HO3D's layout from
+// a synthetic capture (calibration files, rgb/<fid>.jpg and meta/<fid>.pkl per camera
+// folder), and against a meta pickle written by numpy (tests/data/ho3d).
+#include "pipeline/ho3d_frame_source.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+
+#include "core/errors.h"
+#include "core/image_file.h"
+#include "pipeline/capsule_hand.h"
+#include "pipeline/label_stage_factory.h"
+#include "pipeline/synth_capture.h"
+#include "tests/core/mano_sized_model.h"  // Py2PickleWriter
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const std::string kData = std::string(HANDLABEL_SOURCE_DIR) + "/tests/data/ho3d";
+
+struct Ho3dFixture {
+  std::string root;
+  std::string split;  // <root>/train
+  Rig rig;            // cameras ABF1<i>
+  std::vector<SynthFrame> frames;
+};
+
+std::string Fid(int frame) {
+  char text[8];
+  std::snprintf(text, sizeof(text), "%04d", frame);
+  return text;
+}
+
+// One meta pickle: handJoints3D (float32, OpenGL camera axes, MANO order + tips) and
+// a few of HO3D's other keys.
+void WriteMeta(const std::string& path, const Points3d& snap_in_camera) {
+  std::vector<float> gl(3 * kNumHandKeypoints);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const int n = kSnapFromNative[k];
+    gl[3 * n] = static_cast<float>(snap_in_camera(k, 0));
+    gl[3 * n + 1] = static_cast<float>(-snap_in_camera(k, 1));
+    gl[3 * n + 2] = static_cast<float>(-snap_in_camera(k, 2));
+  }
+  const std::vector<float> pose(48, 0.1f);
+  testing::Py2PickleWriter w;
+  w.Proto();
+  w.BeginDict();
+  w.Str("handPose");
+  w.Array({48}, "f4", pose.data(), pose.size() * 4);
+  w.Str("handJoints3D");
+  w.Array({kNumHandKeypoints, 3}, "f4", gl.data(), gl.size() * 4);
+  w.Str("objName");
+  w.Str("006_mustard_bottle");
+  w.EndDict();
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path, std::ios::binary) << w.Finish();
+}
+
+Ho3dFixture WriteHo3dFixture(const std::string& root, int num_frames = 2,
+                             int num_cameras = 3) {
+  SynthCaptureOptions synth;
+  synth.rig.preset = "dexycb";
+  synth.rig.width = 640;  // HO3D's calibration files imply 640x480
+  synth.rig.height = 480;
+  synth.seed = 4;
+  synth.num_threads = 1;
+  const Rig preset = MakePresetRig(synth.rig, 0);
+  Ho3dFixture fx;
+  fx.root = root;
+  fx.split = root + "/train";
+  const std::string calib = root + "/calibration/ABF1/calibration";
+  fs::create_directories(calib);
+  std::ofstream orders(calib + "/cam_orders.txt");
+  for (int c = 0; c < num_cameras; ++c) {
+    const RigCamera& camera = preset[c];
+    fx.rig.Add({"ABF1" + std::to_string(c), camera.camera, camera.cam_from_world});
+    orders << (c ? "," : "") << c;
+    const std::vector<double>& k = camera.camera.params();
+    std::ofstream intr(calib + "/cam_" + std::to_string(c) + "_intrinsics.txt");
+    intr.precision(17);
+    intr << "fx:" << k[0] << ", fy:" << k[1] << ", ppx:" << k[2] << ", ppy:" << k[3]
+         << "\n";
+    std::ofstream trans(calib + "/trans_" + std::to_string(c) + ".txt");
+    trans.precision(17);
+    const Matrix3x4d m = camera.cam_from_world.Inverse().ToMatrix();  // cam -> common
+    for (int r = 0; r < 3; ++r)
+      trans << m(r, 0) << " " << m(r, 1) << " " << m(r, 2) << " " << m(r, 3) << "\n";
+    trans << "0 0 0 1\n";
+  }
+  const SynthGenerator generator(MakeCapsuleHand(HandSide::kRight), fx.rig, synth);
+  JpegWriteOptions jpeg;
+  jpeg.quality = 100;
+  for (int f = 0; f < num_frames; ++f) {
+    fx.frames.push_back(generator.Generate(f));
+    for (size_t v = 0; v < fx.rig.size(); ++v) {
+      const std::string dir = fx.split + "/" + fx.rig[v].name;
+      WriteJpeg(dir + "/rgb/" + Fid(f) + ".jpg", fx.frames[f].views[v].rgb, jpeg);
+      Points3d in_camera(kNumHandKeypoints, 3);
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        in_camera.row(k) =
+            (fx.rig[v].cam_from_world *
+             Eigen::Vector3d(fx.frames[f].scene.hand.keypoints.row(k).transpose()))
+                .transpose();
+      }
+      WriteMeta(dir + "/meta/" + Fid(f) + ".pkl", in_camera);
+    }
+  }
+  return fx;
+}
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+TEST(Ho3dFrameSource, LoadsTheRigImagesAndTruthThatWereWritten) {
+  const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir());
+  const Ho3dFrameSource source(fx.split + "/ABF1");
+  EXPECT_EQ(source.FrameIds(), (std::vector<std::string>{"0000", "0001"}));
+  EXPECT_EQ(source.Side(), HandSide::kRight);
+  EXPECT_THAT(source.Describe(), HasSubstr("3 cameras, 2 frames"));
+  for (int f = 0; f < 2; ++f) {
+    const FrameInput frame = source.Load(Fid(f));
+    ASSERT_EQ(frame.rig.size(), 3u);
+    EXPECT_TRUE(frame.keypoints_2d.empty());
+    EXPECT_TRUE(frame.mask_paths.empty());
+    for (size_t v = 0; v < 3; ++v) {
+      EXPECT_EQ(frame.rig[v].name, fx.rig[v].name);
+      for (int i = 0; i < 4; ++i) {
+        EXPECT_NEAR(frame.rig[v].camera.params()[i], fx.rig[v].camera.params()[i], 1e-12);
+      }
+      EXPECT_THAT(frame.rig[v].cam_from_world,
+                  testing::Rigid3Near(fx.rig[v].cam_from_world, 1e-12, 1e-12));
+      EXPECT_EQ(frame.image_paths[v],
+                fx.split + "/" + fx.rig[v].name + "/rgb/" + Fid(f) + ".jpg");
+      const ImageU8 image = ReadImageFile(frame.image_paths[v]);
+      const ImageU8& rendered = fx.frames[f].views[v].rgb;
+      ASSERT_EQ(image.data.size(), rendered.data.size());
+      int worst = 0;
+      for (size_t i = 0; i < image.data.size(); ++i)
+        worst = std::max(worst, std::abs(int(image.data[i]) - int(rendered.data[i])));
+      EXPECT_LE(worst, 6);
+    }
+    ASSERT_TRUE(frame.ground_truth.has_value());
+    // float32 in the pickles
+    EXPECT_THAT(frame.ground_truth->keypoints,
+                testing::MatrixNear(fx.frames[f].scene.hand.keypoints, 1e-6));
+    EXPECT_EQ(frame.ground_truth->vertices.rows(), 0);
+  }
+}
+
+TEST(Ho3dFrameSource, TruthFromTheFirstCameraWithFullJoints) {
+  const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir(), 1);
+  // Evaluation-split style: only the root joint. Then camera 1's joints are used.
+  testing::Py2PickleWriter w;
+  const float root_joint[3] = {0.f, 0.f, -0.5f};
+  w.Proto();
+  w.BeginDict();
+  w.Str("handJoints3D");
+  w.Array({3}, "f4", root_joint, 12);
+  w.EndDict();
+  std::ofstream(fx.split + "/ABF10/meta/0000.pkl", std::ios::binary) << w.Finish();
+  FrameInput frame = Ho3dFrameSource(fx.split + "/ABF1").Load("0000");
+  ASSERT_TRUE(frame.ground_truth.has_value());
+  EXPECT_THAT(frame.ground_truth->keypoints,
+              testing::MatrixNear(fx.frames[0].scene.hand.keypoints, 1e-6));
+  // Without any meta file there is no truth.
+  for (const RigCamera& camera : fx.rig.cameras())
+    fs::remove_all(fx.split + "/" + camera.name + "/meta");
+  frame = Ho3dFrameSource(fx.split + "/ABF1").Load("0000");
+  EXPECT_FALSE(frame.ground_truth.has_value());
+}
+
+TEST(Ho3dFrameSource, NumpyWrittenMetaGivesOpenCvAxesAndSnapOrder) {
+  const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir(), 1);
+  for (const RigCamera& camera : fx.rig.cameras())
+    fs::remove_all(fx.split + "/" + camera.name + "/meta");
+  fs::create_directories(fx.split + "/ABF11/meta");
+  fs::copy_file(kData + "/meta_0000.pkl", fx.split + "/ABF11/meta/0000.pkl");
+  const FrameInput frame = Ho3dFrameSource(fx.split + "/ABF1").Load("0000");
+  ASSERT_TRUE(frame.ground_truth.has_value());
+  std::ifstream in(kData + "/expected.json");
+  const nlohmann::json expected = nlohmann::json::parse(in)["keypoints_in_camera_snap"];
+  const Rigid3 world_from_cam = fx.rig[1].cam_from_world.Inverse();
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const Eigen::Vector3d in_camera(expected[k][0].get<double>(),
+                                    expected[k][1].get<double>(),
+                                    expected[k][2].get<double>());
+    EXPECT_THAT(frame.ground_truth->keypoints.row(k),
+                testing::MatrixNear((world_from_cam * in_camera).transpose(), 1e-12))
+        << k;
+  }
+}
+
+TEST(Ho3dFrameSource, SplitFolderListsCalibratedSequences) {
+  const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir(), 2);
+  // A single-camera sequence without multi-camera calibration is not part of it.
+  WriteJpeg(fx.split + "/MC1/rgb/0000.jpg", fx.frames[0].views[0].rgb);
+  const Ho3dFrameSource source(fx.split);
+  EXPECT_EQ(source.FrameIds(), (std::vector<std::string>{"ABF1/0000", "ABF1/0001"}));
+  const FrameInput frame = source.Load("ABF1/0001");
+  EXPECT_EQ(frame.image_paths[2], fx.split + "/ABF12/rgb/0001.jpg");
+  EXPECT_THAT(ErrorOf([&] { source.Load("0001"); }), HasSubstr("frame id"));
+  EXPECT_THAT(ErrorOf([&] { source.Load("ABF1/0002"); }), HasSubstr("frame id"));
+}
+
+TEST(Ho3dFrameSource, JobFileSelectsIt) {
+  const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir(), 1);
+  std::ofstream(fx.root + "/job.yaml") << R"(input:
+  format: ho3d
+  path: train/ABF1
+network:
+  weights: poem.pt
+output:
+  dir: out
+)";
+  const std::unique_ptr<FrameSource> source =
+      BuildFrameSource(LoadJobConfig(fx.root + "/job.yaml"));
+  EXPECT_THAT(source->Describe(), HasSubstr("HO3D v3"));
+  EXPECT_EQ(source->FrameIds(), std::vector<std::string>{"0000"});
+}
+
+TEST(Ho3dFrameSource, BrokenLayoutsNameTheFileAndField) {
+  const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir(), 2);
+  // An image missing in one camera fails that frame only.
+  fs::remove(fx.split + "/ABF12/rgb/0001.jpg");
+  const Ho3dFrameSource source(fx.split + "/ABF1");
+  EXPECT_EQ(source.FrameIds().size(), 2u);
+  EXPECT_NO_THROW(source.Load("0000"));
+  std::string error = ErrorOf([&] { source.Load("0001"); });
+  EXPECT_THAT(error, HasSubstr(fx.split + "/ABF12/rgb/0001.jpg"));
+  EXPECT_THAT(error, HasSubstr("ABF12"));
+  // A broken meta pickle fails its frame, naming it.
+  std::ofstream(fx.split + "/ABF10/meta/0000.pkl") << "garbage";
+  EXPECT_THAT(ErrorOf([&] { source.Load("0000"); }), HasSubstr("ABF10/meta/0000.pkl"));
+  // A camera folder listed by the calibration is missing.
+  fs::rename(fx.split + "/ABF11", fx.split + "/moved");
+  error = ErrorOf([&] { Ho3dFrameSource{fx.split + "/ABF1"}; });
+  EXPECT_THAT(error, HasSubstr("ABF11/rgb"));
+  EXPECT_THAT(error, HasSubstr("cam_orders.txt"));
+  fs::rename(fx.split + "/moved", fx.split + "/ABF11");
+  // A calibration file is broken.
+  std::ofstream(fx.root + "/calibration/ABF1/calibration/cam_1_intrinsics.txt")
+      << "fx:600, fy:600\n";
+  error = ErrorOf([&] { Ho3dFrameSource{fx.split + "/ABF1"}; });
+  EXPECT_THAT(error, HasSubstr("cam_1_intrinsics.txt"));
+  EXPECT_THAT(error, HasSubstr("ppx"));
+  // Not an HO3D sequence.
+  EXPECT_THAT(ErrorOf([&] { Ho3dFrameSource{fx.split + "/XYZ1"}; }),
+              HasSubstr("input.path"));
+  EXPECT_THAT(ErrorOf([&] { Ho3dFrameSource{fx.root + "/nowhere/ABF1"}; }),
+              HasSubstr("input.path"));
+}
+
+}  // namespace
+}  // namespace handlabel
