@@ -6,8 +6,10 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iostream>
+#include <iterator>
 
 #include "tests/test_util.h"
 
@@ -38,7 +40,8 @@ std::mt19937_64& TestRng() { return g_rng; }
 uint64_t TestSeed() { return g_seed; }
 
 std::string ScratchDir() {
-  const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const ::testing::TestInfo* info =
+      ::testing::UnitTest::GetInstance()->current_test_info();
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() /
       ("handlabel_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
@@ -46,6 +49,22 @@ std::string ScratchDir() {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
+}
+
+std::string ReadFileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::map<std::string, std::string> FilesUnder(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::map<std::string, std::string> files;
+  if (!fs::exists(dir)) return files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file())
+      files[fs::relative(e.path(), dir).string()] = ReadFileBytes(e.path().string());
+  }
+  return files;
 }
 
 }  // namespace handlabel::testing

@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 
 #include <Eigen/Core>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -22,6 +23,13 @@ uint64_t TestSeed();
 // tests that ctest runs in parallel never share files. Removed again at the next call
 // for the same test; left behind after a failure for inspection.
 std::string ScratchDir();
+
+// The bytes of a file ("" if it cannot be read).
+std::string ReadFileBytes(const std::string& path);
+
+// Every regular file under `dir` (path relative to `dir` -> bytes); empty if `dir` does
+// not exist. For comparing whole output folders.
+std::map<std::string, std::string> FilesUnder(const std::string& dir);
 
 inline double Uniform(double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(TestRng());

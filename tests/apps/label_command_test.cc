@@ -29,22 +29,6 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using testing::RunHandlabelCommand;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-// Every regular file under `dir` (relative path -> bytes), temporaries excluded.
-std::map<std::string, std::string> Files(const std::string& dir) {
-  std::map<std::string, std::string> files;
-  if (!fs::exists(dir)) return files;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    if (e.is_regular_file())
-      files[fs::relative(e.path(), dir).string()] = ReadAll(e.path());
-  }
-  return files;
-}
-
 std::string Binary() { return std::string(HANDLABEL_BINARY_DIR) + "/apps/handlabel"; }
 
 // Starts the real binary; output goes to `log`.
@@ -85,7 +69,7 @@ void ExpectConsistent(const std::string& out) {
   if (fs::is_directory(out + "/meshes")) {
     for (const auto& e : fs::directory_iterator(out + "/meshes")) {
       if (e.path().filename().string().find(".tmp.") != std::string::npos) continue;
-      const std::string text = ReadAll(e.path().string());
+      const std::string text = testing::ReadFileBytes(e.path().string());
       EXPECT_EQ(text.back(), '\n') << e.path();
       EXPECT_THAT(text, HasSubstr("end_header")) << e.path();
     }
@@ -113,7 +97,7 @@ TEST(LabelCommand,
 
   const auto start = std::chrono::steady_clock::now();
   ASSERT_EQ(Wait(Spawn({"label", "--job", reference_job}, dir + "/ref.log")), 0)
-      << ReadAll(dir + "/ref.log");
+      << testing::ReadFileBytes(dir + "/ref.log");
   const double full_run_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -136,17 +120,19 @@ TEST(LabelCommand,
   }
   ASSERT_EQ(Wait(Spawn({"label", "--job", killed_job, "--resume"}, dir + "/killed.log")),
             0)
-      << ReadAll(dir + "/killed.log");
+      << testing::ReadFileBytes(dir + "/killed.log");
   RecordProperty("kill_rounds", rounds);
   RecordProperty("killed_mid_run", killed_mid_run);
 
   // Identical outputs, and no temporary left behind.
-  const auto reference = Files(dir + "/ref/labels");
-  const auto resumed = Files(dir + "/killed/labels");
+  const auto reference = testing::FilesUnder(dir + "/ref/labels");
+  const auto resumed = testing::FilesUnder(dir + "/killed/labels");
   ASSERT_EQ(reference.size(), 8u);
   EXPECT_EQ(resumed, reference);
-  EXPECT_EQ(Files(dir + "/killed/meshes"), Files(dir + "/ref/meshes"));
-  EXPECT_EQ(ReadAll(dir + "/killed/manifest.json"), ReadAll(dir + "/ref/manifest.json"));
+  EXPECT_EQ(testing::FilesUnder(dir + "/killed/meshes"),
+            testing::FilesUnder(dir + "/ref/meshes"));
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/killed/manifest.json"),
+            testing::ReadFileBytes(dir + "/ref/manifest.json"));
 }
 
 TEST(LabelCommand, ShardsFromFlagOrEnvironmentMergeToTheSingleProcessResult) {
@@ -180,9 +166,10 @@ TEST(LabelCommand, ShardsFromFlagOrEnvironmentMergeToTheSingleProcessResult) {
   const auto merged = RunHandlabelCommand({"merge", "--job", sharded});
   ASSERT_EQ(merged.status, 0) << merged.err;
   EXPECT_THAT(merged.out, HasSubstr("5 frames: 5 labelled"));
-  EXPECT_EQ(Files(dir + "/sharded/labels"), Files(dir + "/single/labels"));
-  EXPECT_EQ(ReadAll(dir + "/sharded/manifest.json"),
-            ReadAll(dir + "/single/manifest.json"));
+  EXPECT_EQ(testing::FilesUnder(dir + "/sharded/labels"),
+            testing::FilesUnder(dir + "/single/labels"));
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/sharded/manifest.json"),
+            testing::ReadFileBytes(dir + "/single/manifest.json"));
   // Three shard logs, each frame in exactly one of them.
   int records = 0;
   for (int i = 0; i < 3; ++i) {
@@ -199,7 +186,7 @@ TEST(LabelCommand, FitOnlyJobLabelsEveryFrameCloseToTheGroundTruth) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("3 frames: 3 labelled (fallback_fit 3), 0 failed"));
   const nlohmann::json summary =
-      nlohmann::json::parse(ReadAll(dir + "/out/summary.json"));
+      nlohmann::json::parse(testing::ReadFileBytes(dir + "/out/summary.json"));
   // Simulated detections with ~2 px noise at 160x120: the fit lands within ~1.5 cm.
   EXPECT_LT(summary.at("metrics").at("labels").at("mpjpe_mm").get<double>(), 15.0);
   const LabelRecord label = ReadLabelFile(LabelFilePath(dir + "/out", "000001"));

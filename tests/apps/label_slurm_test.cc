@@ -22,20 +22,6 @@ namespace {
 namespace fs = std::filesystem;
 using testing::RunHandlabelCommand;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-std::map<std::string, std::string> Files(const std::string& dir) {
-  std::map<std::string, std::string> files;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    if (e.is_regular_file())
-      files[fs::relative(e.path(), dir).string()] = ReadAll(e.path());
-  }
-  return files;
-}
-
 // Runs a shell command; returns its exit status and stdout.
 int Shell(const std::string& command, std::string* out = nullptr) {
   FILE* pipe = popen(command.c_str(), "r");
@@ -115,7 +101,7 @@ TEST(LabelSlurm, ArrayJobOnARealLocalClusterMergesToTheSingleProcessRun) {
   std::string task_logs;
   for (const auto& e : fs::directory_iterator(cluster.state)) {
     if (e.path().filename().string().rfind("task-", 0) == 0)
-      task_logs += ReadAll(e.path());
+      task_logs += testing::ReadFileBytes(e.path());
   }
   ASSERT_TRUE(queued.empty()) << "the array job did not finish in 120 s:\n" << task_logs;
   for (const char* shard : {"shard 0/3", "shard 1/3", "shard 2/3"}) {
@@ -124,10 +110,11 @@ TEST(LabelSlurm, ArrayJobOnARealLocalClusterMergesToTheSingleProcessRun) {
 
   const auto merged = RunHandlabelCommand({"merge", "--job", array});
   ASSERT_EQ(merged.status, 0) << merged.out << merged.err;
-  EXPECT_EQ(Files(dir + "/array/labels"), Files(dir + "/single/labels"));
-  EXPECT_EQ(Files(dir + "/array/labels").size(), 7u);
-  EXPECT_EQ(ReadAll(dir + "/array/manifest.json"),
-            ReadAll(dir + "/single/manifest.json"));
+  EXPECT_EQ(testing::FilesUnder(dir + "/array/labels"),
+            testing::FilesUnder(dir + "/single/labels"));
+  EXPECT_EQ(testing::FilesUnder(dir + "/array/labels").size(), 7u);
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/array/manifest.json"),
+            testing::ReadFileBytes(dir + "/single/manifest.json"));
 }
 
 }  // namespace

@@ -13,13 +13,6 @@ namespace {
 
 using testing::RunHandlabelCommand;
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // A coarse build, quick enough for a test.
 std::vector<std::string> CoarseBuild(const std::string& side, const std::string& out) {
   return {"model",       "build", "--side",          side, "--out",          out,
@@ -33,7 +26,8 @@ TEST(ModelBuildCommand, WritesALoadableModelAndTheSameBytesTwice) {
   EXPECT_NE(r.out.find("closed manifold: yes"), std::string::npos) << r.out;
   r = RunHandlabelCommand(CoarseBuild("left", dir + "/b.npz"));
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(ReadBytes(dir + "/a.npz"), ReadBytes(dir + "/b.npz"));
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/a.npz"),
+            testing::ReadFileBytes(dir + "/b.npz"));
   const HandModel m = LoadHandModel(dir + "/a.npz");
   EXPECT_EQ(m.side, HandSide::kLeft);
   EXPECT_EQ(m.name, "open_hand_left");
@@ -57,7 +51,7 @@ TEST(ModelRenderCommand, WritesAPngSheetOfTheShippedModel) {
        std::string(HANDLABEL_SOURCE_DIR) + "/models/open_hand_right.npz", "--out", out,
        "--tile", "64", "--poses", "rest,fist", "--views", "palm,thumb"});
   ASSERT_EQ(r.status, 0) << r.err;
-  const std::string png = ReadBytes(out);
+  const std::string png = testing::ReadFileBytes(out);
   ASSERT_GT(png.size(), 100u);
   EXPECT_EQ(png.substr(1, 3), "PNG");
   // 2 views x 64 wide, 2 poses x 64 high.

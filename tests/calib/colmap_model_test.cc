@@ -19,11 +19,6 @@ using testing::ExpectRigsEqual;
 using testing::RandomColmapModel;
 using testing::ScratchDir;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in),
-                     std::istreambuf_iterator<char>());
-}
 void WriteAll(const std::string& path, const std::string& data) {
   std::ofstream(path, std::ios::binary) << data;
 }
@@ -67,7 +62,7 @@ TEST(ColmapModel, BinaryLayoutMatchesTheDocumentedRecordSizes) {
   EXPECT_EQ(fs::file_size(dir + "/cameras.bin"), 8u + 4 + 4 + 8 + 8 + 8 * 8);
   EXPECT_EQ(fs::file_size(dir + "/images.bin"), 8u + 4 + 7 * 8 + 4 + 8 + 8 + 2 * 24);
   EXPECT_EQ(fs::file_size(dir + "/points3D.bin"), 8u + 8 + 24 + 3 + 8 + 8 + 8);
-  const std::string images = ReadAll(dir + "/images.bin");
+  const std::string images = testing::ReadFileBytes(dir + "/images.bin");
   EXPECT_EQ(images.substr(8 + 4 + 56 + 4, 8), std::string("abc.png\0", 8));
 }
 
@@ -95,7 +90,7 @@ TEST(ColmapModel, TruncatedBinaryFilesFailWithTheFileAndField) {
   WriteColmapBinary(RandomColmapModel(), dir);
   for (const char* file : {"cameras.bin", "images.bin", "points3D.bin"}) {
     const std::string path = dir + "/" + file;
-    const std::string full = ReadAll(path);
+    const std::string full = testing::ReadFileBytes(path);
     for (size_t cut = 0; cut < full.size(); cut += 1 + full.size() / 31) {
       WriteAll(path, full.substr(0, cut));
       const std::string error = ErrorOf([&] { ReadColmapBinary(dir); });
@@ -108,7 +103,7 @@ TEST(ColmapModel, TruncatedBinaryFilesFailWithTheFileAndField) {
 TEST(ColmapModel, GarbledFilesFailClearly) {
   const std::string dir = ScratchDir();
   WriteColmapBinary(RandomColmapModel(), dir);
-  std::string cameras = ReadAll(dir + "/cameras.bin");
+  std::string cameras = testing::ReadFileBytes(dir + "/cameras.bin");
   cameras[7] = '\x7f';  // an absurd camera count
   WriteAll(dir + "/cameras.bin", cameras);
   EXPECT_NE(ErrorOf([&] { ReadColmapBinary(dir); }).find("num_cameras"),

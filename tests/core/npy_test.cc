@@ -16,13 +16,6 @@ std::string Fixture(const std::string& name) {
   return std::string(HANDLABEL_SOURCE_DIR) + "/tests/data/npy/" + name;
 }
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The logical values make_npy_fixtures.py stores for element i of each kind.
 double Expected(DType dtype, int i) {
   switch (dtype) {
@@ -82,12 +75,13 @@ TEST(Npy, OurBytesEqualNumpysForTheSameArray) {
   // numpy writes version 1.0, '<f8', C order, header padded to 64 bytes: ours must be
   // byte-identical, which is the strongest check that numpy reads what we write.
   const NdArray a = ReadNpyFile(Fixture("f8_c.npy"));
-  EXPECT_EQ(SerializeNpy(a), ReadBytes(Fixture("f8_c.npy")));
-  EXPECT_EQ(SerializeNpy(ReadNpyFile(Fixture("u1.npy"))), ReadBytes(Fixture("u1.npy")));
+  EXPECT_EQ(SerializeNpy(a), testing::ReadFileBytes(Fixture("f8_c.npy")));
+  EXPECT_EQ(SerializeNpy(ReadNpyFile(Fixture("u1.npy"))),
+            testing::ReadFileBytes(Fixture("u1.npy")));
   EXPECT_EQ(SerializeNpy(ReadNpyFile(Fixture("unicode.npy"))),
-            ReadBytes(Fixture("unicode.npy")));
+            testing::ReadFileBytes(Fixture("unicode.npy")));
   EXPECT_EQ(SerializeNpy(ReadNpyFile(Fixture("scalar.npy"))),
-            ReadBytes(Fixture("scalar.npy")));
+            testing::ReadFileBytes(Fixture("scalar.npy")));
 }
 
 TEST(Npy, RoundTripsEveryDTypeThroughAFile) {
@@ -130,7 +124,7 @@ std::string ErrorOf(const std::string& bytes) {
 }
 
 TEST(Npy, RejectsTruncatedAndHostileFilesWithClearErrors) {
-  const std::string good = ReadBytes(Fixture("f8_c.npy"));
+  const std::string good = testing::ReadFileBytes(Fixture("f8_c.npy"));
   EXPECT_NE(ErrorOf(good.substr(0, good.size() - 8)).find("truncated"),
             std::string::npos);
   EXPECT_NE(ErrorOf(good.substr(0, 40)).find("truncated"), std::string::npos);

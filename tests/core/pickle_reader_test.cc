@@ -22,13 +22,6 @@ std::string DataPath(const std::string& rel) {
   return std::string(HANDLABEL_SOURCE_DIR) + "/tests/data/" + rel;
 }
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The error message ReadPickle gives, or "" when it succeeds.
 std::string PickleError(const std::string& bytes, const PickleLimits& limits = {}) {
   try {
@@ -153,7 +146,7 @@ TEST(PickleReader, RefusesHugeDeclaredSizesBeforeAllocating) {
       PickleError(std::string("\x80\x02\x8b\x00\x00\x00\x80", 7)).find("at most 8 bytes"),
       std::string::npos);
   // An ndarray whose shape claims 10^18 elements but carries 8 bytes of data.
-  std::string bytes = ReadBytes(DataPath("mano/small_p2.pkl"));
+  std::string bytes = testing::ReadFileBytes(DataPath("mano/small_p2.pkl"));
   const std::string shape = std::string("K\x02K\x03\x86", 5);  // (2, 3)
   const size_t at = bytes.find(shape);
   ASSERT_NE(at, std::string::npos);
@@ -173,9 +166,10 @@ TEST(PickleReader, RefusesHugeDeclaredSizesBeforeAllocating) {
   EXPECT_NE(PickleError(many + ".", tight).find("at most 100 values"), std::string::npos);
   tight = PickleLimits();
   tight.max_total_bytes = 1000;
-  EXPECT_NE(PickleError(ReadBytes(DataPath("mano/mano_py2_right.pkl")), tight)
-                .find("at most 1000 bytes"),
-            std::string::npos);
+  EXPECT_NE(
+      PickleError(testing::ReadFileBytes(DataPath("mano/mano_py2_right.pkl")), tight)
+          .find("at most 1000 bytes"),
+      std::string::npos);
 }
 
 TEST(PickleReader, RefusesDeepNestingAndCyclesWithoutRecursingDeeply) {
@@ -210,7 +204,7 @@ TEST(PickleReader, RefusesDeepNestingAndCyclesWithoutRecursingDeeply) {
 TEST(PickleReader, EveryTruncationFailsCleanly) {
   for (const char* file : {"mano/small_p0.pkl", "mano/small_p2.pkl", "mano/small_p5.pkl",
                            "mano/mano_py2_right.pkl"}) {
-    const std::string bytes = ReadBytes(DataPath(file));
+    const std::string bytes = testing::ReadFileBytes(DataPath(file));
     const size_t step = std::max<size_t>(1, bytes.size() / 300);
     for (size_t n = 0; n + 1 < bytes.size(); n += step) {
       const std::string error = PickleError(bytes.substr(0, n));
@@ -220,7 +214,7 @@ TEST(PickleReader, EveryTruncationFailsCleanly) {
 }
 
 TEST(PickleReader, RandomByteFlipsNeverCrash) {
-  const std::string good = ReadBytes(DataPath("mano/mano_py2_right.pkl"));
+  const std::string good = testing::ReadFileBytes(DataPath("mano/mano_py2_right.pkl"));
   for (int trial = 0; trial < 300; ++trial) {
     std::string bad = good;
     for (int k = 0; k < 3; ++k) {
@@ -238,7 +232,7 @@ TEST(PickleReader, FuzzCorpusSmoke) {
       std::string(HANDLABEL_SOURCE_DIR) + "/fuzz/corpus/pickle_reader";
   int inputs = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    const std::string bytes = ReadBytes(entry.path().string());
+    const std::string bytes = testing::ReadFileBytes(entry.path().string());
     const std::string error = PickleError(bytes);
     if (entry.path().extension() == ".pkl") EXPECT_EQ(error, "") << entry.path();
     ++inputs;

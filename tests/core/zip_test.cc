@@ -18,13 +18,6 @@ std::string Fixture(const std::string& name) {
   return std::string(HANDLABEL_SOURCE_DIR) + "/tests/data/npy/" + name;
 }
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 std::string RandomBytes(size_t n, bool compressible) {
   std::string s(n, '\0');
   for (char& c : s) c = static_cast<char>(testing::Uniform(0, compressible ? 4 : 256));
@@ -85,7 +78,7 @@ TEST_P(ZipRoundTrip, ReaderReturnsWhatWriterWrote) {
     }
     zip.Close();
   }
-  const std::string bytes = ReadBytes(path);
+  const std::string bytes = testing::ReadFileBytes(path);
   const ZipReader zip = ZipReader::OpenFile(path);
   ASSERT_EQ(zip.entries().size(), files.size());
   for (size_t i = 0; i < files.size(); ++i) {
@@ -119,7 +112,8 @@ TEST(ZipWriter, IsDeterministic) {
     zip.Add("x", "payload", ZipMethod::kDeflate);
     zip.Close();
   }
-  EXPECT_EQ(ReadBytes(dir + "/a.zip"), ReadBytes(dir + "/b.zip"));
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/a.zip"),
+            testing::ReadFileBytes(dir + "/b.zip"));
 }
 
 TEST(Npz, WriteReadRoundTrip) {
@@ -149,7 +143,7 @@ std::string ZipErrorOf(const std::string& bytes, const std::string& entry = "") 
 }
 
 TEST(ZipReader, RejectsCorruptArchivesWithClearErrors) {
-  const std::string good = ReadBytes(Fixture("compressed.npz"));
+  const std::string good = testing::ReadFileBytes(Fixture("compressed.npz"));
   EXPECT_EQ(ZipErrorOf(good), "");
   EXPECT_NE(ZipErrorOf("not a zip at all, just some text").find("end of central"),
             std::string::npos);
@@ -163,7 +157,7 @@ TEST(ZipReader, RejectsCorruptArchivesWithClearErrors) {
   // Every truncation either opens nothing or fails cleanly; never crashes.
   for (size_t n = 0; n < good.size(); n += 7) ZipErrorOf(good.substr(0, n));
   // A central directory claiming a huge entry is refused before allocating.
-  std::string huge = ReadBytes(Fixture("stored.npz"));
+  std::string huge = testing::ReadFileBytes(Fixture("stored.npz"));
   const size_t cd = huge.find("PK\x01\x02");
   for (int k = 0; k < 4; ++k) huge[cd + 24 + k] = '\xF0';  // uncompressed size
   ZipLimits limits;
@@ -182,7 +176,7 @@ TEST(ZipReader, FuzzCorpusSmoke) {
   const std::string dir = std::string(HANDLABEL_SOURCE_DIR) + "/fuzz/corpus/npz_reader";
   int inputs = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    const std::string bytes = ReadBytes(entry.path().string());
+    const std::string bytes = testing::ReadFileBytes(entry.path().string());
     ++inputs;
     try {
       if (LooksLikeZip(bytes)) {

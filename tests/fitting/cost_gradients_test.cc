@@ -36,6 +36,36 @@ Params FromHandParams(const HandParams& p) {
   return out;
 }
 
+// Two implementations of one cost (e.g. autodiff and analytic) agree on residuals
+// (1e-9) and on every Jacobian block (`jacobian_tolerance` relative to the block's
+// largest entry).
+void ExpectSameResidualsAndJacobians(const ceres::CostFunction& a,
+                                     const ceres::CostFunction& b,
+                                     const std::vector<const double*>& blocks,
+                                     double jacobian_tolerance = 1e-8) {
+  const int n = a.num_residuals();
+  ASSERT_EQ(b.num_residuals(), n);
+  const std::vector<int32_t>& sizes = a.parameter_block_sizes();
+  ASSERT_EQ(sizes, b.parameter_block_sizes());
+  std::vector<Eigen::MatrixXd> ja(sizes.size()), jb(sizes.size());
+  std::vector<double*> pa(sizes.size()), pb(sizes.size());
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    ja[k].resize(sizes[k], n);  // column-major sizes x n = Ceres' row-major n x sizes
+    jb[k].resize(sizes[k], n);
+    pa[k] = ja[k].data();
+    pb[k] = jb[k].data();
+  }
+  Eigen::VectorXd ra(n), rb(n);
+  ASSERT_TRUE(a.Evaluate(blocks.data(), ra.data(), pa.data()));
+  ASSERT_TRUE(b.Evaluate(blocks.data(), rb.data(), pb.data()));
+  EXPECT_THAT(rb, testing::MatrixNear(ra, 1e-9));
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    const double scale = std::max(1.0, ja[k].cwiseAbs().maxCoeff());
+    EXPECT_THAT(jb[k], testing::MatrixNear(ja[k], jacobian_tolerance * scale))
+        << "block " << k;
+  }
+}
+
 // Central differences (step 1e-6) against the cost function's Jacobians, block by
 // block; tolerance `precision` relative to the largest entry of the column (plus the
 // same absolute amount).
@@ -122,25 +152,10 @@ TEST_F(CostGradientsTest, KeypointReprojectionAnalyticMatchesAutodiff) {
         MultiViewKeypointCost<>::Create(evaluator_, views, loss, 1.0));
     std::unique_ptr<ceres::CostFunction> analytic(
         MultiViewKeypointCostFunction::Create(evaluator_, views, loss, 1.0));
+    ExpectSameResidualsAndJacobians(*autodiff, *analytic, params_.Blocks(), 1e-7);
     const int n = autodiff->num_residuals();
-    ASSERT_EQ(n, analytic->num_residuals());
-    const int sizes[4] = {3, 45, 10, 3};
-    std::vector<Eigen::MatrixXd> ja(4), jb(4);
-    std::vector<double*> pa(4), pb(4);
-    for (int b = 0; b < 4; ++b) {
-      ja[b].resize(sizes[b], n);  // column-major of size x n == row-major n x size
-      jb[b].resize(sizes[b], n);
-      pa[b] = ja[b].data();
-      pb[b] = jb[b].data();
-    }
-    Eigen::VectorXd ra(n), rb(n);
-    ASSERT_TRUE(autodiff->Evaluate(params_.Blocks().data(), ra.data(), pa.data()));
-    ASSERT_TRUE(analytic->Evaluate(params_.Blocks().data(), rb.data(), pb.data()));
-    EXPECT_THAT(rb, testing::MatrixNear(ra, 1e-9));
-    for (int b = 0; b < 4; ++b) {
-      const double scale = std::max(1.0, ja[b].cwiseAbs().maxCoeff());
-      EXPECT_THAT(jb[b], testing::MatrixNear(ja[b], 1e-7 * scale)) << "block " << b;
-    }
+    Eigen::VectorXd ra(n);
+    ASSERT_TRUE(autodiff->Evaluate(params_.Blocks().data(), ra.data(), nullptr));
     // Residual-only evaluation agrees too.
     Eigen::VectorXd rc(n);
     ASSERT_TRUE(analytic->Evaluate(params_.Blocks().data(), rc.data(), nullptr));
@@ -221,25 +236,7 @@ TEST_F(CostGradientsTest, Silhouette) {
   // The analytic-projection version agrees with autodiff.
   std::unique_ptr<ceres::CostFunction> fast(
       MultiViewSilhouetteCostFunction<>::Create(evaluator_, ids, views, 2.0));
-  const int n = cost->num_residuals();
-  ASSERT_EQ(fast->num_residuals(), n);
-  const int sizes[4] = {3, 45, 10, 3};
-  std::vector<Eigen::MatrixXd> ja(4), jb(4);
-  std::vector<double*> pa(4), pb(4);
-  for (int b = 0; b < 4; ++b) {
-    ja[b].resize(sizes[b], n);
-    jb[b].resize(sizes[b], n);
-    pa[b] = ja[b].data();
-    pb[b] = jb[b].data();
-  }
-  Eigen::VectorXd ra(n), rb(n);
-  ASSERT_TRUE(cost->Evaluate(params_.Blocks().data(), ra.data(), pa.data()));
-  ASSERT_TRUE(fast->Evaluate(params_.Blocks().data(), rb.data(), pb.data()));
-  EXPECT_THAT(rb, testing::MatrixNear(ra, 1e-9));
-  for (int b = 0; b < 4; ++b) {
-    const double scale = std::max(1.0, ja[b].cwiseAbs().maxCoeff());
-    EXPECT_THAT(jb[b], testing::MatrixNear(ja[b], 1e-8 * scale)) << "block " << b;
-  }
+  ExpectSameResidualsAndJacobians(*cost, *fast, params_.Blocks());
 }
 
 TEST(AxisAngleManifoldTest, Invariants) {
@@ -274,24 +271,7 @@ TEST(Keypoints3dCostFunctionTest, MatchesAutodiffPoints3d) {
   std::unique_ptr<ceres::CostFunction> analytic(Keypoints3dCostFunction::Create(
       evaluator, targets.keypoints, targets.keypoint_weights, 0.002));
   Params params = FromHandParams(frame.params);
-  const int n = 63;
-  const int sizes[4] = {3, 45, 10, 3};
-  std::vector<Eigen::MatrixXd> ja(4), jb(4);
-  std::vector<double*> pa(4), pb(4);
-  for (int b = 0; b < 4; ++b) {
-    ja[b].resize(sizes[b], n);
-    jb[b].resize(sizes[b], n);
-    pa[b] = ja[b].data();
-    pb[b] = jb[b].data();
-  }
-  Eigen::VectorXd ra(n), rb(n);
-  ASSERT_TRUE(autodiff->Evaluate(params.Blocks().data(), ra.data(), pa.data()));
-  ASSERT_TRUE(analytic->Evaluate(params.Blocks().data(), rb.data(), pb.data()));
-  EXPECT_THAT(rb, testing::MatrixNear(ra, 1e-9));
-  for (int b = 0; b < 4; ++b) {
-    const double scale = std::max(1.0, ja[b].cwiseAbs().maxCoeff());
-    EXPECT_THAT(jb[b], testing::MatrixNear(ja[b], 1e-8 * scale)) << "block " << b;
-  }
+  ExpectSameResidualsAndJacobians(*autodiff, *analytic, params.Blocks());
   ExpectGradientsMatch(*analytic, params.Blocks(), 1e-6);
 }
 

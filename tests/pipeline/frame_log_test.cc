@@ -16,11 +16,6 @@ namespace fs = std::filesystem;
 
 std::string TempDir() { return testing::ScratchDir(); }
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 TEST(FrameLog, RecordsSurviveReopenAndLaterRecordsSupersede) {
   const std::string path = TempDir() + "/shard-0-of-1.jsonl";
   {
@@ -83,14 +78,14 @@ TEST(AtomicFile, ReplacesContentAndLeavesNoTemporary) {
   const std::string path = dir + "/sub/label.json";
   WriteFileAtomically(path, "first");
   WriteFileAtomically(path, "second");
-  EXPECT_EQ(ReadAll(path), "second");
+  EXPECT_EQ(testing::ReadFileBytes(path), "second");
   int files = 0;
   for (const auto& e : fs::recursive_directory_iterator(dir))
     files += e.is_regular_file();
   EXPECT_EQ(files, 1);
   std::ofstream(dir + "/sub/x.json.tmp.123") << "half";
   EXPECT_EQ(RemoveStaleTemporaries(dir), 1);
-  EXPECT_EQ(ReadAll(path), "second");
+  EXPECT_EQ(testing::ReadFileBytes(path), "second");
 }
 
 }  // namespace

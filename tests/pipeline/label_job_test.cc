@@ -21,11 +21,6 @@ using testing::TestCapture;
 using testing::TestFitter;
 using testing::TestPredictor;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 JobConfig MakeJob(const std::string& out, RefineMode mode) {
   JobConfig job;
   job.source_file = "test.yaml";
@@ -192,12 +187,12 @@ TEST(LabelJob, ResumeRedoesExactlyTheUnfinishedFramesAndGivesIdenticalLabels) {
   RunLabelJob(job, s.Set(), {});
   std::map<std::string, std::string> before;
   for (const std::string& f : s.capture.FrameIds())
-    before[f] = ReadAll(LabelFilePath(out, f));
+    before[f] = testing::ReadFileBytes(LabelFilePath(out, f));
 
   // Simulate a crash: the log lost its last 4 records (one torn), two of those labels
   // never reached disk and a temporary was left behind.
   const std::string log_path = ShardLogPath(out, {0, 1});
-  std::string log = ReadAll(log_path);
+  std::string log = testing::ReadFileBytes(log_path);
   for (int i = 0; i < 4; ++i) log.erase(log.rfind('\n', log.size() - 2) + 1);
   log += "{\"frame\": \"0000";
   std::ofstream(log_path, std::ios::binary | std::ios::trunc) << log;
@@ -223,7 +218,7 @@ TEST(LabelJob, ResumeRedoesExactlyTheUnfinishedFramesAndGivesIdenticalLabels) {
   EXPECT_EQ(summary.ok, 12);
   EXPECT_FALSE(fs::exists(LabelFilePath(out, unfinished[2]) + ".tmp.12345"));
   for (const auto& [frame, text] : before)
-    EXPECT_EQ(ReadAll(LabelFilePath(out, frame)), text);
+    EXPECT_EQ(testing::ReadFileBytes(LabelFilePath(out, frame)), text);
 
   // --force labels everything again.
   s.capture.loads = 0;
@@ -252,11 +247,11 @@ TEST(LabelJob, ShardsPartitionTheFramesAndTheirMergeEqualsOneProcess) {
   const std::string hash = JobHash(sharded, s.predictor.WeightsSha256());
   const LabelSummary merged = MergeLabelOutputs(root + "/sharded", "test", hash, frames);
   EXPECT_EQ(merged.ok, 12);
-  EXPECT_EQ(ReadAll(ManifestPath(root + "/sharded")),
-            ReadAll(ManifestPath(root + "/single")));
+  EXPECT_EQ(testing::ReadFileBytes(ManifestPath(root + "/sharded")),
+            testing::ReadFileBytes(ManifestPath(root + "/single")));
   for (const std::string& f : frames) {
-    EXPECT_EQ(ReadAll(LabelFilePath(root + "/sharded", f)),
-              ReadAll(LabelFilePath(root + "/single", f)))
+    EXPECT_EQ(testing::ReadFileBytes(LabelFilePath(root + "/sharded", f)),
+              testing::ReadFileBytes(LabelFilePath(root + "/single", f)))
         << f;
   }
 }
