@@ -7,6 +7,7 @@
 #include "apps/commands.h"
 #include "calib/board_calib_report.h"
 #include "calib/board_images.h"
+#include "calib/board_scale.h"
 #include "calib/colmap_sfm.h"
 #include "calib/rig_io.h"
 #include "calib/rig_plot.h"
@@ -137,7 +138,10 @@ int RunCalibColmap(int argc, char** argv) {
       "feature_extractor (one camera per folder), exhaustive_matcher, mapper. Needs one\n"
       "image per camera of a static, well-textured scene: IMAGES/<camera>/<image>.\n"
       "Scale comes from --scale CAM_A,CAM_B,METRES (the distance of two camera "
-      "centres).\n"
+      "centres)\n"
+      "or from a board seen by 2+ cameras at once: --board SPEC --board-images DIR\n"
+      "(DIR/<camera>/<frame>.png, same frame names = same moment; --world board puts\n"
+      "the world on the board of the first such frame).\n"
       "Writes OUT/rig.json, OUT/colmap/ (rig as a text model), OUT/rig.png; COLMAP's "
       "own\n"
       "database, logs and model stay in OUT/colmap_work.\n"
@@ -145,6 +149,7 @@ int RunCalibColmap(int argc, char** argv) {
       "sfm_out",
       "calib colmap");
   std::string images, out = "sfm_out", model = "OPENCV", scale;
+  std::string board_spec, board_images, world = "camera";
   ColmapSfmOptions options;
   app.add_option("--images", images, "folder with one sub-folder of images per camera")
       ->required();
@@ -153,6 +158,14 @@ int RunCalibColmap(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--scale", scale,
                  "CAM_A,CAM_B,METRES: known distance between two camera centres");
+  app.add_option("--board", board_spec,
+                 "board for the scale, e.g. charuco:11x8:0.03:0.022 (docs/cameras.md)");
+  app.add_option("--board-images", board_images,
+                 "folder with <camera>/<frame> images of the board (cameras named as the "
+                 "--images folders; only cameras that see it)");
+  app.add_option("--world", world, "camera (the master) or board (needs --board)")
+      ->check(CLI::IsMember({"camera", "board"}))
+      ->capture_default_str();
   app.add_option("--master", options.master, "world = this camera (default: the first)");
   app.add_option("--colmap", options.colmap, "the colmap binary")->capture_default_str();
   app.add_option("--threads", options.num_threads, "threads for COLMAP")
@@ -174,13 +187,42 @@ int RunCalibColmap(int argc, char** argv) {
                          "'" + scale + "'");
       }
     }
+    if (!board_spec.empty() && !scale.empty()) {
+      throw InputError("calib colmap", "--scale / --board", "one source of scale",
+                       "both given");
+    }
+    if (board_spec.empty() != board_images.empty()) {
+      throw InputError("calib colmap", "--board / --board-images", "both or neither",
+                       board_spec.empty() ? "only --board-images" : "only --board");
+    }
+    if (world == "board" && board_spec.empty()) {
+      throw InputError("calib colmap", "--world", "camera, or board with --board",
+                       "board without --board");
+    }
+    const BoardSpec board = board_spec.empty() ? BoardSpec() : ParseBoardSpec(board_spec);
     std::cout << "running colmap on " << images << "\n";
-    const ColmapSfmResult result = CalibrateWithColmap(images, options, &std::cout);
+    ColmapSfmResult result = CalibrateWithColmap(images, options, &std::cout);
     fs::create_directories(out);
     RigFileInfo info;
     info.world = "camera:" + result.rig[0].name;
     if (!options.master.empty()) info.world = "camera:" + options.master;
-    if (options.camera_a.empty()) info.world += " (COLMAP units, scale unknown)";
+    if (!board_spec.empty()) {
+      std::cout << "detecting the board in " << board_images << "\n";
+      const std::vector<CameraBoardViews> views =
+          DetectBoardsInFolders(board_images, board, {}, &std::cout);
+      const BoardScaleResult fix = ScaleFromBoard(result.rig, views, board, board_images);
+      ScaleRig(&result.rig, fix.scale);
+      result.scale = fix.scale;
+      std::cout << "board scale from " << fix.corners << " corners in " << fix.frames
+                << " frames (" << fix.pairs << " pairs, spread " << 100 * fix.spread
+                << " %)\n";
+      if (world == "board") {
+        SetWorldToBoard(&result.rig, fix.world_from_board);
+        info.world = "board in frame " + fix.board_frame;
+      }
+    } else if (options.camera_a.empty()) {
+      info.world += " (COLMAP units, scale unknown)";
+    }
     WriteRig(result.rig, {"json", (fs::path(out) / "rig.json").string()}, info);
     WriteRig(result.rig, {"colmap-text", (fs::path(out) / "colmap").string()}, info);
     RigPlotOptions plot;
@@ -199,7 +241,8 @@ void PrintCalibUsage(std::ostream& out) {
          "  board   --images DIR --board SPEC [--out DIR]   calibrate from board images\n"
          "  render-board --out DIR                         synthetic board images to try "
          "it\n"
-         "  colmap  --images DIR [--scale A,B,METRES]      calibrate by SfM with colmap\n"
+         "  colmap  --images DIR [--scale A,B,METRES | --board SPEC --board-images DIR]\n"
+         "                                                 calibrate by SfM with colmap\n"
          "Run 'handlabel calib <board|colmap> --help' for the options. Guide: "
          "docs/cameras.md\n";
 }

@@ -1,15 +1,17 @@
 // `handlabel eval-network`: accuracy of POEM weights on held-out synthetic frames
 // (docs/training.md).
 
+#include <unistd.h>
 #include <cstdio>
+
 #include <iostream>
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
-#include "apps/progress_bar.h"
 #include "core/errors.h"
 #include "core/hand_model_io.h"
 #include "pipeline/network_evaluation.h"
+#include "pipeline/progress.h"
 #include "pipeline/train_config.h"
 
 namespace handlabel {
@@ -51,10 +53,10 @@ int RunEvalNetwork(int argc, char** argv) {
     tc.source_file = "--hand-model";
     std::string hand_source;
     const HandModel hand = LoadTrainingHandModel(tc, &hand_source);
-    ProgressBar bar(o.frames, "frames");
+    Progress progress(o.frames, std::cerr, Progress::IsTerminal(STDERR_FILENO), "eval");
     const NetworkEvalResult r =
-        EvaluatePoemOnSynth(hand, o, [&](int done, int) { bar.Update(done); });
-    bar.Finish();
+        EvaluatePoemOnSynth(hand, o, [&](int done, int) { progress.Update(done); });
+    progress.Finish();
     std::printf(
         "frames %d (preset %s, seed %llu)\n"
         "MPJPE    %.2f mm\nMPVPE    %.2f mm\nPA-MPJPE %.2f mm\nPA-MPVPE %.2f mm\n"

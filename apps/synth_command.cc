@@ -1,12 +1,14 @@
+#include <unistd.h>
+
 #include <iostream>
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
-#include "apps/progress_bar.h"
 #include "core/errors.h"
 #include "pipeline/capture_reader.h"
 #include "pipeline/contact_sheet.h"
 #include "pipeline/hand_model_source.h"
+#include "pipeline/progress.h"
 #include "pipeline/synth_capture.h"
 
 namespace handlabel {
@@ -86,11 +88,12 @@ int RunSynth(int argc, char** argv) {
     const ResolvedHandModel hand =
         ResolveHandModel(hand_model, side == "left" ? HandSide::kLeft : HandSide::kRight);
     if (!hand.note.empty()) std::cerr << "handlabel synth: note: " << hand.note << "\n";
-    ProgressBar bar(o.num_frames, "frames");
+    Progress progress(o.num_frames, std::cerr, Progress::IsTerminal(STDERR_FILENO),
+                      "synth");
     const SynthCaptureSummary s =
         WriteSynthCapture(hand.model, o, out_dir, hand.source, overwrite,
-                          [&](int done, int) { bar.Update(done); });
-    bar.Finish();
+                          [&](int done, int) { progress.Update(done); });
+    progress.Finish();
     std::cout << "wrote " << s.frames << " frames x " << s.views / s.frames
               << " views to " << out_dir << " (" << s.views_visible
               << " views show the hand, " << s.views_occluded << " occluded, "

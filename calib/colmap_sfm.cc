@@ -1,5 +1,7 @@
 #include "calib/colmap_sfm.h"
 
+#include "calib/board_scale.h"
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -51,7 +53,7 @@ double FixRigScale(Rig* rig, const std::string& a, const std::string& b, double 
                      a + " and " + b + " coincide");
   }
   const double scale = distance / d;
-  for (size_t i = 0; i < rig->size(); ++i) (*rig)[i].cam_from_world.translation *= scale;
+  ScaleRig(rig, scale);
   return scale;
 }
 

@@ -11,6 +11,7 @@
 
 #include "core/errors.h"
 #include "core/triangulation.h"
+#include "fitting/analytic_hand_pose.h"
 #include "fitting/axis_angle_manifold.h"
 #include "fitting/joint_limit_cost.h"
 #include "fitting/keypoint_reprojection_cost.h"
@@ -287,8 +288,8 @@ class FitRun {
         AddPriors(&problem, b);
         if (!config_.optimise_shape) problem.Hold(b->betas);
       }
-      problem.Solve(SolverOptions(options_, stage == 0 ? options_.rigid_iterations
-                                                       : options_.init_iterations));
+      problem.Solve(SolverOptions(
+          options_, stage == 0 ? options_.rigid_iterations : options_.init_iterations));
     }
   }
 
@@ -491,6 +492,13 @@ class FitRun {
     for (int i = 0; i < 3; ++i) {
       b.orient[i] = orient[i];
       b.transl[i] = transl[i];
+    }
+    if constexpr (P == kNumPoseParams) {
+      if (source.size() >= 3) {
+        const Points3d rest_points =
+            Eigen::Map<const Points3d>(rest, kNumHandKeypoints, 3);
+        AnalyticHandPose(rest_points, keypoints, weights, r, b.pose.data());
+      }
     }
     if (known >= 4) {
       Points3dTargets targets;

@@ -84,8 +84,9 @@ struct HandFitOptions {
   int keypoint_iterations = 60;
   int silhouette_iterations = 10;
   // Pose-and-shape iterations of the 3D initialisation (InitFromKeypoints3d/Views): it
-  // must land in the keypoint stages' basin; fewer iterations miss it (tested).
-  int init_iterations = 60;
+  // starts from the closed-form bone alignment (fitting/analytic_hand_pose.h), so it
+  // needs few iterations to land in the keypoint stages' basin.
+  int init_iterations = 20;
   // Ceres convergence tolerances.
   double function_tolerance = 1e-6;
   double parameter_tolerance = 1e-10;

@@ -4,34 +4,12 @@
 #include <cmath>
 #include <vector>
 
+#include "core/hand_rest_skeleton.h"
+
 namespace handlabel {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Right-hand rest positions (metres): 16 native joints then 5 fingertips
-// (thumb, index, middle, ring, pinky).
-const double kJoints[21][3] = {{0, 0, 0},  // wrist
-                               {-0.09, 0, 0.025},
-                               {-0.13, 0, 0.025},
-                               {-0.155, 0, 0.025},  // index
-                               {-0.092, 0.002, 0.004},
-                               {-0.137, -0.003, 0.005},
-                               {-0.165, -0.006, 0.006},  // middle
-                               {-0.08, 0.0, -0.035},
-                               {-0.11, -0.004, -0.04},
-                               {-0.128, -0.007, -0.043},  // pinky
-                               {-0.088, 0.001, -0.016},
-                               {-0.13, -0.003, -0.019},
-                               {-0.157, -0.006, -0.021},  // ring
-                               {-0.02, -0.01, 0.025},
-                               {-0.045, -0.015, 0.05},
-                               {-0.065, -0.018, 0.065},  // thumb
-                               {-0.085, -0.02, 0.075},
-                               {-0.175, 0, 0.025},
-                               {-0.186, -0.009, 0.007},
-                               {-0.177, -0.009, -0.022},
-                               {-0.144, -0.01, -0.045}};
 
 struct Builder {
   std::vector<Eigen::Vector3d> v;
@@ -119,7 +97,7 @@ HandModel MakeCapsuleHand(HandSide side) {
   Builder m;
   std::vector<Eigen::Vector3d> p(21);
   for (int i = 0; i < 21; ++i)
-    p[i] = Eigen::Vector3d(kJoints[i][0], kJoints[i][1], kJoints[i][2]);
+    p[i] = Eigen::Vector3d(kRestSkeleton[i][0], kRestSkeleton[i][1], kRestSkeleton[i][2]);
   // Hidden joint vertices first: vertex j = joint j, moving with its parent.
   for (int j = 0; j < kNumHandJoints; ++j) {
     m.v.push_back(p[j]);

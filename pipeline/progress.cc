@@ -61,6 +61,17 @@ void Progress::FrameDone(bool failed) {
   std::lock_guard<std::mutex> lock(mutex_);
   ++done_;
   failed_ += failed;
+  Draw();
+}
+
+void Progress::Update(int done) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (done <= done_) return;
+  done_ = done;
+  Draw();
+}
+
+void Progress::Draw() {
   const auto now = std::chrono::steady_clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   if (interactive_) {

@@ -16,6 +16,8 @@ class Progress {
   Progress(int total, std::ostream& out, bool interactive, std::string label = "label");
   // One frame finished (ok or failed).
   void FrameDone(bool failed);
+  // For callers that report a running count instead: `done` frames are finished.
+  void Update(int done);
   // Final line (a newline after the bar). Called by the destructor if not before.
   void Finish();
   ~Progress();
@@ -27,6 +29,7 @@ class Progress {
 
  private:
   std::string Line(double elapsed) const;
+  void Draw();  // with mutex_ held
 
   const int total_;
   std::ostream& out_;

@@ -5,9 +5,11 @@
 #include <filesystem>
 #include <random>
 
+#include "calib/board_scale.h"
 #include "calib/gray_image.h"
 #include "calib/rig_compare.h"
 #include "calib/rig_json.h"
+#include "calib/synthetic_board_capture.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 
@@ -65,10 +67,8 @@ GrayImage RenderScene(const RigCamera& c) {
   return image;
 }
 
-TEST(CalibColmap, RecoversASyntheticRigUpToTheKnownScale) {
-  if (std::system("colmap help > /dev/null 2>&1") != 0)
-    GTEST_SKIP() << "no colmap binary";
-  const std::string dir = testing::ScratchDir();
+// 4 cameras on an arc looking at the scene, each with one image of it.
+Rig MakeSceneRig(const std::string& dir) {
   Rig truth;
   // Small images and few cameras keep COLMAP's run short.
   for (int i = 0; i < 4; ++i) {
@@ -81,6 +81,14 @@ TEST(CalibColmap, RecoversASyntheticRigUpToTheKnownScale) {
     WriteGrayImage(RenderScene(truth[i]),
                    dir + "/images/" + truth[i].name + "/000000.png");
   }
+  return truth;
+}
+
+TEST(CalibColmap, RecoversASyntheticRigUpToTheKnownScale) {
+  if (std::system("colmap help > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "no colmap binary";
+  const std::string dir = testing::ScratchDir();
+  const Rig truth = MakeSceneRig(dir);
   const double distance = (truth[0].CenterInWorld() - truth[3].CenterInWorld()).norm();
   const auto r = testing::RunHandlabelCommand(
       {"calib", "colmap", "--images", dir + "/images", "--model", "SIMPLE_PINHOLE",
@@ -92,6 +100,55 @@ TEST(CalibColmap, RecoversASyntheticRigUpToTheKnownScale) {
   EXPECT_LT(d.worst.focal_rel, 0.02);
   EXPECT_LT(d.worst.rotation_deg, 0.5);
   EXPECT_LT(d.worst.centre_m, 0.01);
+}
+
+TEST(CalibColmap, TakesScaleAndWorldFromABoardSeenByTwoCameras) {
+  if (std::system("colmap help > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "no colmap binary";
+  const std::string dir = testing::ScratchDir();
+  const Rig truth = MakeSceneRig(dir);
+  // One frame of a board held up towards the cameras, rendered into every camera.
+  const BoardSpec board = ParseBoardSpec("charuco:7x5:0.06:0.045");
+  SyntheticBoardCapture capture;
+  capture.rig = truth;
+  const Eigen::Vector3d target(0.4, 0.3, 0.35);
+  // Board z points away from the cameras (its printed side faces them).
+  const Rigid3 facing =
+      LookAt(Eigen::Vector3d(0.75, 0.75, 0.9), target, Eigen::Vector3d::UnitZ())
+          .Inverse();
+  const Eigen::Vector3d board_centre(board.Width() / 2, board.Height() / 2, 0);
+  capture.world_from_board["000000"] =
+      Rigid3(facing.rotation, target - facing.rotation * board_centre);
+  RenderBoardCapture(capture, board, dir + "/board");
+
+  const auto r = testing::RunHandlabelCommand(
+      {"calib", "colmap", "--images", dir + "/images", "--model", "SIMPLE_PINHOLE",
+       "--board", board.ToString(), "--board-images", dir + "/board", "--world", "board",
+       "--out", dir + "/out", "--threads", "1"});
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("board scale from"), std::string::npos) << r.out;
+  const Rig rig = ReadRigJson(dir + "/out/rig.json");
+  Rig truth_on_board = truth;
+  SetWorldToBoard(&truth_on_board, capture.world_from_board.at("000000"));
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const RigCamera& c = rig.Find(truth[i].name);
+    EXPECT_LT((c.CenterInWorld() - truth_on_board[i].CenterInWorld()).norm(), 0.01)
+        << c.name;
+    std::cout << c.name << " centre error "
+              << (c.CenterInWorld() - truth_on_board[i].CenterInWorld()).norm() << " m\n";
+  }
+}
+
+TEST(CalibColmap, ScaleAndBoardOptionsAreCheckedBeforeColmapRuns) {
+  const auto both = testing::RunHandlabelCommand(
+      {"calib", "colmap", "--images", "x", "--scale", "a,b,1", "--board",
+       "charuco:7x5:0.04:0.03", "--board-images", "y"});
+  EXPECT_EQ(both.status, 1);
+  EXPECT_NE(both.err.find("one source of scale"), std::string::npos) << both.err;
+  const auto world = testing::RunHandlabelCommand(
+      {"calib", "colmap", "--images", "x", "--world", "board"});
+  EXPECT_EQ(world.status, 1);
+  EXPECT_NE(world.err.find("--world"), std::string::npos) << world.err;
 }
 
 }  // namespace

@@ -8,32 +8,12 @@
 #include <random>
 
 #include "core/hand_model.h"
+#include "core/hand_rest_skeleton.h"
 
 namespace handlabel::testing {
 
 inline HandModel MakeStickHand(HandSide side) {
-  // Native joints then tips (thumb, index, middle, ring, pinky), metres.
-  const double p[21][3] = {{0, 0, 0},  // wrist
-                           {-0.09, 0, 0.025},
-                           {-0.13, 0, 0.025},
-                           {-0.155, 0, 0.025},  // index
-                           {-0.092, 0.002, 0.004},
-                           {-0.137, -0.003, 0.005},
-                           {-0.165, -0.006, 0.006},  // middle
-                           {-0.08, 0.0, -0.035},
-                           {-0.11, -0.004, -0.04},
-                           {-0.128, -0.007, -0.043},  // pinky
-                           {-0.088, 0.001, -0.016},
-                           {-0.13, -0.003, -0.019},
-                           {-0.157, -0.006, -0.021},  // ring
-                           {-0.02, -0.01, 0.025},
-                           {-0.045, -0.015, 0.05},
-                           {-0.065, -0.018, 0.065},   // thumb
-                           {-0.085, -0.02, 0.075},    // thumb tip
-                           {-0.175, 0, 0.025},        // index tip
-                           {-0.186, -0.009, 0.007},   // middle tip
-                           {-0.177, -0.009, -0.022},  // ring tip
-                           {-0.144, -0.01, -0.045}};  // pinky tip
+  const auto& p = kRestSkeleton;
   const int kVerts = 21;
   const double mirror = side == HandSide::kLeft ? -1.0 : 1.0;
   const double m[3] = {mirror, 1.0, 1.0};

@@ -39,6 +39,19 @@ TEST(Progress, InteractiveModeRedrawsOneLineWithBarAndEndsWithANewline) {
   EXPECT_EQ(text.back(), '\n');
 }
 
+TEST(Progress, RunningCountsGiveTheSameLinesAsSingleFrames) {
+  std::ostringstream counted;
+  {
+    Progress progress(10, counted, false, "synth");
+    progress.Update(4);
+    progress.Update(3);  // late reports from other threads never go backwards
+    progress.Update(10);
+  }
+  EXPECT_THAT(counted.str(), HasSubstr("synth 4/10 frames"));
+  EXPECT_THAT(counted.str(), HasSubstr("synth 10/10 frames"));
+  EXPECT_EQ(counted.str().find("3/10"), std::string::npos);
+}
+
 TEST(Progress, DurationsReadNaturally) {
   EXPECT_EQ(Progress::FormatDuration(12.4), "12s");
   EXPECT_EQ(Progress::FormatDuration(187), "3m07s");
