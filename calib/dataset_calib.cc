@@ -263,21 +263,7 @@ Rig ReadOakInk(const fs::path& path, RigFileInfo* info) {
   for (const fs::path& f : files) {
     std::string g, c;
     if (!split(f.stem().string(), &g, &c) || g != group) continue;
-    const PickleValue root = ReadPickleFile(f.string());
-    if (root.kind != PickleValue::Kind::kDict) {
-      throw InputError(f.string(), "(pickle)", "a dict with cam_intr and cam_extr",
-                       root.Describe());
-    }
-    const std::vector<double> k = PickleMatrix(root, "cam_intr", 3, 3, f.string());
-    const std::vector<double> e = PickleMatrix(root, "cam_extr", 4, 4, f.string());
-    Matrix3x4d m;
-    for (int r = 0; r < 3; ++r) {
-      for (int col = 0; col < 4; ++col) m(r, col) = e[4 * r + col];
-    }
-    rig.Add(
-        {c,
-         Camera(CameraModelId::kPinhole, 848, 480, {k[0], k[4], k[2], k[5]}, f.string()),
-         Rigid3::FromMatrix(m)});
+    rig.Add(ReadOakInkCamera(f.string(), c));
   }
   if (rig.empty()) {
     throw InputError(path.string(), "(pickles)", "OakInk general_info pickles",
@@ -288,6 +274,22 @@ Rig ReadOakInk(const fs::path& path, RigFileInfo* info) {
 }
 
 }  // namespace
+
+RigCamera ReadOakInkCamera(const std::string& path, const std::string& name) {
+  const PickleValue root = ReadPickleFile(path);
+  if (root.kind != PickleValue::Kind::kDict) {
+    throw InputError(path, "(pickle)", "a dict with cam_intr and cam_extr",
+                     root.Describe());
+  }
+  const std::vector<double> k = PickleMatrix(root, "cam_intr", 3, 3, path);
+  const std::vector<double> e = PickleMatrix(root, "cam_extr", 4, 4, path);
+  Matrix3x4d m;
+  for (int r = 0; r < 3; ++r) {
+    for (int col = 0; col < 4; ++col) m(r, col) = e[4 * r + col];
+  }
+  return {name, Camera(CameraModelId::kPinhole, 848, 480, {k[0], k[4], k[2], k[5]}, path),
+          Rigid3::FromMatrix(m)};
+}
 
 std::vector<std::string> DatasetRigFormats() { return {"dexycb", "ho3d", "oakink"}; }
 

@@ -25,4 +25,10 @@ std::vector<std::string> DatasetRigFormats();
 Rig ReadDatasetRig(const std::string& format, const std::string& path,
                    RigFileInfo* info = nullptr);
 
+// One OakInk camera from one general_info pickle (cam_intr 3x3, cam_extr 4x4 world ->
+// camera; PINHOLE 848x480), named `name`: what ReadDatasetRig("oakink", ...) reads per
+// camera, for readers that already know which pickles form a frame. Throws InputError
+// naming the file and key.
+RigCamera ReadOakInkCamera(const std::string& path, const std::string& name);
+
 }  // namespace handlabel

@@ -7,6 +7,7 @@
 #include "pipeline/ho3d_frame_source.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/native_frame_source.h"
+#include "pipeline/oakink_frame_source.h"
 #include "pipeline/poem_mesh_predictor.h"
 
 namespace handlabel {
@@ -36,9 +37,10 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
   if (job.input_format == "ho3d") {
     return std::make_unique<Ho3dFrameSource>(job.input_path, cameras);
   }
-  // OakInk: convert to the native layout first (its reader plugs in here).
-  throw InputError(job.source_file, "input.format",
-                   "a format this build reads directly (native, dexycb, ho3d)",
+  if (job.input_format == "oakink") {
+    return std::make_unique<OakInkFrameSource>(job.input_path, cameras);
+  }
+  throw InputError(job.source_file, "input.format", "native | dexycb | ho3d | oakink",
                    "'" + job.input_format + "'");
 }
 
