@@ -16,6 +16,13 @@
 namespace handlabel::testing {
 namespace {
 
+// The running test's private folder (ScratchDir); removed when the test passes.
+std::filesystem::path ScratchPath(const ::testing::TestInfo& info) {
+  return std::filesystem::temp_directory_path() /
+         ("handlabel_" + std::string(info.test_suite_name()) + "_" + info.name() + "_" +
+          std::to_string(::getpid()));
+}
+
 std::mt19937_64 g_rng;
 uint64_t g_seed = 0;
 
@@ -30,7 +37,12 @@ class SeedPerTest : public ::testing::EmptyTestEventListener {
     g_rng.seed(h);
   }
   void OnTestEnd(const ::testing::TestInfo& info) override {
-    if (info.result()->Failed()) std::cerr << "  test seed: " << g_seed << "\n";
+    if (info.result()->Failed()) {
+      std::cerr << "  test seed: " << g_seed << "\n";
+      return;  // the scratch folder stays for inspection
+    }
+    std::error_code ignored;
+    std::filesystem::remove_all(ScratchPath(info), ignored);
   }
 };
 
@@ -42,10 +54,7 @@ uint64_t TestSeed() { return g_seed; }
 std::string ScratchDir() {
   const ::testing::TestInfo* info =
       ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() /
-      ("handlabel_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-       std::to_string(::getpid()));
+  const std::filesystem::path dir = ScratchPath(*info);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

@@ -20,8 +20,8 @@ std::mt19937_64& TestRng();
 uint64_t TestSeed();
 
 // A fresh, empty folder for the running test, unique per test name and process, so
-// tests that ctest runs in parallel never share files. Removed again at the next call
-// for the same test; left behind after a failure for inspection.
+// tests that ctest runs in parallel never share files. Removed when the test passes
+// (and at the next call for the same test); left behind after a failure for inspection.
 std::string ScratchDir();
 
 // The bytes of a file ("" if it cannot be read).
