@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -18,9 +19,11 @@ namespace {
 
 // The running test's private folder (ScratchDir); removed when the test passes.
 std::filesystem::path ScratchPath(const ::testing::TestInfo& info) {
+  // Parameterised tests have '/' in their names: keep the folder one level deep.
+  std::string name = std::string(info.test_suite_name()) + "_" + info.name();
+  std::replace(name.begin(), name.end(), '/', '_');
   return std::filesystem::temp_directory_path() /
-         ("handlabel_" + std::string(info.test_suite_name()) + "_" + info.name() + "_" +
-          std::to_string(::getpid()));
+         ("handlabel_" + name + "_" + std::to_string(::getpid()));
 }
 
 std::mt19937_64 g_rng;
