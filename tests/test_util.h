@@ -5,11 +5,13 @@
 #include <gmock/gmock.h>
 
 #include <Eigen/Core>
+#include <functional>
 #include <map>
 #include <random>
 #include <sstream>
 #include <string>
 
+#include "core/errors.h"
 #include "core/rigid3.h"
 
 namespace handlabel::testing {
@@ -23,6 +25,17 @@ uint64_t TestSeed();
 // tests that ctest runs in parallel never share files. Removed when the test passes
 // (and at the next call for the same test); left behind after a failure for inspection.
 std::string ScratchDir();
+
+// The message of the InputError `f` throws, or "(no InputError)": for asserting that an
+// error names the file, field and expectation.
+inline std::string InputErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
 
 // The bytes of a file ("" if it cannot be read).
 std::string ReadFileBytes(const std::string& path);

@@ -23,15 +23,6 @@ void WriteAll(const std::string& path, const std::string& data) {
   std::ofstream(path, std::ios::binary) << data;
 }
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(ColmapModel, TextRoundTripIsExact) {
   const ColmapModel model = RandomColmapModel();
   const std::string dir = ScratchDir();
@@ -93,7 +84,7 @@ TEST(ColmapModel, TruncatedBinaryFilesFailWithTheFileAndField) {
     const std::string full = testing::ReadFileBytes(path);
     for (size_t cut = 0; cut < full.size(); cut += 1 + full.size() / 31) {
       WriteAll(path, full.substr(0, cut));
-      const std::string error = ErrorOf([&] { ReadColmapBinary(dir); });
+      const std::string error = testing::InputErrorOf([&] { ReadColmapBinary(dir); });
       EXPECT_NE(error.find(file), std::string::npos) << "cut at " << cut << ": " << error;
     }
     WriteAll(path, full);
@@ -106,25 +97,28 @@ TEST(ColmapModel, GarbledFilesFailClearly) {
   std::string cameras = testing::ReadFileBytes(dir + "/cameras.bin");
   cameras[7] = '\x7f';  // an absurd camera count
   WriteAll(dir + "/cameras.bin", cameras);
-  EXPECT_NE(ErrorOf([&] { ReadColmapBinary(dir); }).find("num_cameras"),
+  EXPECT_NE(testing::InputErrorOf([&] { ReadColmapBinary(dir); }).find("num_cameras"),
             std::string::npos);
 
   const std::string text = ScratchDir();
   WriteColmapText(RandomColmapModel(), text);
   WriteAll(text + "/cameras.txt", "1 PINHOLE 640 480 500 500 320\n");
-  EXPECT_NE(ErrorOf([&] { ReadColmapText(text); }).find("line 1 PARAMS"),
+  EXPECT_NE(testing::InputErrorOf([&] { ReadColmapText(text); }).find("line 1 PARAMS"),
             std::string::npos);
   WriteAll(text + "/cameras.txt", "1 PINHOLE 640 480 500 500 320 abc\n");
-  EXPECT_NE(ErrorOf([&] { ReadColmapText(text); }).find("'abc'"), std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { ReadColmapText(text); }).find("'abc'"),
+            std::string::npos);
   WriteAll(text + "/cameras.txt", "1 FISH 640 480 500 500 320 240\n");
-  EXPECT_NE(ErrorOf([&] { ReadColmapText(text); }).find("FISH"), std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { ReadColmapText(text); }).find("FISH"),
+            std::string::npos);
   WriteAll(text + "/cameras.txt", "1 PINHOLE 640 480 500 500 320 240\n");
   WriteAll(text + "/images.txt", "1 1 0 0 0 0 0 0 1 a.png\n");
-  EXPECT_NE(ErrorOf([&] { ReadColmapText(text); }).find("line 2 POINTS2D"),
+  EXPECT_NE(testing::InputErrorOf([&] { ReadColmapText(text); }).find("line 2 POINTS2D"),
             std::string::npos);
   WriteAll(text + "/images.txt", "1 1 0 0 0 0 0 0 2 a.png\n\n");
-  EXPECT_NE(ErrorOf([&] { ReadColmapText(text); }).find("CAMERA_ID"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ReadColmapModel(ScratchDir()); }).find("cameras"),
+  EXPECT_NE(testing::InputErrorOf([&] { ReadColmapText(text); }).find("CAMERA_ID"),
+            std::string::npos);
+  EXPECT_NE(testing::InputErrorOf([&] { ReadColmapModel(ScratchDir()); }).find("cameras"),
             std::string::npos);
 }
 

@@ -46,15 +46,6 @@ std::pair<double, int> ImageDifference(const ImageU8& a, const ImageU8& b) {
   return {sum / a.data.size(), worst};
 }
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
-
 TEST(DexYcbFrameSource, LoadsTheRigImagesKeypointsAndTruthThatWereWritten) {
   const DexYcbFixture fx =
       WriteDexYcbFixture(testing::ScratchDir(), MakeCapsuleHand(HandSide::kRight));
@@ -169,16 +160,17 @@ TEST(DexYcbFrameSource, SeveralSequencesGetSubjectAndSequenceInTheirIds) {
               testing::MatrixNear(fb.frames[0].scene.hand.keypoints, 1e-9));
   EXPECT_EQ(LabelFilePath("out", want[2]),
             "out/labels/20200709-subject-01__20200709_142123__000000.json");
-  EXPECT_THAT(ErrorOf([&] { source.Load(s + "20200709_142123/000001"); }),
+  EXPECT_THAT(testing::InputErrorOf([&] { source.Load(s + "20200709_142123/000001"); }),
               HasSubstr("frame id"));
-  EXPECT_THAT(ErrorOf([&] { source.Load("000000"); }), HasSubstr("frame id"));
+  EXPECT_THAT(testing::InputErrorOf([&] { source.Load("000000"); }),
+              HasSubstr("frame id"));
 
   // One job fits one hand model: mixed sides are refused, naming the sequence.
   DexYcbFixtureOptions c = b;
   c.sequence = "20200709_150000";
   c.side = "left";
   WriteDexYcbFixture(root, MakeCapsuleHand(HandSide::kLeft), c);
-  const std::string error = ErrorOf([&] { DexYcbFrameSource{root}; });
+  const std::string error = testing::InputErrorOf([&] { DexYcbFrameSource{root}; });
   EXPECT_THAT(error, HasSubstr("20200709_150000/meta.yml"));
   EXPECT_THAT(error, HasSubstr("mano_sides"));
 }
@@ -214,21 +206,22 @@ TEST(DexYcbFrameSource, BrokenLayoutsNameTheFileAndField) {
   fs::remove(image);
   const DexYcbFrameSource source(fx.sequence);
   EXPECT_NO_THROW(source.Load("000000"));
-  std::string error = ErrorOf([&] { source.Load("000001"); });
+  std::string error = testing::InputErrorOf([&] { source.Load("000001"); });
   EXPECT_THAT(error, HasSubstr(image));
   EXPECT_THAT(error, HasSubstr(fx.rig[2].name));
-  EXPECT_THAT(ErrorOf([&] { source.Load("000002"); }), HasSubstr("000000..000001"));
+  EXPECT_THAT(testing::InputErrorOf([&] { source.Load("000002"); }),
+              HasSubstr("000000..000001"));
 
   // A labels file without joint_2d.
   WriteNpzFile(fx.sequence + "/" + fx.rig[1].name + "/labels_000000.npz",
                {{"seg", NdArray::FromMatrix(Eigen::MatrixXd::Zero(2, 2))}});
-  error = ErrorOf([&] { source.Load("000000"); });
+  error = testing::InputErrorOf([&] { source.Load("000000"); });
   EXPECT_THAT(error, HasSubstr("labels_000000.npz"));
   EXPECT_THAT(error, HasSubstr("joint_2d"));
 
   // A camera folder is missing.
   fs::rename(fx.sequence + "/" + fx.rig[3].name, fx.sequence + "/moved");
-  error = ErrorOf([&] { DexYcbFrameSource{fx.sequence}; });
+  error = testing::InputErrorOf([&] { DexYcbFrameSource{fx.sequence}; });
   EXPECT_THAT(error, HasSubstr(meta));
   EXPECT_THAT(error, HasSubstr("serials"));
   EXPECT_THAT(error, HasSubstr(fx.rig[3].name));
@@ -237,7 +230,7 @@ TEST(DexYcbFrameSource, BrokenLayoutsNameTheFileAndField) {
   // meta.yml fields.
   const auto with_meta = [&](const std::string& text) {
     std::ofstream(meta) << text;
-    return ErrorOf([&] { DexYcbFrameSource{fx.sequence}; });
+    return testing::InputErrorOf([&] { DexYcbFrameSource{fx.sequence}; });
   };
   const std::string serials = "serials: ['" + fx.rig[0].name + "']\n";
   const std::string calib = "extrinsics: 20200709-subject-01\n";
@@ -253,7 +246,7 @@ TEST(DexYcbFrameSource, BrokenLayoutsNameTheFileAndField) {
   EXPECT_THAT(with_meta(serials + "num_frames: 2\nmano_sides: [right]\n"),
               HasSubstr("extrinsics"));
   EXPECT_THAT(with_meta("serials: [a\n"), HasSubstr("YAML"));
-  EXPECT_THAT(ErrorOf([&] { DexYcbFrameSource{fx.root + "/calibration"}; }),
+  EXPECT_THAT(testing::InputErrorOf([&] { DexYcbFrameSource{fx.root + "/calibration"}; }),
               HasSubstr("meta.yml"));
 }
 

@@ -118,15 +118,6 @@ Ho3dFixture WriteHo3dFixture(const std::string& root, int num_frames = 2,
   return fx;
 }
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
-
 TEST(Ho3dFrameSource, LoadsTheRigImagesAndTruthThatWereWritten) {
   const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir());
   const Ho3dFrameSource source(fx.split + "/ABF1");
@@ -214,8 +205,9 @@ TEST(Ho3dFrameSource, SplitFolderListsCalibratedSequences) {
   EXPECT_EQ(source.FrameIds(), (std::vector<std::string>{"ABF1/0000", "ABF1/0001"}));
   const FrameInput frame = source.Load("ABF1/0001");
   EXPECT_EQ(frame.image_paths[2], fx.split + "/ABF12/rgb/0001.jpg");
-  EXPECT_THAT(ErrorOf([&] { source.Load("0001"); }), HasSubstr("frame id"));
-  EXPECT_THAT(ErrorOf([&] { source.Load("ABF1/0002"); }), HasSubstr("frame id"));
+  EXPECT_THAT(testing::InputErrorOf([&] { source.Load("0001"); }), HasSubstr("frame id"));
+  EXPECT_THAT(testing::InputErrorOf([&] { source.Load("ABF1/0002"); }),
+              HasSubstr("frame id"));
 }
 
 TEST(Ho3dFrameSource, JobFileSelectsIt) {
@@ -241,28 +233,29 @@ TEST(Ho3dFrameSource, BrokenLayoutsNameTheFileAndField) {
   const Ho3dFrameSource source(fx.split + "/ABF1");
   EXPECT_EQ(source.FrameIds().size(), 2u);
   EXPECT_NO_THROW(source.Load("0000"));
-  std::string error = ErrorOf([&] { source.Load("0001"); });
+  std::string error = testing::InputErrorOf([&] { source.Load("0001"); });
   EXPECT_THAT(error, HasSubstr(fx.split + "/ABF12/rgb/0001.jpg"));
   EXPECT_THAT(error, HasSubstr("ABF12"));
   // A broken meta pickle fails its frame, naming it.
   std::ofstream(fx.split + "/ABF10/meta/0000.pkl") << "garbage";
-  EXPECT_THAT(ErrorOf([&] { source.Load("0000"); }), HasSubstr("ABF10/meta/0000.pkl"));
+  EXPECT_THAT(testing::InputErrorOf([&] { source.Load("0000"); }),
+              HasSubstr("ABF10/meta/0000.pkl"));
   // A camera folder listed by the calibration is missing.
   fs::rename(fx.split + "/ABF11", fx.split + "/moved");
-  error = ErrorOf([&] { Ho3dFrameSource{fx.split + "/ABF1"}; });
+  error = testing::InputErrorOf([&] { Ho3dFrameSource{fx.split + "/ABF1"}; });
   EXPECT_THAT(error, HasSubstr("ABF11/rgb"));
   EXPECT_THAT(error, HasSubstr("cam_orders.txt"));
   fs::rename(fx.split + "/moved", fx.split + "/ABF11");
   // A calibration file is broken.
   std::ofstream(fx.root + "/calibration/ABF1/calibration/cam_1_intrinsics.txt")
       << "fx:600, fy:600\n";
-  error = ErrorOf([&] { Ho3dFrameSource{fx.split + "/ABF1"}; });
+  error = testing::InputErrorOf([&] { Ho3dFrameSource{fx.split + "/ABF1"}; });
   EXPECT_THAT(error, HasSubstr("cam_1_intrinsics.txt"));
   EXPECT_THAT(error, HasSubstr("ppx"));
   // Not an HO3D sequence.
-  EXPECT_THAT(ErrorOf([&] { Ho3dFrameSource{fx.split + "/XYZ1"}; }),
+  EXPECT_THAT(testing::InputErrorOf([&] { Ho3dFrameSource{fx.split + "/XYZ1"}; }),
               HasSubstr("input.path"));
-  EXPECT_THAT(ErrorOf([&] { Ho3dFrameSource{fx.root + "/nowhere/ABF1"}; }),
+  EXPECT_THAT(testing::InputErrorOf([&] { Ho3dFrameSource{fx.root + "/nowhere/ABF1"}; }),
               HasSubstr("input.path"));
 }
 

@@ -106,15 +106,6 @@ OakInkFixture WriteOakInkFixture(const std::string& root, int num_frames = 2) {
   return fx;
 }
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
-
 TEST(OakInkFrameSource, LoadsTheRigImagesAndTruthThatWereWritten) {
   const OakInkFixture fx = WriteOakInkFixture(testing::ScratchDir());
   const OakInkFrameSource source(fx.image_dir);
@@ -206,20 +197,21 @@ TEST(OakInkFrameSource, BrokenLayoutsNameTheFileAndField) {
   fs::remove(image);
   const OakInkFrameSource source(fx.image_dir);
   EXPECT_NO_THROW(source.Load(fx.ids[0]));
-  EXPECT_THAT(ErrorOf([&] { source.Load(fx.ids[1]); }), HasSubstr(image));
+  EXPECT_THAT(testing::InputErrorOf([&] { source.Load(fx.ids[1]); }), HasSubstr(image));
   // A hand_j file of the wrong shape.
   WritePickle(anno + "/hand_j/" + fx.ids[0] + "__0.pkl",
               PointsPickle(fx.frames[0].scene.hand.keypoints.topRows(5), Rigid3()));
-  std::string error = ErrorOf([&] { source.Load(fx.ids[0]); });
+  std::string error = testing::InputErrorOf([&] { source.Load(fx.ids[0]); });
   EXPECT_THAT(error, HasSubstr("hand_j/" + fx.ids[0] + "__0.pkl"));
   EXPECT_THAT(error, HasSubstr("21 x 3"));
-  EXPECT_THAT(ErrorOf([&] { source.Load("nope"); }), HasSubstr("frame id"));
+  EXPECT_THAT(testing::InputErrorOf([&] { source.Load("nope"); }), HasSubstr("frame id"));
   // A misnamed pickle and a missing folder stop the job before it starts.
   std::ofstream(anno + "/general_info/stray.pkl") << "x";
-  error = ErrorOf([&] { OakInkFrameSource{fx.image_dir}; });
+  error = testing::InputErrorOf([&] { OakInkFrameSource{fx.image_dir}; });
   EXPECT_THAT(error, HasSubstr("stray.pkl"));
   EXPECT_THAT(error, HasSubstr("<seq>__<ts>__<sbj>__<frame>__<cam>.pkl"));
-  EXPECT_THAT(ErrorOf([&] { OakInkFrameSource{anno}; }), HasSubstr("input.path"));
+  EXPECT_THAT(testing::InputErrorOf([&] { OakInkFrameSource{anno}; }),
+              HasSubstr("input.path"));
 }
 
 }  // namespace
