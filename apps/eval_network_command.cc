@@ -66,6 +66,7 @@ int RunEvalNetwork(int argc, char** argv) {
         static_cast<unsigned long long>(o.synth.seed), r.mpjpe_mm, r.mpvpe_mm,
         r.pa_mpjpe_mm, r.pa_mpvpe_mm, r.joint_pck.auc, r.vertex_pck.auc,
         r.frames_per_second);
+    if (r.mask_iou >= 0) std::printf("mask IoU (crop grid)   %.3f\n", r.mask_iou);
     if (!pck_png.empty()) {
       WritePckPlot(r, pck_png, "PCK " + o.synth.rig.preset + " synthetic");
       std::cout << "PCK curve: " << pck_png << "\n";

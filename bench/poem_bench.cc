@@ -3,8 +3,9 @@
 //
 //   ./build/bench/poem_bench [--benchmark_filter=Small]
 // Arguments: views, frames per batch, intra-op threads. Counters: frames_per_s.
-// Configs: "small" (half-width ResNet18, 128 crops, 1024 points, 3 blocks) and the
-// released architecture (ResNet34, 256 crops, 4096 points, 6 blocks).
+// Configs: "small" (half-width ResNet18, 128 crops, 1024 points, 3 blocks), the
+// released architecture (ResNet34, 256 crops, 4096 points, 6 blocks), and the shipped
+// models/poem_small_dexycb.pt (its own config, with the mask head if it has one).
 
 #include <benchmark/benchmark.h>
 
@@ -13,6 +14,7 @@
 
 #include "core/rigid3.h"
 #include "network/hand_mesh_predictor.h"
+#include "pipeline/build_config.h"
 
 namespace handlabel {
 namespace {
@@ -44,7 +46,12 @@ std::vector<HandMeshInput> SyntheticFrames(int frames, int views, int crop) {
 
 void BM_Poem(benchmark::State& state, const std::string& config) {
   HandMeshPredictorOptions o;
-  o.config = config;
+  const std::string shipped = std::string(HANDLABEL_SOURCE_DIR) + "/" + config;
+  if (config.find(".pt") != std::string::npos) {
+    o.weights = shipped;
+  } else {
+    o.config = config;
+  }
   o.num_views = static_cast<int>(state.range(0));
   o.batch_size = static_cast<int>(state.range(1));
   o.num_threads = static_cast<int>(state.range(2));
@@ -63,6 +70,12 @@ BENCHMARK_CAPTURE(BM_Poem, Small, std::string("small"))
     ->Args({4, 1, 2})
     ->Args({4, 4, 2})
     ->Args({8, 1, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Poem, Shipped, std::string("models/poem_small_dexycb.pt"))
+    ->Args({8, 1, 1})
+    ->Args({8, 1, 2})
+    ->Args({8, 4, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 // The released 8-view model takes seconds per frame: a few iterations only.

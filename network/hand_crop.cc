@@ -169,4 +169,53 @@ ViewCrop CropForView(const RgbImageView& image, const Camera& camera,
   return crop;
 }
 
+MaskImage CropMaskToImage(const Eigen::MatrixXf& probability, int cell,
+                          const Eigen::Matrix3d& K, const Camera& camera,
+                          double threshold) {
+  const int M = static_cast<int>(probability.rows());
+  HL_CHECK(M > 0 && probability.cols() == M && cell > 0, "a square, non-empty grid");
+  const double side = static_cast<double>(M) * cell;
+  MaskImage mask = MaskImage::Zero(camera.height(), camera.width());
+  // Image box of the crop: its border rays, projected (bent by the distortion).
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY);
+  Eigen::Vector2d hi = Eigen::Vector2d::Constant(-INFINITY);
+  constexpr int kBorderSamples = 32;
+  for (int i = 0; i <= kBorderSamples; ++i) {
+    const double t = -0.5 + side * i / kBorderSamples;
+    for (const Eigen::Vector2d& c :
+         {Eigen::Vector2d(t, -0.5), Eigen::Vector2d(t, side - 0.5),
+          Eigen::Vector2d(-0.5, t), Eigen::Vector2d(side - 0.5, t)}) {
+      const Eigen::Vector2d xy((c.x() - K(0, 2)) / K(0, 0), (c.y() - K(1, 2)) / K(1, 1));
+      const Eigen::Vector2d uv = camera.ImageFromNormalized(xy);
+      lo = lo.cwiseMin(uv);
+      hi = hi.cwiseMax(uv);
+    }
+  }
+  const int x_begin = std::max(0, static_cast<int>(std::floor(lo.x())) - 1);
+  const int y_begin = std::max(0, static_cast<int>(std::floor(lo.y())) - 1);
+  const int x_end = std::min(camera.width(), static_cast<int>(std::ceil(hi.x())) + 2);
+  const int y_end = std::min(camera.height(), static_cast<int>(std::ceil(hi.y())) + 2);
+  // Cell (i, j) covers crop pixels [cell j, cell j + cell): its centre is at crop
+  // coordinate cell j + (cell - 1) / 2 (pixel centres at integers).
+  const double centre = 0.5 * (cell - 1);
+  for (int y = y_begin; y < y_end; ++y) {
+    for (int x = x_begin; x < x_end; ++x) {
+      const Eigen::Vector2d xy = camera.NormalizedFromImage(Eigen::Vector2d(x, y));
+      const double cx = K(0, 0) * xy.x() + K(0, 2), cy = K(1, 1) * xy.y() + K(1, 2);
+      if (cx < -0.5 || cy < -0.5 || cx > side - 0.5 || cy > side - 0.5) continue;
+      const double gx = std::clamp((cx - centre) / cell, 0.0, M - 1.0);
+      const double gy = std::clamp((cy - centre) / cell, 0.0, M - 1.0);
+      const int j0 = std::min(static_cast<int>(gx), std::max(M - 2, 0));
+      const int i0 = std::min(static_cast<int>(gy), std::max(M - 2, 0));
+      const int j1 = std::min(j0 + 1, M - 1), i1 = std::min(i0 + 1, M - 1);
+      const double ax = gx - j0, ay = gy - i0;
+      const double p =
+          (1 - ay) * ((1 - ax) * probability(i0, j0) + ax * probability(i0, j1)) +
+          ay * ((1 - ax) * probability(i1, j0) + ax * probability(i1, j1));
+      if (p > threshold) mask(y, x) = 255;
+    }
+  }
+  return mask;
+}
+
 }  // namespace handlabel

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "core/distance_transform.h"
 #include "core/rigid3.h"
 
 namespace handlabel {
@@ -96,5 +97,15 @@ struct HandEvidence {
 // warps the image.
 ViewCrop CropForView(const RgbImageView& image, const Camera& camera,
                      const HandEvidence& evidence, const HandCropOptions& options);
+
+// The inverse direction, for a mask predicted on a coarse grid over a crop
+// (hand_mesh_predictor.h HandMeshPrediction::masks: M x M cells of `cell` crop pixels,
+// M * cell = crop side): the full-image mask (camera size; 255 where the bilinearly
+// interpolated probability exceeds `threshold`, 0 elsewhere and outside the crop).
+// Each image pixel is undistorted to its ray and projected with K_crop, so distorted
+// cameras are exact, as in WarpCrop.
+MaskImage CropMaskToImage(const Eigen::MatrixXf& probability, int cell,
+                          const Eigen::Matrix3d& crop_intrinsics, const Camera& camera,
+                          double threshold = 0.5);
 
 }  // namespace handlabel

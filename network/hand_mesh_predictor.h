@@ -43,6 +43,10 @@ struct HandMeshPrediction {
   // Per view and joint: the heatmap's peak value (sigmoid output, 0..1).
   std::vector<Eigen::Matrix<double, 21, 1>> joint_confidence;
   int64_t points_inside_ball = 0;  // frustum points near the initial mesh
+  // Per view, the mask head's hand probability (0..1) on an M x M grid over the crop,
+  // M = crop_size / 4: cell (row i, column j) covers crop pixels [4j, 4j + 4) x
+  // [4i, 4i + 4). Empty when the network has no mask head.
+  std::vector<Eigen::MatrixXf> masks;
 };
 
 class HandMeshPredictor {
@@ -51,6 +55,8 @@ class HandMeshPredictor {
   virtual std::string name() const = 0;
   virtual int num_views() const = 0;
   virtual int crop_size() const = 0;
+  // True when predictions carry per-view masks (a POEM with a mask head).
+  virtual bool predicts_masks() const = 0;
   // One prediction per frame. Throws InputError naming the frame, view and field of
   // the first invalid input, before any inference runs.
   virtual std::vector<HandMeshPrediction> Predict(

@@ -146,8 +146,15 @@ PoemModel LoadPoemCheckpoint(const std::string& path) {
   return model;
 }
 
-void LoadPoemCheckpointInto(PoemModel& model, const std::string& path) {
+void LoadPoemCheckpointInto(PoemModel& model, const std::string& path,
+                            bool keep_missing_mask_head) {
   Archive a = ReadArchive(path);
+  if (keep_missing_mask_head && model->config().mask_head && !a.config.mask_head) {
+    a.config.mask_head = true;
+    for (const auto& [key, value] : PoemStateDict(model)) {
+      if (key.rfind("mask_head.", 0) == 0) a.tensors[key] = value.detach().clone();
+    }
+  }
   const std::vector<std::string> diff = model->config().Differences(a.config);
   if (!diff.empty()) {
     std::string got;

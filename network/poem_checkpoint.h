@@ -39,7 +39,10 @@ PoemConfig ReadPoemCheckpointConfig(const std::string& path);
 // Builds the model from the embedded config and loads the weights.
 PoemModel LoadPoemCheckpoint(const std::string& path);
 // Loads into an existing model; throws InputError listing every config difference if
-// the checkpoint was written for another configuration.
-void LoadPoemCheckpointInto(PoemModel& model, const std::string& path);
+// the checkpoint was written for another configuration. With keep_missing_mask_head,
+// a checkpoint without a mask head loads into an otherwise equal model with one, whose
+// head keeps its current weights (training a head onto trained weights).
+void LoadPoemCheckpointInto(PoemModel& model, const std::string& path,
+                            bool keep_missing_mask_head = false);
 
 }  // namespace handlabel

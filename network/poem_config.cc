@@ -99,6 +99,7 @@ std::string PoemConfig::ToJson() const {
   j["num_sampled_points"] = num_sampled_points;
   j["ball_radius"] = ball_radius;
   j["position_range"] = position_range;
+  j["mask_head"] = mask_head;
   return j.dump(2);
 }
 
@@ -139,6 +140,8 @@ PoemConfig PoemConfig::FromJson(const std::string& text, const std::string& sour
         c.ball_radius = value.get<double>();
       else if (key == "position_range")
         c.position_range = value.get<std::array<double, 6>>();
+      else if (key == "mask_head")
+        c.mask_head = value.get<bool>();
       else
         throw InputError(source, key, "a known POEM config field", "unknown field");
     } catch (const Json::exception& e) {
@@ -167,6 +170,7 @@ std::vector<std::string> PoemConfig::Differences(const PoemConfig& o) const {
   cmp("num_sampled_points", Str(num_sampled_points), Str(o.num_sampled_points));
   cmp("ball_radius", Str(ball_radius), Str(o.ball_radius));
   cmp("position_range", RangeString(position_range), RangeString(o.position_range));
+  cmp("mask_head", mask_head ? "true" : "false", o.mask_head ? "true" : "false");
   return d;
 }
 

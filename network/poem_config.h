@@ -51,8 +51,13 @@ struct PoemConfig {
   // xmin, ymin, zmin, xmax, ymax, zmax in metres, master frame. Points are normalised
   // per axis into [0, 1] by this box; the frustum spans depths [zmin, zmax).
   std::array<double, 6> position_range = {-1.2, -1.2, 0.2, 1.2, 1.2, 2.0};
+  // Our addition, absent from the released weights: a per-view hand-mask head on the
+  // feature decoder (module `mask_head`, logits at crop_size / 4), so the fitting can
+  // use predicted silhouettes when a capture has no masks.
+  bool mask_head = false;
 
   int heatmap_size() const { return crop_size / 8; }
+  int mask_size() const { return crop_size / 4; }
   // Channels of `feat_in` (the reference's IN_CHANNELS = layer2 channels).
   int image_feature_dim() const { return 2 * backbone_width; }
   int stage_channels(int stage) const { return backbone_width << stage; }  // 0..3

@@ -15,6 +15,25 @@ torch::Tensor WeightedMean(const torch::Tensor& per_item, const torch::Tensor& w
   return (per_item * weights).sum() / weights.sum().clamp_min(1e-12);
 }
 
+// Backward, per-parameter clipping, optimizer step; the loss values as doubles.
+TrainStepResult BackwardAndStep(PoemModel& model, torch::optim::Optimizer& optimizer,
+                                const PoemLoss& loss, const TrainStepOptions& options) {
+  loss.total.backward();
+  if (options.grad_clip_norm > 0) {
+    for (auto& p : model->parameters()) {
+      if (p.grad().defined())
+        torch::nn::utils::clip_grad_norm_(p, options.grad_clip_norm);
+    }
+  }
+  optimizer.step();
+  TrainStepResult result;
+  result.total = loss.total.item<double>();
+  for (const auto& [name, value] : loss.terms) {
+    result.terms.emplace_back(name, value.item<double>());
+  }
+  return result;
+}
+
 }  // namespace
 
 void PoemLossOptions::Check() const {
@@ -23,7 +42,8 @@ void PoemLossOptions::Check() const {
       {"triangulation_weight", triangulation_weight},
       {"joints_weight", joints_weight},
       {"vertices_weight", vertices_weight},
-      {"joints_2d_weight", joints_2d_weight}};
+      {"joints_2d_weight", joints_2d_weight},
+      {"mask_weight", mask_weight}};
   for (const auto& [name, value] : fields) {
     if (!(value >= 0)) {
       throw InputError("POEM loss options", name, ">= 0", std::to_string(value));
@@ -71,8 +91,18 @@ PoemLoss ComputePoemLoss(const PoemOutputs& out, const PoemBatch& batch,
       loss.terms.emplace_back("joints_2d", j2d);
     }
   }
+  if (out.mask_logits.defined() && t.masks.defined()) {
+    const torch::Tensor masks = PoemMaskLoss(out.mask_logits, t.masks);
+    total = total + o.mask_weight * masks;
+    loss.terms.emplace_back("masks", masks);
+  }
   loss.total = total;
   return loss;
+}
+
+torch::Tensor PoemMaskLoss(const torch::Tensor& logits, const torch::Tensor& coverage) {
+  HL_CHECK(logits.sizes() == coverage.sizes(), "mask logits and targets differ in shape");
+  return torch::binary_cross_entropy_with_logits(logits, coverage.to(logits.dtype()));
 }
 
 torch::Tensor PoemKeypointRegressor(const HandModel& model) {
@@ -102,20 +132,22 @@ TrainStepResult TrainStep(PoemModel& model, torch::optim::Optimizer& optimizer,
   optimizer.zero_grad();
   const PoemOutputs out = model->forward(batch);
   const PoemLoss loss = ComputePoemLoss(out, batch, targets, regressor, loss_options);
-  loss.total.backward();
-  if (options.grad_clip_norm > 0) {
-    for (auto& p : model->parameters()) {
-      if (p.grad().defined())
-        torch::nn::utils::clip_grad_norm_(p, options.grad_clip_norm);
-    }
-  }
-  optimizer.step();
-  TrainStepResult result;
-  result.total = loss.total.item<double>();
-  for (const auto& [name, value] : loss.terms) {
-    result.terms.emplace_back(name, value.item<double>());
-  }
-  return result;
+  return BackwardAndStep(model, optimizer, loss, options);
+}
+
+TrainStepResult TrainMaskHeadStep(PoemModel& model, torch::optim::Optimizer& optimizer,
+                                  const PoemBatch& batch, const PoemTargets& targets,
+                                  const TrainStepOptions& options) {
+  HL_CHECK(model->mask_head, "TrainMaskHeadStep needs a model with a mask head");
+  HL_CHECK(targets.masks.defined(), "TrainMaskHeadStep needs target masks");
+  model->eval();
+  model->mask_head->train();
+  optimizer.zero_grad();
+  PoemLoss loss;
+  loss.total =
+      PoemMaskLoss(model->MaskLogitsOnFrozenFeatures(batch.images), targets.masks);
+  loss.terms = {{"masks", loss.total}};
+  return BackwardAndStep(model, optimizer, loss, options);
 }
 
 }  // namespace handlabel

@@ -24,6 +24,9 @@ struct PoemTargets {
   // Optional (B, N, 21) weights of the 2D terms (0 for views where the hand is not
   // visible); undefined = all ones (the reference).
   torch::Tensor joints_2d_weights;
+  // Optional (B, N, M, M) hand-mask coverage in [0, 1] at the mask head's resolution
+  // (PoemConfig::mask_size); used when the model has a mask head.
+  torch::Tensor masks;
 };
 
 // Weights of the reference (config LOSS section of the released configs).
@@ -33,16 +36,21 @@ struct PoemLossOptions {
   double joints_weight = 1.0;          // per layer: joint MSE + regressed-joint MSE
   double vertices_weight = 1.0;        // per layer: vertex L1
   double joints_2d_weight = 1.0;       // per layer: clamped reprojection of the joints
-  void Check() const;                  // throws InputError for negative weights
+  double mask_weight = 1.0;  // mask head (ours): binary cross-entropy of the logits
+  void Check() const;        // throws InputError for negative weights
 };
 
 struct PoemLoss {
   torch::Tensor total;  // scalar, differentiable
   // Named scalar terms (unweighted): heatmap_joints, triangulated_joints,
   // dec<i>_recon (weighted sum of layer i), and for the last layer joints_3d,
-  // joints_3d_from_mesh, vertices_3d, joints_2d.
+  // joints_3d_from_mesh, vertices_3d, joints_2d; masks when the model has a mask head
+  // and the targets have masks.
   std::vector<std::pair<std::string, torch::Tensor>> terms;
 };
+
+// Mean binary cross-entropy of mask logits against coverage targets (same shape).
+torch::Tensor PoemMaskLoss(const torch::Tensor& logits, const torch::Tensor& coverage);
 
 // regressor (21, 778): keypoints (SNAP order) as linear functions of the vertices,
 // e.g. PoemKeypointRegressor(hand_model).
@@ -72,5 +80,12 @@ TrainStepResult TrainStep(PoemModel& model, torch::optim::Optimizer& optimizer,
                           const torch::Tensor& regressor,
                           const PoemLossOptions& loss_options = {},
                           const TrainStepOptions& options = {});
+
+// Trains only the mask head, on frozen features (PoemModelImpl::
+// MaskLogitsOnFrozenFeatures): the rest of the model stays in eval mode, so its batch
+// norm statistics do not move either. `optimizer` should hold the head's parameters.
+TrainStepResult TrainMaskHeadStep(PoemModel& model, torch::optim::Optimizer& optimizer,
+                                  const PoemBatch& batch, const PoemTargets& targets,
+                                  const TrainStepOptions& options = {});
 
 }  // namespace handlabel

@@ -208,10 +208,18 @@ PoemModelImpl::PoemModelImpl(const PoemConfig& config) : config_(config) {
       "linear_inv_skin",
       torch::nn::Linear(PoemConfig::kNumJoints, PoemConfig::kNumVertices));
   ptEmb_head = register_module("ptEmb_head", PoemHead(config_));
-  torch::NoGradGuard no_grad;
-  linear_inv_skin->weight.fill_(1.0 / PoemConfig::kNumJoints);
-  linear_inv_skin->bias.zero_();
-  ptEmb_head->reference_embed->weight.uniform_(0, 1);
+  {
+    torch::NoGradGuard no_grad;
+    linear_inv_skin->weight.fill_(1.0 / PoemConfig::kNumJoints);
+    linear_inv_skin->bias.zero_();
+    ptEmb_head->reference_embed->weight.uniform_(0, 1);
+  }
+  // Last, so the other modules get the same random weights with or without it.
+  if (config_.mask_head) {
+    mask_head = register_module("mask_head",
+                                torch::nn::Sequential(ConvBlock(w, w, 3, true, true),
+                                                      ConvBlock(w, 1, 1, false, false)));
+  }
 }
 
 void PoemModelImpl::CheckBatch(const PoemBatch& b) const {
@@ -245,7 +253,13 @@ PoemOutputs PoemModelImpl::forward(const PoemBatch& batch) {
   PoemOutputs out;
 
   const auto f = img_backbone->forward(batch.images.reshape({B * N, 3, S, S}));
-  const torch::Tensor feat = feat_in(UDecode(feat_delayer, f));  // (BN, 2w, H, W)
+  const torch::Tensor feat_full = UDecodeBeforePool(feat_delayer, f);  // (BN, w, 2H, 2W)
+  const torch::Tensor feat =
+      feat_in(F::max_pool2d(feat_full, F::MaxPool2dFuncOptions(2).stride(2)));
+  if (mask_head) {
+    const int64_t M = c.mask_size();
+    out.mask_logits = mask_head->forward(feat_full).view({B, N, M, M});
+  }
   const torch::Tensor heatmaps = torch::sigmoid(uv_out(UDecode(uv_delayer, f)));
   out.heatmaps = heatmaps.view({B, N, J, H, H});
   out.joints_2d = SoftArgmax2d(heatmaps, S).view({B, N, J, 2});
@@ -267,6 +281,21 @@ PoemOutputs PoemModelImpl::forward(const PoemBatch& batch) {
   ptEmb_head->forward(feat.view({B, N, feat.size(1), H, H}), out.initial_mesh, batch,
                       cam_from_master, &out);
   return out;
+}
+
+torch::Tensor PoemModelImpl::MaskLogitsOnFrozenFeatures(const torch::Tensor& images) {
+  HL_CHECK(mask_head, "MaskLogitsOnFrozenFeatures needs a model with a mask head");
+  const PoemConfig& c = config_;
+  const int64_t B = images.size(0), N = c.num_views, S = c.crop_size, M = c.mask_size();
+  HL_CHECK(images.dim() == 5 && images.size(1) == N && images.size(3) == S,
+           "images must be (B, num_views, 3, crop_size, crop_size)");
+  torch::Tensor features;
+  {
+    torch::NoGradGuard no_grad;
+    features = UDecodeBeforePool(feat_delayer,
+                                 img_backbone->forward(images.reshape({B * N, 3, S, S})));
+  }
+  return mask_head->forward(features).view({B, N, M, M});
 }
 
 PoemModel MakeRandomPoemModel(const PoemConfig& config, uint64_t seed) {

@@ -37,6 +37,9 @@ struct PoemOutputs {
   torch::Tensor sampled_points;       // (B, K, 3) metres
   std::vector<int64_t> points_inside_ball;  // per frame: frustum points inside the ball
   torch::Tensor layer_coords;               // (L, B, 799, 3) every decoder layer, metres
+  // (B, N, M, M) hand-mask logits, M = config.mask_size(); undefined without a mask
+  // head. Pixel (i, j) covers crop pixels [4j, 4j + 4) x [4i, 4i + 4).
+  torch::Tensor mask_logits;
 
   torch::Tensor joints() const;    // (B, 21, 3) last layer
   torch::Tensor vertices() const;  // (B, 778, 3) last layer
@@ -81,6 +84,10 @@ struct PoemModelImpl : torch::nn::Module {
   explicit PoemModelImpl(const PoemConfig& config);
   // Throws InputError if tensor shapes disagree with the config.
   PoemOutputs forward(const PoemBatch& batch);
+  // Mask logits (B, N, M, M) of images (B, N, 3, S, S) with everything but the mask
+  // head run without gradients: training the head on frozen features. Needs
+  // config.mask_head.
+  torch::Tensor MaskLogitsOnFrozenFeatures(const torch::Tensor& images);
 
   const PoemConfig& config() const { return config_; }
 
@@ -89,6 +96,9 @@ struct PoemModelImpl : torch::nn::Module {
   ConvBlock uv_out{nullptr}, uv_in{nullptr}, feat_in{nullptr};
   torch::nn::Linear linear_inv_skin{nullptr};
   PoemHead ptEmb_head{nullptr};
+  // 3x3 ConvBlock + 1x1 conv on feat_delayer's output before its max-pool; only with
+  // config.mask_head (keys mask_head.0.*, mask_head.1.*).
+  torch::nn::Sequential mask_head{nullptr};
 
  private:
   void CheckBatch(const PoemBatch& batch) const;

@@ -126,6 +126,12 @@ torch::nn::ModuleList MakeUDecoder(int width) {
 
 torch::Tensor UDecode(torch::nn::ModuleList& delayer,
                       const std::array<torch::Tensor, 4>& f) {
+  return F::max_pool2d(UDecodeBeforePool(delayer, f),
+                       F::MaxPool2dFuncOptions(2).stride(2));
+}
+
+torch::Tensor UDecodeBeforePool(torch::nn::ModuleList& delayer,
+                                const std::array<torch::Tensor, 4>& f) {
   torch::Tensor x = f[3];
   for (int i = 0; i < 3; ++i) {
     x = F::interpolate(x, F::InterpolateFuncOptions()
@@ -135,7 +141,7 @@ torch::Tensor UDecode(torch::nn::ModuleList& delayer,
     x = torch::cat({x, f[2 - i]}, 1);
     x = delayer[i]->as<ConvBlock>()->forward(x);
   }
-  return F::max_pool2d(x, F::MaxPool2dFuncOptions(2).stride(2));
+  return x;
 }
 
 torch::nn::Sequential Mlp(int64_t in, int64_t hidden, int64_t out) {

@@ -55,6 +55,9 @@ TORCH_MODULE(ConvBlock);
 // the reference's `uv_delayer` / `feat_delayer` (keys 0, 1, 2).
 torch::Tensor UDecode(torch::nn::ModuleList& delayer,
                       const std::array<torch::Tensor, 4>& f);
+// The same before the max-pool (the resolution of f[0], crop_size / 4).
+torch::Tensor UDecodeBeforePool(torch::nn::ModuleList& delayer,
+                                const std::array<torch::Tensor, 4>& f);
 torch::nn::ModuleList MakeUDecoder(int width);
 
 // Linear(in, hidden), ReLU, Linear(hidden, out) as a Sequential (keys 0, 2).

@@ -29,6 +29,7 @@ class PoemPredictor : public HandMeshPredictor {
   std::string name() const override { return "poem"; }
   int num_views() const override { return model_->config().num_views; }
   int crop_size() const override { return model_->config().crop_size; }
+  bool predicts_masks() const override { return model_->config().mask_head; }
 
   std::vector<HandMeshPrediction> Predict(
       const std::vector<HandMeshInput>& frames) override {
@@ -92,6 +93,10 @@ class PoemPredictor : public HandMeshPredictor {
     const torch::Tensor uv = o.joints_2d.to(torch::kFloat64).contiguous();
     const torch::Tensor peak =
         std::get<0>(o.heatmaps.flatten(3).max(-1)).to(torch::kFloat64).contiguous();
+    torch::Tensor masks;
+    if (o.mask_logits.defined()) {
+      masks = torch::sigmoid(o.mask_logits).to(torch::kFloat32).contiguous();
+    }
     for (int64_t b = 0; b < B; ++b) {
       HandMeshPrediction p;
       p.joints = Eigen::Map<const Keypoints3>(joints[b].data_ptr<double>());
@@ -103,6 +108,13 @@ class PoemPredictor : public HandMeshPredictor {
         p.joints_2d.push_back(Eigen::Map<const Keypoints2>(uv[b][n].data_ptr<double>()));
         p.joint_confidence.push_back(Eigen::Map<const Eigen::Matrix<double, 21, 1>>(
             peak[b][n].data_ptr<double>()));
+        if (masks.defined()) {
+          const int64_t M = masks.size(2);
+          p.masks.push_back(
+              Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic,
+                                             Eigen::RowMajor>>(
+                  masks[b][n].data_ptr<float>(), M, M));
+        }
       }
       p.points_inside_ball = o.points_inside_ball.empty() ? 0 : o.points_inside_ball[b];
       out->push_back(std::move(p));
@@ -124,6 +136,7 @@ PoemModel LoadModel(const HandMeshPredictorOptions& o) {
   PoemModel model = LoadPoemCheckpoint(o.weights);
   if (!o.config.empty()) {
     PoemConfig wanted = PoemConfigByName(o.config, o.num_views);
+    wanted.mask_head = model->config().mask_head;  // an optional extra, not a size
     const auto diff = wanted.Differences(model->config());
     if (!diff.empty()) {
       std::string got;

@@ -195,6 +195,7 @@ void PoemTrainerOptions::Check(const std::string& source) const {
   non_negative("joints_weight", joints_weight);
   non_negative("vertices_weight", vertices_weight);
   non_negative("joints_2d_weight", joints_2d_weight);
+  non_negative("mask_weight", mask_weight);
 }
 
 double PoemLearningRate(const PoemTrainerOptions& o, int64_t step) {
@@ -208,6 +209,8 @@ PoemValidation ValidatePoem(PoemModel& model, const TrainingSampleSource& source
                             int count, int batch_size) {
   PoemValidation v;
   double joints = 0, verts = 0;
+  MaskIouCounts masks;
+  bool any_mask = false;
   for (int first = 0; first < count; first += batch_size) {
     std::vector<TrainingSample> samples;
     for (int i = first; i < std::min(count, first + batch_size); ++i) {
@@ -217,6 +220,7 @@ PoemValidation ValidatePoem(PoemModel& model, const TrainingSampleSource& source
     for (size_t i = 0; i < samples.size(); ++i) {
       joints += MeanPointError(pred[i].joints_3d, samples[i].joints_3d);
       verts += MeanPointError(pred[i].vertices_3d, samples[i].vertices_3d);
+      any_mask |= masks.Add(pred[i], samples[i]);
     }
     v.samples += static_cast<int>(samples.size());
   }
@@ -224,6 +228,7 @@ PoemValidation ValidatePoem(PoemModel& model, const TrainingSampleSource& source
     v.mpjpe_mm = 1000.0 * joints / v.samples;
     v.mpvpe_mm = 1000.0 * verts / v.samples;
   }
+  if (any_mask) v.mask_iou = masks.Iou();
   return v;
 }
 
@@ -246,6 +251,7 @@ struct PoemTrainer::State {
     loss.joints_weight = o.joints_weight;
     loss.vertices_weight = o.vertices_weight;
     loss.joints_2d_weight = o.joints_2d_weight;
+    loss.mask_weight = o.mask_weight;
   }
 
   std::string Path(const std::string& name) const {
@@ -254,7 +260,8 @@ struct PoemTrainer::State {
 
   void MakeOptimizer() {
     optimizer = std::make_unique<torch::optim::Adam>(
-        model->parameters(), torch::optim::AdamOptions(options.learning_rate));
+        options.mask_head_only ? model->mask_head->parameters() : model->parameters(),
+        torch::optim::AdamOptions(options.learning_rate));
   }
 
   void SetLearningRate(double lr) {
@@ -330,6 +337,10 @@ PoemTrainer::PoemTrainer(const PoemConfig& config, const HandModel& hand_model,
                      std::to_string(train.num_views()) + " views of " +
                          std::to_string(train.crop_size()) + " px");
   }
+  if (options.mask_head_only && !config.mask_head) {
+    throw InputError("trainer", "mask_head_only", "a network with mask_head: true",
+                     "a network without a mask head");
+  }
   state_->regressor = PoemKeypointRegressor(hand_model);
   state_->model = MakeRandomPoemModel(config, options.seed);
   state_->MakeOptimizer();
@@ -363,7 +374,7 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
   if (has_run) {
     step = s.LoadLatest();
   } else if (!o.init_weights.empty()) {
-    LoadPoemCheckpointInto(s.model, o.init_weights);
+    LoadPoemCheckpointInto(s.model, o.init_weights, /*keep_missing_mask_head=*/true);
     step = o.init_step;
   }
   summary.start_step = step;
@@ -386,8 +397,11 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
       s.SetLearningRate(lr);
       TrainStepOptions step_options;
       step_options.grad_clip_norm = o.grad_clip_norm;
-      const TrainStepResult r = TrainStep(s.model, *s.optimizer, tb.batch, tb.targets,
-                                          s.regressor, s.loss, step_options);
+      const TrainStepResult r =
+          o.mask_head_only ? TrainMaskHeadStep(s.model, *s.optimizer, tb.batch,
+                                               tb.targets, step_options)
+                           : TrainStep(s.model, *s.optimizer, tb.batch, tb.targets,
+                                       s.regressor, s.loss, step_options);
       if (!std::isfinite(r.total)) {
         throw Error("training diverged at step " + std::to_string(step) +
                     " (loss not finite); resume from the last checkpoint with a lower "
@@ -414,7 +428,7 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
         }
         for (const auto& [name, value] : r.terms) {
           if (name == "heatmap_joints" || name == "triangulated_joints" ||
-              name == "joints_3d" || name == "vertices_3d") {
+              name == "joints_3d" || name == "vertices_3d" || name == "masks") {
             line << " " << name << " " << value;
           }
         }
@@ -437,15 +451,25 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
         v.step = step;
         summary.last_validation = v;
         std::ostringstream row;
+        std::string header = "step,mpjpe_mm,mpvpe_mm,samples";
         row << step << "," << v.mpjpe_mm << "," << v.mpvpe_mm << "," << v.samples;
-        AppendLine(s.Path("validation.csv"), "step,mpjpe_mm,mpvpe_mm,samples", row.str());
+        if (s.config.mask_head) {
+          header += ",mask_iou";
+          row << "," << v.mask_iou;
+        }
+        AppendLine(s.Path("validation.csv"), header, row.str());
         if (s.hooks.progress) {
-          char text[128];
+          char text[160];
           std::snprintf(
               text, sizeof(text),
               "validation at step %lld: MPJPE %.2f mm, MPVPE %.2f mm (%d samples)",
               static_cast<long long>(step), v.mpjpe_mm, v.mpvpe_mm, v.samples);
-          s.hooks.progress(text);
+          std::string line = text;
+          if (v.mask_iou >= 0) {
+            std::snprintf(text, sizeof(text), ", mask IoU %.3f", v.mask_iou);
+            line += text;
+          }
+          s.hooks.progress(line);
         }
         wrote_logs = true;
       }

@@ -14,7 +14,7 @@
 //   checkpoints/step_XXXXXXXX.pt      model (an own POEM checkpoint, usable as weights)
 //   checkpoints/step_XXXXXXXX.optim   optimizer state and step
 //   loss.csv                          step, lr, total, every loss term, samples/s, wall s
-//   validation.csv                    step, mpjpe_mm, mpvpe_mm, samples
+//   validation.csv                    step, mpjpe_mm, mpvpe_mm, samples[, mask_iou]
 // Torch-free interface (the model lives behind the pimpl), so apps/ and pipeline/ can
 // drive training.
 
@@ -52,14 +52,19 @@ struct PoemTrainerOptions {
   // Start a new run (no checkpoint in out_dir yet) from these weights instead of random
   // ones, counting steps from init_step; the optimizer state starts afresh. Used to
   // continue from the small weights-only checkpoint committed to the repository.
+  // init_weights may lack the mask head (the head then starts from random weights).
   std::string init_weights;
   int64_t init_step = 0;
+  // Train only the mask head (PoemConfig::mask_head) on frozen features, with the
+  // mask loss alone; everything else keeps the init_weights bit for bit.
+  bool mask_head_only = false;
   // Loss weights (PoemLossOptions; the reference's values).
   double heatmap_weight = 10.0;
   double triangulation_weight = 10.0;
   double joints_weight = 1.0;
   double vertices_weight = 1.0;
   double joints_2d_weight = 1.0;
+  double mask_weight = 1.0;
   void Check(const std::string& source = "trainer options") const;
 };
 
@@ -71,6 +76,7 @@ struct PoemValidation {
   double mpjpe_mm = 0;
   double mpvpe_mm = 0;
   int samples = 0;
+  double mask_iou = -1;  // -1: the model has no mask head
 };
 
 struct PoemTrainerHooks {

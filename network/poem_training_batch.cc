@@ -5,6 +5,29 @@
 #include "core/errors.h"
 
 namespace handlabel {
+namespace {
+
+namespace F = torch::nn::functional;
+
+// (B, N, S/4, S/4): the fraction of each 4 x 4 block of the S x S crop masks that is
+// hand, the mask head's target.
+torch::Tensor MaskCoverage(const std::vector<TrainingSample>& samples, int64_t S) {
+  const int64_t B = samples.size(), N = samples[0].views.size();
+  torch::Tensor masks = torch::empty({B * N, 1, S, S}, torch::kFloat32);
+  float* dst = masks.data_ptr<float>();
+  for (int64_t b = 0; b < B; ++b) {
+    for (int64_t n = 0; n < N; ++n) {
+      const std::vector<float>& mask = samples[b].views[n].mask;
+      HL_CHECK(static_cast<int64_t>(mask.size()) == S * S,
+               "every view of a batch needs an S x S mask, or none does");
+      std::memcpy(dst + (b * N + n) * S * S, mask.data(), sizeof(float) * S * S);
+    }
+  }
+  return F::avg_pool2d(masks, F::AvgPool2dFuncOptions(4).stride(4))
+      .view({B, N, S / 4, S / 4});
+}
+
+}  // namespace
 
 PoemTrainingBatch ToPoemTrainingBatch(const std::vector<TrainingSample>& samples) {
   HL_CHECK(!samples.empty(), "a batch needs samples");
@@ -60,6 +83,7 @@ PoemTrainingBatch ToPoemTrainingBatch(const std::vector<TrainingSample>& samples
   out.targets.vertices_3d = v3d;
   out.targets.joints_2d = j2d;
   out.targets.joints_2d_weights = w2d;
+  if (!samples[0].views[0].mask.empty()) out.targets.masks = MaskCoverage(samples, S);
   return out;
 }
 
@@ -72,7 +96,18 @@ std::vector<PoemPrediction> PredictPoem(PoemModel& model,
   const torch::Tensor joints = out.joints().to(torch::kFloat64).contiguous();
   const torch::Tensor verts = out.vertices().to(torch::kFloat64).contiguous();
   std::vector<PoemPrediction> result(samples.size());
+  torch::Tensor masks;
+  if (out.mask_logits.defined()) {
+    masks = torch::sigmoid(out.mask_logits).to(torch::kFloat32).contiguous();
+  }
   for (size_t b = 0; b < samples.size(); ++b) {
+    if (masks.defined()) {
+      const int64_t cells = masks.size(2) * masks.size(3);
+      for (int64_t n = 0; n < masks.size(1); ++n) {
+        const float* p = masks[b][n].data_ptr<float>();
+        result[b].masks.emplace_back(p, p + cells);
+      }
+    }
     result[b].joints_3d =
         Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
             joints[b].data_ptr<double>(), joints.size(1), 3);

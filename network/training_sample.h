@@ -43,6 +43,22 @@ struct TrainingSample {
 struct PoemPrediction {
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> joints_3d;    // 21 x 3
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> vertices_3d;  // V x 3
+  // Per view, the mask head's hand probability on its M x M grid (M = crop size / 4,
+  // row-major; cell (i, j) covers crop pixels [4j, 4j + 4) x [4i, 4i + 4)); empty
+  // without a mask head.
+  std::vector<std::vector<float>> masks;
+};
+
+// Intersection over union of predicted masks (probability > 0.5) with the samples'
+// crop masks (4 x 4 block coverage > 0.5), pooled over every cell added.
+struct MaskIouCounts {
+  double intersection = 0;
+  double union_cells = 0;
+  // Adds one view: `probability` M x M, `crop_mask` S x S with S = 4 M.
+  void Add(const std::vector<float>& probability, const std::vector<float>& crop_mask);
+  // Adds every view of every sample that has both; returns false if none had.
+  bool Add(const PoemPrediction& prediction, const TrainingSample& sample);
+  double Iou() const { return union_cells > 0 ? intersection / union_cells : 1.0; }
 };
 
 // Makes samples; Sample(i) must depend only on i (and the source's settings) and be

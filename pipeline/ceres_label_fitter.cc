@@ -44,8 +44,16 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
     view.confidence = request.keypoints_2d[v]->confidence;
     input.views.push_back(view);
   }
-  if (use_masks_ && !frame.mask_paths.empty()) {
-    // Masks follow the order of input.views.
+  // Masks follow the order of input.views.
+  std::string silhouettes = "none";
+  if (!request.masks.empty()) {
+    silhouettes = "network";
+    HL_CHECK(request.masks.size() == request.keypoints_2d.size(), "one mask per view");
+    for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
+      if (request.keypoints_2d[v]) input.masks.push_back(request.masks[v]);
+    }
+  } else if (use_masks_ && !frame.mask_paths.empty()) {
+    silhouettes = "files";
     for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
       if (!request.keypoints_2d[v]) continue;
       input.masks.push_back(
@@ -86,7 +94,8 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
                 {"message", fit.message},
                 {"term_costs", fit.term_costs},
                 {"view_rms_px", fit.view_rms_px},
-                {"view_iou", fit.view_iou}};
+                {"view_iou", fit.view_iou},
+                {"silhouettes", silhouettes}};
   return out;
 }
 

@@ -7,7 +7,8 @@
 //                              to the 2D keypoints (+ silhouettes)
 //   fit from 2D only           the paper's multi-view fitting baseline: robust
 //                              triangulation of the 2D keypoints, IK alignment, fit
-// Silhouettes are used when the job reads masks from files and the capture has them.
+// Silhouettes are used when the request carries them (the network's, evidence.masks:
+// network), or when use_masks is set and the capture has mask files.
 
 #include <string>
 

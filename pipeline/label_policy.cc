@@ -87,6 +87,8 @@ FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
     request.frame = &frame;
     request.init = init;
     request.keypoints_2d = FitEvidence(job, frame, prediction);
+    if (job.masks == MaskSource::kNetwork && prediction)
+      request.masks = prediction->masks;
     request.seed = seed;
     return context.fitter->Fit(request);
   };

@@ -53,6 +53,14 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
     built.predictor = std::make_unique<PoemMeshPredictor>(job.network_weights,
                                                           job.batch_size, job.threads);
   }
+  if (job.masks == MaskSource::kNetwork &&
+      !(built.predictor && built.predictor->PredictsMasks())) {
+    throw InputError(job.source_file, "evidence.masks",
+                     "files or none (network needs network.weights with a mask head)",
+                     built.predictor
+                         ? "network, but " + job.network_weights + " has no mask head"
+                         : "network, but no network.weights");
+  }
   if (job.refine_mode != RefineMode::kOff || job.baseline) {
     HandFitOptions options;
     options.num_threads = 1;  // frames run in parallel

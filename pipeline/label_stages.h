@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/distance_transform.h"
 #include "core/hand_lbs.h"
 #include "core/rig.h"
 
@@ -52,6 +53,9 @@ struct MeshPrediction {
   Points3d keypoints;                         // 21 x 3
   std::vector<Keypoints2dView> keypoints_2d;  // one per rig camera: the network's own 2D
   std::optional<HandParams> params;           // when the network regresses them
+  // One per rig camera: the network's hand silhouette in the full image (255 = hand);
+  // empty when the network has no mask head.
+  std::vector<MaskImage> masks;
 };
 
 class FrameSource {
@@ -75,6 +79,8 @@ class MeshPredictor {
   virtual std::string ModelName() const = 0;
   // SHA-256 of the weights file (recorded in every label).
   virtual std::string WeightsSha256() const = 0;
+  // True when predictions carry silhouettes (MeshPrediction::masks).
+  virtual bool PredictsMasks() const { return false; }
   // One batch; called by one thread at a time (it may use threads itself). Returns one
   // prediction per frame, in order. Throws if the whole batch fails; the runner then
   // retries the frames one by one so that one bad frame fails alone.
@@ -89,6 +95,9 @@ struct LabelFitRequest {
   const MeshPrediction* init = nullptr;
   // 2D evidence, one entry per rig camera (job field evidence.keypoints_2d).
   std::vector<std::optional<Keypoints2dView>> keypoints_2d;
+  // Silhouettes to fit to instead of the capture's mask files, one per rig camera
+  // (evidence.masks: network); empty = the fitter's own choice.
+  std::vector<MaskImage> masks;
   uint64_t seed = 0;
 };
 

@@ -55,7 +55,7 @@ ImageU8 DrawTrainingCurves(const CsvTable& loss, const CsvTable& validation) {
   std::vector<PlotSeries> losses;
   int color = 0;
   for (const char* name : {"total", "heatmap_joints", "triangulated_joints", "joints_3d",
-                           "vertices_3d", "joints_2d"}) {
+                           "vertices_3d", "joints_2d", "masks"}) {
     PlotSeries s;
     s.name = name;
     s.x = steps;

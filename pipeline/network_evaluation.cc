@@ -31,6 +31,7 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   so.box_scale = o.box_scale;
   so.augment.enabled = false;
   so.augment_seed = o.synth.seed;
+  so.masks = predictor.config().mask_head;
   const SynthTrainingSamples source(hand, o.synth, so);
   if (source.num_views() != predictor.config().num_views) {
     throw InputError(o.weights, "num_views",
@@ -38,6 +39,7 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
                      std::to_string(predictor.config().num_views));
   }
   NetworkEvalResult r;
+  MaskIouCounts mask_iou;
   Eigen::MatrixXd joint_errors(o.frames, 21), vertex_errors;
   for (int first = 0; first < o.frames; first += o.batch_size) {
     std::vector<TrainingSample> samples;
@@ -57,6 +59,7 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
       r.pa_mpjpe_mm += 1000 * ProcrustesMeanPointError(pred[i].joints_3d, s.joints_3d);
       r.pa_mpvpe_mm +=
           1000 * ProcrustesMeanPointError(pred[i].vertices_3d, s.vertices_3d);
+      mask_iou.Add(pred[i], s);
     }
     r.frames += static_cast<int>(samples.size());
     if (progress) progress(r.frames, o.frames);
@@ -67,6 +70,7 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   r.pa_mpvpe_mm /= r.frames;
   r.joint_pck = ComputePck(joint_errors, o.pck);
   r.vertex_pck = ComputePck(vertex_errors, o.pck);
+  if (so.masks) r.mask_iou = mask_iou.Iou();
   r.frames_per_second = r.seconds > 0 ? r.frames / r.seconds : 0;
   return r;
 }

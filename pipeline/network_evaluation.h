@@ -33,6 +33,9 @@ struct NetworkEvalResult {
   PckCurve joint_pck, vertex_pck;           // thresholds in metres
   double seconds = 0;                       // wall time of the forward passes
   double frames_per_second = 0;             // network only (crops excluded)
+  // Mask head: IoU of the predicted crop masks with the true ones (network/
+  // training_sample.h MaskIouCounts, every view); -1 without a mask head.
+  double mask_iou = -1;
 };
 
 // progress(done, total) after every batch.

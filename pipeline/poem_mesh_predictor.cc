@@ -99,6 +99,11 @@ std::vector<MeshPrediction> PoemMeshPredictor::Predict(
             in_front && crops[f][v].hand_visible ? out.joint_confidence[v](k) : 0.0;
       }
       p.keypoints_2d.push_back(view);
+      if (!out.masks.empty()) {
+        const int cell = network_->crop_size() / static_cast<int>(out.masks[v].rows());
+        p.masks.push_back(
+            CropMaskToImage(out.masks[v], cell, crops[f][v].intrinsics, rig[v].camera));
+      }
     }
     predictions.push_back(std::move(p));
   }

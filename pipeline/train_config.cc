@@ -111,6 +111,12 @@ TrainConfig LoadTrainConfig(const std::string& path) {
   train.Read("threads", &t.threads);
   train.Read("prefetch_batches", &t.prefetch_batches);
   train.Read("out_dir", &t.out_dir);
+  std::string trainable = "all";
+  train.Read("trainable", &trainable);
+  if (trainable != "all" && trainable != "mask_head") {
+    throw InputError(path, "train.trainable", "all or mask_head", trainable);
+  }
+  t.mask_head_only = trainable == "mask_head";
   train.RejectUnknownKeys();
 
   Section loss = top.Child("loss");
@@ -119,6 +125,7 @@ TrainConfig LoadTrainConfig(const std::string& path) {
   loss.Read("joints_weight", &t.joints_weight);
   loss.Read("vertices_weight", &t.vertices_weight);
   loss.Read("joints_2d_weight", &t.joints_2d_weight);
+  loss.Read("mask_weight", &t.mask_weight);
   loss.RejectUnknownKeys();
 
   const YAML::Node overrides = top.Raw("network_overrides");
@@ -130,14 +137,22 @@ TrainConfig LoadTrainConfig(const std::string& path) {
   if (overrides && !overrides.IsNull()) {
     if (!overrides.IsMap()) throw InputError(path, "network_overrides", "a mapping");
     nlohmann::json j = nlohmann::json::parse(c.network.ToJson());
-    for (const auto& [key, value] : ToJson(overrides).items()) j[key] = value;
+    // A named object: items() of a temporary would dangle inside the loop.
+    const nlohmann::json given = ToJson(overrides);
+    for (const auto& [key, value] : given.items()) j[key] = value;
     c.network = PoemConfig::FromJson(j.dump(), path + " (network_overrides)");
   }
   if (c.network.num_views != views) {
     throw InputError(path, "network", std::to_string(views) + " views (the rig's)",
                      std::to_string(c.network.num_views));
   }
+  if (t.mask_head_only && !c.network.mask_head) {
+    throw InputError(path, "train.trainable",
+                     "all (mask_head needs network_overrides: {mask_head: true})",
+                     "mask_head");
+  }
   c.samples.crop_size = c.network.crop_size;
+  c.samples.masks = c.network.mask_head;  // the mask head's targets
   c.samples.reuse_group = c.trainer.batch_size;
   c.samples.augment_seed = c.synth.seed;
   c.samples.Check(path);

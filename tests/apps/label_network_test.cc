@@ -21,14 +21,18 @@ namespace {
 using ::testing::HasSubstr;
 using testing::RunHandlabelCommand;
 
-std::string NetworkJob(const std::string& dir, const std::string& mode) {
-  const std::string path = dir + "/" + mode + ".yaml";
+std::string NetworkJob(const std::string& dir, const std::string& mode,
+                       const std::string& weights = "tiny.pt",
+                       const std::string& masks = "none") {
+  const std::string path = dir + "/" + mode + "-" + masks + ".yaml";
   std::ofstream(path) << "name: net\nseed: 3\nhand_model: capsule\n"
                       << "input: {format: native, path: capture}\n"
-                      << "network: {weights: tiny.pt, threads: 2, batch_size: 2}\n"
+                      << "network: {weights: " << weights
+                      << ", threads: 2, batch_size: 2}\n"
                       << "refine: {mode: " << mode << "}\n"
-                      << "evidence: {keypoints_2d: both, masks: none}\n"
-                      << "output: {dir: " << mode << ", overlays: false}\n";
+                      << "evidence: {keypoints_2d: both, masks: " << masks << "}\n"
+                      << "output: {dir: " << mode << "-" << masks
+                      << ", overlays: false}\n";
   return path;
 }
 
@@ -46,7 +50,7 @@ TEST_F(LabelNetwork, RefineOffLabelsEveryFrameWithTheNetworkAndItsQualityFlags) 
   const auto r = RunHandlabelCommand({"label", "--job", NetworkJob(dir_, "off")});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("2 labelled (network 2)"));
-  const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/off", "000000"));
+  const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/off-none", "000000"));
   EXPECT_EQ(label.path, LabelPath::kNetwork);
   EXPECT_EQ(label.quality.flags.size(), 5u);
   EXPECT_EQ(label.mesh.vertices.rows(), 778);
@@ -60,7 +64,8 @@ TEST_F(LabelNetwork, FallbackFitsWhereTheRandomNetworkFailsItsChecks) {
   ASSERT_EQ(r.status, 0) << r.err;
   // Random weights never pass the checks: every frame falls back to the fit.
   EXPECT_THAT(r.err, HasSubstr("2 labelled (fallback_fit 2)"));
-  const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/fallback", "000001"));
+  const LabelRecord label =
+      ReadLabelFile(LabelFilePath(dir_ + "/fallback-none", "000001"));
   EXPECT_FALSE(label.quality.Passed());
   EXPECT_THAT(label.fit.at("why").get<std::string>(), HasSubstr("quality checks failed"));
   EXPECT_THAT(r.err, HasSubstr("network_raw (2 frames)"));
@@ -70,9 +75,41 @@ TEST_F(LabelNetwork, AlwaysRefinesTheNetworkAnswer) {
   const auto r = RunHandlabelCommand({"label", "--job", NetworkJob(dir_, "always")});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("2 labelled (refined 2)"));
-  const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/always", "000000"));
+  const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/always-none", "000000"));
   EXPECT_EQ(label.fit.at("init"), "network");
   ASSERT_TRUE(label.params.has_value());
+}
+
+TEST_F(LabelNetwork, NetworkSilhouettesNeedAMaskHead) {
+  const auto r = RunHandlabelCommand(
+      {"label", "--job", NetworkJob(dir_, "always", "tiny.pt", "network")});
+  EXPECT_NE(r.status, 0);
+  EXPECT_THAT(r.err, HasSubstr("evidence.masks"));
+  EXPECT_THAT(r.err, HasSubstr("has no mask head"));
+}
+
+TEST_F(LabelNetwork, RefinementFitsTheMaskHeadsSilhouettes) {
+  PoemConfig c = PoemConfigByName("tiny", 8);
+  c.mask_head = true;
+  WriteRandomPoemCheckpoint(c, 5, dir_ + "/tiny_masks.pt");
+  const auto r = RunHandlabelCommand(
+      {"label", "--job", NetworkJob(dir_, "always", "tiny_masks.pt", "network")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("2 labelled (refined 2)"));
+  const LabelRecord label =
+      ReadLabelFile(LabelFilePath(dir_ + "/always-network", "000000"));
+  EXPECT_EQ(label.fit.at("silhouettes"), "network");
+  // Silhouette agreement is measured in the views that got a predicted mask.
+  int measured = 0;
+  for (const auto& iou : label.fit.at("view_iou")) measured += iou.is_number();
+  EXPECT_GT(measured, 0);
+  // Without `network` the same weights fit keypoints only.
+  const auto plain = RunHandlabelCommand(
+      {"label", "--job", NetworkJob(dir_, "always", "tiny_masks.pt", "none")});
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_EQ(
+      ReadLabelFile(LabelFilePath(dir_ + "/always-none", "000000")).fit.at("silhouettes"),
+      "none");
 }
 
 }  // namespace

@@ -109,6 +109,60 @@ TEST(HandCrop, ChoosesEvidenceInOrderAndMarksMissedViews) {
   EXPECT_TRUE(c.hand_visible);
 }
 
+// A mask predicted on the crop grid comes back to the image where it was: warp a
+// disc mask into the crop (WarpCrop, the network's input path), pool it to 4 x 4
+// cells as the mask head's target, map it back and compare with the disc.
+TEST(HandCrop, CropMaskMapsBackOntoTheImageMask) {
+  const Camera cam(CameraModelId::kOpenCV, 320, 240,
+                   {300, 305, 160, 120, -0.25, 0.06, 0.001, -0.002});
+  const Eigen::Vector2d disc(210, 90);  // off-centre: distortion bends it
+  const double radius = 30;
+  std::vector<uint8_t> img(320 * 240 * 3, 0);
+  MaskImage truth = MaskImage::Zero(240, 320);
+  for (int y = 0; y < 240; ++y)
+    for (int x = 0; x < 320; ++x)
+      if ((Eigen::Vector2d(x, y) - disc).norm() < radius) {
+        truth(y, x) = 255;
+        for (int c = 0; c < 3; ++c) img[(y * 320 + x) * 3 + c] = 255;
+      }
+  HandCropOptions o;
+  o.crop_size = 128;
+  o.mean = 0;
+  o.std = 1;
+  const CropWindow w = CropFromBox(disc.array() - radius, disc.array() + radius, o);
+  const std::vector<float> crop = WarpCrop({320, 240, img.data()}, cam, w, o);
+  const int M = 32;
+  Eigen::MatrixXf cells = Eigen::MatrixXf::Zero(M, M);
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 128; ++x) cells(y / 4, x / 4) += crop[y * 128 + x] / 16.0f;
+  const MaskImage back =
+      CropMaskToImage(cells, 4, CropIntrinsics(cam, w, o.crop_size), cam);
+  ASSERT_EQ(back.rows(), 240);
+  ASSERT_EQ(back.cols(), 320);
+  int inter = 0, uni = 0, far_set = 0;
+  for (int y = 0; y < 240; ++y)
+    for (int x = 0; x < 320; ++x) {
+      const bool a = truth(y, x), b = back(y, x);
+      inter += a && b;
+      uni += a || b;
+      // Nothing outside the crop window (side 2 x 60 px around the disc).
+      far_set += b && (Eigen::Vector2d(x, y) - disc).norm() > 2 * radius;
+    }
+  EXPECT_GT(static_cast<double>(inter) / uni, 0.95);
+  EXPECT_EQ(far_set, 0);
+  // A wrong intrinsic (shifted crop) moves it: the test sees the geometry.
+  Eigen::Matrix3d shifted = CropIntrinsics(cam, w, o.crop_size);
+  shifted(0, 2) += 20;
+  const MaskImage moved = CropMaskToImage(cells, 4, shifted, cam);
+  int moved_inter = 0, moved_uni = 0;
+  for (int y = 0; y < 240; ++y)
+    for (int x = 0; x < 320; ++x) {
+      moved_inter += truth(y, x) && moved(y, x);
+      moved_uni += truth(y, x) || moved(y, x);
+    }
+  EXPECT_LT(static_cast<double>(moved_inter) / moved_uni, 0.8);
+}
+
 TEST(HandCrop, RejectsMismatchedConfidences) {
   HandCropOptions o;
   EXPECT_THROW(CropFromKeypoints({{1, 2}}, {}, o), InputError);

@@ -49,6 +49,43 @@ TEST(HandMeshPredictor, PoemFromCheckpointMatchesTheModel) {
   }
 }
 
+TEST(HandMeshPredictor, MaskHeadProbabilitiesAreTheModelsSigmoid) {
+  PoemConfig c = TinyPoemConfig(2);
+  c.mask_head = true;
+  const std::string path = testing::ScratchDir() + "/tiny_masks.pt";
+  WriteRandomPoemCheckpoint(c, 8, path);
+  HandMeshPredictorOptions o;
+  o.weights = path;
+  o.config = "tiny";  // a name with sizes: the head is an extra, not a mismatch
+  o.num_views = 2;
+  o.num_threads = 1;
+  auto predictor = CreateHandMeshPredictor(o);
+  EXPECT_TRUE(predictor->predicts_masks());
+  const PoemBatch batch = testing::MakeSyntheticBatch(c, 2, 3);
+  const auto predictions = predictor->Predict(testing::ToInputs(batch));
+  PoemModel model = MakeRandomPoemModel(c, 8);
+  model->eval();
+  torch::NoGradGuard g;
+  const torch::Tensor expected =
+      torch::sigmoid(model->MaskLogitsOnFrozenFeatures(batch.images));
+  const int M = c.mask_size();
+  for (int f = 0; f < 2; ++f) {
+    ASSERT_EQ(predictions[f].masks.size(), 2u);
+    for (int n = 0; n < 2; ++n) {
+      ASSERT_EQ(predictions[f].masks[n].rows(), M);
+      for (int i = 0; i < M; i += 3)
+        for (int j = 0; j < M; j += 5)
+          EXPECT_NEAR(predictions[f].masks[n](i, j), expected[f][n][i][j].item<float>(),
+                      1e-5);
+    }
+  }
+  // Without a head: no masks.
+  WriteRandomPoemCheckpoint(TinyPoemConfig(2), 8, path);
+  auto plain = CreateHandMeshPredictor(o);
+  EXPECT_FALSE(plain->predicts_masks());
+  EXPECT_TRUE(plain->Predict(testing::ToInputs(batch))[0].masks.empty());
+}
+
 TEST(HandMeshPredictor, ValidatesFramesBeforeRunning) {
   HandMeshPredictorOptions o;
   o.config = "tiny";

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -28,11 +29,12 @@ HandModel MakeRegressorModel() {
 }
 
 // Samples of a 2-camera rig around a hand-sized blob 0.6 m in front of camera 0;
-// sample i depends only on (seed, i), or on seed alone when `fixed`.
+// sample i depends only on (seed, i), or on seed alone when `fixed`. With `masks`,
+// every view also shows a bright disc and has its mask.
 class FakeSamples : public TrainingSampleSource {
  public:
-  FakeSamples(const PoemConfig& c, uint64_t seed, bool fixed)
-      : c_(c), seed_(seed), fixed_(fixed) {}
+  FakeSamples(const PoemConfig& c, uint64_t seed, bool fixed, bool masks = false)
+      : c_(c), seed_(seed), fixed_(fixed), masks_(masks) {}
   int num_views() const override { return c_.num_views; }
   int crop_size() const override { return c_.crop_size; }
   TrainingSample Sample(int64_t index) const override {
@@ -75,6 +77,18 @@ class FakeSamples : public TrainingSampleSource {
       v.image.resize(3 * S * S);
       std::uniform_real_distribution<float> u(-0.5f, 0.5f);
       for (float& x : v.image) x = u(rng);
+      if (masks_) {
+        std::uniform_real_distribution<double> where(0.3 * S, 0.7 * S);
+        const double cx = where(rng), cy = where(rng), r = 0.2 * S;
+        v.mask.assign(S * S, 0.0f);
+        for (int y = 0; y < S; ++y) {
+          for (int x = 0; x < S; ++x) {
+            if (std::hypot(x - cx, y - cy) >= r) continue;
+            v.mask[y * S + x] = 1.0f;
+            for (int ch = 0; ch < 3; ++ch) v.image[(ch * S + y) * S + x] = 0.5f;
+          }
+        }
+      }
       s.views.push_back(std::move(v));
     }
     return s;
@@ -84,6 +98,7 @@ class FakeSamples : public TrainingSampleSource {
   PoemConfig c_;
   uint64_t seed_;
   bool fixed_;
+  bool masks_;
 };
 
 PoemTrainerOptions TinyOptions(const std::string& dir) {
@@ -191,6 +206,59 @@ TEST(PoemTrainer, LearningRateScheduleWarmsUpAndDecays) {
   EXPECT_DOUBLE_EQ(PoemLearningRate(o, 100), 1e-3);
   EXPECT_DOUBLE_EQ(PoemLearningRate(o, 699), 1e-3);
   EXPECT_DOUBLE_EQ(PoemLearningRate(o, 700), 1e-4);
+}
+
+TEST(PoemTrainer, MaskHeadAloneOntoTrainedWeights) {
+  PoemConfig plain = TinyPoemConfig(2);
+  const std::string dir = testing::ScratchDir();
+  {  // "trained" weights without a head
+    const FakeSamples train(plain, 5, false);
+    PoemTrainerOptions o = TinyOptions(dir + "/base");
+    o.steps = 2;
+    PoemTrainer(plain, MakeRegressorModel(), train, nullptr, o).Run(false);
+  }
+  PoemConfig c = plain;
+  c.mask_head = true;
+  const FakeSamples train(c, 8, false, /*masks=*/true);
+  const FakeSamples validation(c, 9, false, /*masks=*/true);
+  PoemTrainerOptions o = TinyOptions(dir + "/masks");
+  o.steps = 30;
+  o.learning_rate = 1e-2;
+  o.validate_every = 30;
+  o.validation_samples = 4;
+  o.checkpoint_every = 30;
+  o.init_weights = LatestPoemCheckpointModel(dir + "/base");
+  o.mask_head_only = true;
+  std::vector<double> losses;
+  PoemTrainerHooks hooks;
+  hooks.progress = [&](const std::string& line) {
+    if (line.rfind("step ", 0) == 0)
+      losses.push_back(std::stod(line.substr(line.find("loss ") + 5)));
+  };
+  PoemTrainer trainer(c, MakeRegressorModel(), train, &validation, o, hooks);
+  const PoemTrainSummary s = trainer.Run(false);
+  ASSERT_EQ(losses.size(), 30u);
+  EXPECT_LT(losses.back(), 0.7 * losses.front());
+  // Computed (-1 means not); 30 steps need not have found the discs yet.
+  EXPECT_GE(s.last_validation.mask_iou, 0.0);
+  EXPECT_LE(s.last_validation.mask_iou, 1.0);
+  // Everything but the head is the base run's, bit for bit.
+  const auto base = Weights(dir + "/base");
+  int head_keys = 0;
+  for (const auto& [key, value] : Weights(dir + "/masks")) {
+    if (key.rfind("mask_head.", 0) == 0) {
+      ++head_keys;
+      continue;
+    }
+    EXPECT_TRUE(torch::equal(base.at(key), value)) << key;
+  }
+  EXPECT_GT(head_keys, 0);
+  std::ifstream csv(dir + "/masks/validation.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "step,mpjpe_mm,mpvpe_mm,samples,mask_iou");
+  // A network without a head cannot train one.
+  EXPECT_THROW(PoemTrainer(plain, MakeRegressorModel(), train, nullptr, o), InputError);
 }
 
 TEST(PoemTrainer, HalfCheckpointLoadsCloseToTheOriginal) {

@@ -1,0 +1,79 @@
+// `handlabel train` and `handlabel eval-network` end to end on a tiny network: a short
+// run, its export, then the mask head trained alone onto the exported weights, and the
+// evaluation of the result (the plumbing, not the accuracy, is under test).
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "tests/apps/run_command.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::RunHandlabelCommand;
+
+std::string TrainConfigFile(const std::string& dir, const std::string& name,
+                            const std::string& extra_train, bool mask_head) {
+  const std::string path = dir + "/" + name + ".yaml";
+  std::ofstream(path) << "network: tiny\n"
+                      << (mask_head ? "network_overrides: {mask_head: true}\n" : "")
+                      << "hand_model: \"\"\n"
+                      << "data: {preset: dexycb, width: 320, height: 240, seed: 4}\n"
+                      << "train:\n  steps: 2\n  batch_size: 1\n  warmup_steps: 1\n"
+                      << "  checkpoint_every: 1\n  log_every: 1\n  validate_every: 2\n"
+                      << "  validation_samples: 2\n  prefetch_batches: 0\n"
+                      << extra_train << "  out_dir: " << dir << "/" << name << "\n";
+  return path;
+}
+
+TEST(TrainCommand, TrainsExportsAndTrainsAMaskHeadOntoTheExport) {
+  const std::string dir = testing::ScratchDir();
+  const auto base =
+      RunHandlabelCommand({"train", "--config", TrainConfigFile(dir, "base", "", false)});
+  ASSERT_EQ(base.status, 0) << base.err;
+  EXPECT_THAT(base.out, HasSubstr("validation at step 2: MPJPE"));
+  const auto exported =
+      RunHandlabelCommand({"train", "--config", TrainConfigFile(dir, "base", "", false),
+                           "--export", dir + "/base.pt"});
+  ASSERT_EQ(exported.status, 0) << exported.err;
+  ASSERT_TRUE(std::filesystem::exists(dir + "/base.pt"));
+
+  const std::string masks_config = TrainConfigFile(
+      dir, "masks", "  trainable: mask_head\n  learning_rate: 0.01\n", true);
+  const auto masks = RunHandlabelCommand(
+      {"train", "--config", masks_config, "--init-weights", dir + "/base.pt"});
+  ASSERT_EQ(masks.status, 0) << masks.err;
+  EXPECT_THAT(masks.out, HasSubstr(" masks "));
+  EXPECT_THAT(masks.out, HasSubstr("mask IoU"));
+  std::ifstream csv(dir + "/masks/validation.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "step,mpjpe_mm,mpvpe_mm,samples,mask_iou");
+  ASSERT_EQ(RunHandlabelCommand(
+                {"train", "--config", masks_config, "--export", dir + "/masks.pt"})
+                .status,
+            0);
+  const auto eval =
+      RunHandlabelCommand({"eval-network", "--weights", dir + "/masks.pt", "--preset",
+                           "dexycb", "--frames", "2", "--seed", "9"});
+  ASSERT_EQ(eval.status, 0) << eval.err;
+  EXPECT_THAT(eval.out, HasSubstr("mask IoU (crop grid)"));
+}
+
+TEST(TrainCommand, MaskHeadTrainingNeedsAHead) {
+  const std::string dir = testing::ScratchDir();
+  const auto r = RunHandlabelCommand(
+      {"train", "--config",
+       TrainConfigFile(dir, "bad", "  trainable: mask_head\n", /*mask_head=*/false)});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_THAT(r.err, HasSubstr("train.trainable"));
+  EXPECT_THAT(r.err, HasSubstr("network_overrides: {mask_head: true}"));
+}
+
+}  // namespace
+}  // namespace handlabel
