@@ -23,10 +23,17 @@ MaskImage ReadMaskImage(const std::string& path) {
 
 CeresLabelFitter::CeresLabelFitter(const HandModel& model, bool use_masks,
                                    const HandFitConfig& config,
-                                   const HandFitOptions& options)
+                                   const HandFitOptions& options,
+                                   double network_mask_sigma_px)
     : fitter_(model, config, options),
       num_vertices_(model.num_vertices()),
-      use_masks_(use_masks) {}
+      use_masks_(use_masks) {
+  if (network_mask_sigma_px > 0) {
+    HandFitOptions coarse = options;
+    coarse.silhouette_sigma_px = network_mask_sigma_px;
+    network_mask_fitter_.emplace(model, config, coarse);
+  }
+}
 
 std::string CeresLabelFitter::Describe() const {
   return std::string("Ceres hand fitter (keypoints") +
@@ -60,6 +67,8 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
           frame.mask_paths[v].empty() ? MaskImage() : ReadMaskImage(frame.mask_paths[v]));
     }
   }
+  const CeresHandFitter& fitter =
+      !request.masks.empty() && network_mask_fitter_ ? *network_mask_fitter_ : fitter_;
   HandParams init;
   if (request.init) {
     const MeshPrediction& net = *request.init;
@@ -76,11 +85,11 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
       }
     }
     input.targets3d = targets;
-    init = fitter_.InitFromKeypoints3d(net.keypoints, targets.keypoint_weights);
+    init = fitter.InitFromKeypoints3d(net.keypoints, targets.keypoint_weights);
   } else {
-    init = fitter_.InitFromViews(input.views);
+    init = fitter.InitFromViews(input.views);
   }
-  const HandFitResult fit = fitter_.Fit(input, init);
+  const HandFitResult fit = fitter.Fit(input, init);
 
   LabelFit out;
   out.params = fit.params;
@@ -96,6 +105,9 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
                 {"view_rms_px", fit.view_rms_px},
                 {"view_iou", fit.view_iou},
                 {"silhouettes", silhouettes}};
+  if (silhouettes != "none") {
+    out.report["silhouette_sigma_px"] = fitter.options().silhouette_sigma_px;
+  }
   return out;
 }
 

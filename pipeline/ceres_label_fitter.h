@@ -10,6 +10,7 @@
 // Silhouettes are used when the request carries them (the network's, evidence.masks:
 // network), or when use_masks is set and the capture has mask files.
 
+#include <optional>
 #include <string>
 
 #include "core/hand_model.h"
@@ -21,13 +22,17 @@ namespace handlabel {
 class CeresLabelFitter : public LabelFitter {
  public:
   // Throws InputError when the config or options do not fit the model.
+  // network_mask_sigma_px > 0: silhouettes that come with the request (the network's)
+  // are fitted with this residual scale instead of options.silhouette_sigma_px.
   CeresLabelFitter(const HandModel& model, bool use_masks,
-                   const HandFitConfig& config = {}, const HandFitOptions& options = {});
+                   const HandFitConfig& config = {}, const HandFitOptions& options = {},
+                   double network_mask_sigma_px = 0);
   LabelFit Fit(const LabelFitRequest& request) const override;
   std::string Describe() const override;
 
  private:
   CeresHandFitter fitter_;
+  std::optional<CeresHandFitter> network_mask_fitter_;
   int num_vertices_;
   bool use_masks_;
 };

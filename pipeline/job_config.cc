@@ -148,6 +148,11 @@ JobConfig LoadJobConfig(const std::string& path) {
   std::string keypoints = "network", masks = "files";
   evidence.Read("keypoints_2d", &keypoints);
   evidence.Read("masks", &masks);
+  evidence.Read("network_mask_sigma_px", &job.network_mask_sigma_px);
+  if (!(job.network_mask_sigma_px > 0)) {
+    throw InputError(path, evidence.Name("network_mask_sigma_px"), "> 0 pixels",
+                     std::to_string(job.network_mask_sigma_px));
+  }
   job.keypoints = ParseEnum<KeypointSource>(keypoints,
                                             {{"network", KeypointSource::kNetwork},
                                              {"files", KeypointSource::kFiles},

@@ -56,6 +56,10 @@ struct JobConfig {
   QualityThresholds quality;
   KeypointSource keypoints = KeypointSource::kNetwork;
   MaskSource masks = MaskSource::kFiles;
+  // Silhouette residual scale (pixels per unit) for the network's masks: coarser than
+  // files' masks (the mask head predicts on 4 x 4-pixel crop cells), so they count
+  // less (docs/labeling-jobs.md has the measurements behind the default).
+  double network_mask_sigma_px = 16.0;
 
   // outputs
   std::string output_dir;

@@ -65,7 +65,8 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
     HandFitOptions options;
     options.num_threads = 1;  // frames run in parallel
     built.fitter = std::make_unique<CeresLabelFitter>(
-        built.hand_model, job.masks == MaskSource::kFiles, HandFitConfig(), options);
+        built.hand_model, job.masks == MaskSource::kFiles, HandFitConfig(), options,
+        job.network_mask_sigma_px);
   }
   if (job.overlays)
     built.overlays = std::make_unique<RasterOverlayWriter>(built.hand_model);

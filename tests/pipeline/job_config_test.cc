@@ -45,6 +45,13 @@ TEST(JobConfig, ReadsFieldsAndResolvesPathsAgainstTheJobFolder) {
   EXPECT_EQ(job.meshes, (std::vector<std::string>{"ply", "obj"}));
   EXPECT_FALSE(job.overlays);
   EXPECT_TRUE(job.evaluate);  // default
+  EXPECT_EQ(job.masks, MaskSource::kFiles);
+  EXPECT_DOUBLE_EQ(job.network_mask_sigma_px, 16.0);
+  const JobConfig with_masks =
+      LoadJobConfig(WriteJob(std::string(kValidJob) +
+                             "evidence: {masks: network, network_mask_sigma_px: 6.5}\n"));
+  EXPECT_EQ(with_masks.masks, MaskSource::kNetwork);
+  EXPECT_DOUBLE_EQ(with_masks.network_mask_sigma_px, 6.5);
 }
 
 void ExpectError(const std::string& yaml, const std::string& field,
@@ -77,6 +84,8 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
   ExpectError(
       "input: {path: c}\noutput: {dir: o, meshes: [stl]}\nnetwork: {weights: w}\n",
       "output.meshes", "ply and/or obj");
+  ExpectError(base + "refine: {mode: always}\nevidence: {network_mask_sigma_px: 0}\n",
+              "evidence.network_mask_sigma_px", "> 0 pixels");
 }
 
 TEST(JobConfig, MissingOrBrokenFileIsAClearError) {
