@@ -44,6 +44,10 @@ int RunEvalNetwork(int argc, char** argv) {
                  "hand model the network was trained with (default: the shipped open "
                  "hand)");
   app.add_option("--pck-png", pck_png, "write the PCK curves to this PNG");
+  app.add_option(
+      "--mask-png", o.mask_png,
+      "networks with a mask head: write the first frames' crops with predicted "
+      "(red) and true (green outline) masks to this PNG");
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("eval-network", [&] {
     o.synth.scene.objects = objects;
@@ -67,6 +71,7 @@ int RunEvalNetwork(int argc, char** argv) {
         r.pa_mpjpe_mm, r.pa_mpvpe_mm, r.joint_pck.auc, r.vertex_pck.auc,
         r.frames_per_second);
     if (r.mask_iou >= 0) std::printf("mask IoU (crop grid)   %.3f\n", r.mask_iou);
+    if (!o.mask_png.empty()) std::cout << "masks: " << o.mask_png << "\n";
     if (!pck_png.empty()) {
       WritePckPlot(r, pck_png, "PCK " + o.synth.rig.preset + " synthetic");
       std::cout << "PCK curve: " << pck_png << "\n";

@@ -5,6 +5,7 @@
 #include "core/errors.h"
 #include "network/poem_sample_predictor.h"
 #include "pipeline/line_plot.h"
+#include "pipeline/mask_sheet.h"
 
 namespace handlabel {
 
@@ -32,6 +33,11 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   so.augment.enabled = false;
   so.augment_seed = o.synth.seed;
   so.masks = predictor.config().mask_head;
+  if (!o.mask_png.empty() && !so.masks) {
+    throw InputError(o.weights, "--mask-png", "weights with a mask head", "no mask head");
+  }
+  std::vector<TrainingSample> sheet_samples;
+  std::vector<PoemPrediction> sheet_predictions;
   const SynthTrainingSamples source(hand, o.synth, so);
   if (source.num_views() != predictor.config().num_views) {
     throw InputError(o.weights, "num_views",
@@ -60,6 +66,10 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
       r.pa_mpvpe_mm +=
           1000 * ProcrustesMeanPointError(pred[i].vertices_3d, s.vertices_3d);
       mask_iou.Add(pred[i], s);
+      if (!o.mask_png.empty() && f < o.mask_png_frames) {
+        sheet_samples.push_back(s);
+        sheet_predictions.push_back(pred[i]);
+      }
     }
     r.frames += static_cast<int>(samples.size());
     if (progress) progress(r.frames, o.frames);
@@ -71,6 +81,8 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   r.joint_pck = ComputePck(joint_errors, o.pck);
   r.vertex_pck = ComputePck(vertex_errors, o.pck);
   if (so.masks) r.mask_iou = mask_iou.Iou();
+  if (!o.mask_png.empty())
+    WritePng(o.mask_png, MakeMaskSheet(sheet_samples, sheet_predictions));
   r.frames_per_second = r.seconds > 0 ? r.frames / r.seconds : 0;
   return r;
 }

@@ -23,6 +23,10 @@ struct NetworkEvalOptions {
   SynthCaptureOptions synth;  // rig preset, seed, scene settings
   double box_scale = 2.0;     // crop side / keypoint box side
   PckOptions pck;             // thresholds of the PCK curve (POEM: 0-20 mm, 20 steps)
+  // With a mask head: write the first mask_png_frames frames' crops with predicted and
+  // true masks to this PNG (pipeline/mask_sheet.h); empty = none.
+  std::string mask_png;
+  int mask_png_frames = 3;
   void Check() const;
 };
 

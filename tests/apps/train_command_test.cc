@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/image.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 
@@ -63,6 +64,24 @@ TEST(TrainCommand, TrainsExportsAndTrainsAMaskHeadOntoTheExport) {
                            "dexycb", "--frames", "2", "--seed", "9"});
   ASSERT_EQ(eval.status, 0) << eval.err;
   EXPECT_THAT(eval.out, HasSubstr("mask IoU (crop grid)"));
+}
+
+TEST(TrainCommand, MaskPictureNeedsAMaskHead) {
+  const std::string dir = testing::ScratchDir();
+  ASSERT_EQ(RunHandlabelCommand({"train", "--config",
+                                 TrainConfigFile(dir, "plain", "", false)})
+                .status,
+            0);
+  ASSERT_EQ(RunHandlabelCommand({"train", "--config",
+                                 TrainConfigFile(dir, "plain", "", false), "--export",
+                                 dir + "/plain.pt"})
+                .status,
+            0);
+  const auto r = RunHandlabelCommand({"eval-network", "--weights", dir + "/plain.pt",
+                                      "--frames", "1", "--mask-png", dir + "/m.png"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_THAT(r.err, HasSubstr("--mask-png"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/m.png"));
 }
 
 TEST(TrainCommand, MaskHeadTrainingNeedsAHead) {
