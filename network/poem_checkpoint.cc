@@ -147,12 +147,17 @@ PoemModel LoadPoemCheckpoint(const std::string& path) {
 }
 
 void LoadPoemCheckpointInto(PoemModel& model, const std::string& path,
-                            bool keep_missing_mask_head) {
+                            bool mask_head_may_differ) {
   Archive a = ReadArchive(path);
-  if (keep_missing_mask_head && model->config().mask_head && !a.config.mask_head) {
+  if (mask_head_may_differ && model->config().mask_head && !a.config.mask_head) {
     a.config.mask_head = true;
     for (const auto& [key, value] : PoemStateDict(model)) {
       if (key.rfind("mask_head.", 0) == 0) a.tensors[key] = value.detach().clone();
+    }
+  } else if (mask_head_may_differ && !model->config().mask_head && a.config.mask_head) {
+    a.config.mask_head = false;
+    for (auto it = a.tensors.begin(); it != a.tensors.end();) {
+      it = it->first.rfind("mask_head.", 0) == 0 ? a.tensors.erase(it) : std::next(it);
     }
   }
   const std::vector<std::string> diff = model->config().Differences(a.config);

@@ -39,10 +39,12 @@ PoemConfig ReadPoemCheckpointConfig(const std::string& path);
 // Builds the model from the embedded config and loads the weights.
 PoemModel LoadPoemCheckpoint(const std::string& path);
 // Loads into an existing model; throws InputError listing every config difference if
-// the checkpoint was written for another configuration. With keep_missing_mask_head,
-// a checkpoint without a mask head loads into an otherwise equal model with one, whose
-// head keeps its current weights (training a head onto trained weights).
+// the checkpoint was written for another configuration. With mask_head_may_differ,
+// the mask head is the one exception: a checkpoint without one loads into a model with
+// one (whose head keeps its current weights: training a head onto trained weights),
+// and a checkpoint's head is dropped when the model has none (continuing the main
+// training from weights that carry a head).
 void LoadPoemCheckpointInto(PoemModel& model, const std::string& path,
-                            bool keep_missing_mask_head = false);
+                            bool mask_head_may_differ = false);
 
 }  // namespace handlabel

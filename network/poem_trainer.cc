@@ -374,7 +374,7 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
   if (has_run) {
     step = s.LoadLatest();
   } else if (!o.init_weights.empty()) {
-    LoadPoemCheckpointInto(s.model, o.init_weights, /*keep_missing_mask_head=*/true);
+    LoadPoemCheckpointInto(s.model, o.init_weights, /*mask_head_may_differ=*/true);
     step = o.init_step;
   }
   summary.start_step = step;

@@ -52,7 +52,8 @@ struct PoemTrainerOptions {
   // Start a new run (no checkpoint in out_dir yet) from these weights instead of random
   // ones, counting steps from init_step; the optimizer state starts afresh. Used to
   // continue from the small weights-only checkpoint committed to the repository.
-  // init_weights may lack the mask head (the head then starts from random weights).
+  // init_weights may lack the mask head (the head then starts from random weights), or
+  // have one the network has not (it is dropped).
   std::string init_weights;
   int64_t init_step = 0;
   // Train only the mask head (PoemConfig::mask_head) on frozen features, with the

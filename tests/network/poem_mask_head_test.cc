@@ -151,7 +151,7 @@ TEST(PoemMaskHead, WeightsWithoutAHeadLoadOnlyWhenAsked) {
   PoemModel masked = MakeRandomPoemModel(TinyWithMasks(2), 22);
   const torch::Tensor head_before = masked->mask_head->parameters()[0].clone();
   EXPECT_THROW(LoadPoemCheckpointInto(masked, dir + "/plain.pt"), InputError);
-  LoadPoemCheckpointInto(masked, dir + "/plain.pt", /*keep_missing_mask_head=*/true);
+  LoadPoemCheckpointInto(masked, dir + "/plain.pt", /*mask_head_may_differ=*/true);
   const auto a = PoemStateDict(plain);
   for (const auto& [key, value] : PoemStateDict(masked)) {
     if (key.rfind("mask_head.", 0) == 0) continue;
@@ -165,6 +165,12 @@ TEST(PoemMaskHead, WeightsWithoutAHeadLoadOnlyWhenAsked) {
   EXPECT_TRUE(torch::equal(back->mask_head->parameters()[0], head_before));
   // A plain checkpoint's config says no head.
   EXPECT_FALSE(ReadPoemCheckpointConfig(dir + "/plain.pt").mask_head);
+  // The other way round the head is dropped, and only when asked.
+  PoemModel plain_again = MakeRandomPoemModel(TinyPoemConfig(2), 23);
+  EXPECT_THROW(LoadPoemCheckpointInto(plain_again, dir + "/masked.pt"), InputError);
+  LoadPoemCheckpointInto(plain_again, dir + "/masked.pt", /*mask_head_may_differ=*/true);
+  EXPECT_TRUE(torch::equal(PoemStateDict(plain_again).at("feat_in.conv.weight"),
+                           PoemStateDict(back).at("feat_in.conv.weight")));
 }
 
 TEST(PoemMaskHead, ConfigJsonCarriesTheFlag) {
