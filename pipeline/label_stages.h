@@ -53,8 +53,8 @@ struct MeshPrediction {
   Points3d keypoints;                         // 21 x 3
   std::vector<Keypoints2dView> keypoints_2d;  // one per rig camera: the network's own 2D
   std::optional<HandParams> params;           // when the network regresses them
-  // One per rig camera: the network's hand silhouette in the full image (255 = hand);
-  // empty when the network has no mask head.
+  // One per rig camera: the network's hand silhouette in the full image (255 = hand;
+  // a 0 x 0 mask where it found none); empty when the network has no mask head.
   std::vector<MaskImage> masks;
 };
 

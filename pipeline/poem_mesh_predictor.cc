@@ -101,8 +101,12 @@ std::vector<MeshPrediction> PoemMeshPredictor::Predict(
       p.keypoints_2d.push_back(view);
       if (!out.masks.empty()) {
         const int cell = network_->crop_size() / static_cast<int>(out.masks[v].rows());
-        p.masks.push_back(
-            CropMaskToImage(out.masks[v], cell, crops[f][v].intrinsics, rig[v].camera));
+        MaskImage mask =
+            CropMaskToImage(out.masks[v], cell, crops[f][v].intrinsics, rig[v].camera);
+        // An empty prediction says "no hand here", which the silhouette term would
+        // enforce; treat it as no evidence instead (the keypoints decide).
+        if ((mask.array() == 0).all()) mask = MaskImage();
+        p.masks.push_back(std::move(mask));
       }
     }
     predictions.push_back(std::move(p));
