@@ -149,8 +149,9 @@ JobConfig LoadJobConfig(const std::string& path) {
   evidence.Read("keypoints_2d", &keypoints);
   evidence.Read("masks", &masks);
   evidence.Read("network_mask_sigma_px", &job.network_mask_sigma_px);
-  if (!(job.network_mask_sigma_px > 0)) {
-    throw InputError(path, evidence.Name("network_mask_sigma_px"), "> 0 pixels",
+  if (!(job.network_mask_sigma_px >= 0)) {
+    throw InputError(path, evidence.Name("network_mask_sigma_px"),
+                     "> 0 pixels, or 0 for the default",
                      std::to_string(job.network_mask_sigma_px));
   }
   job.keypoints = ParseEnum<KeypointSource>(keypoints,
@@ -163,6 +164,9 @@ JobConfig LoadJobConfig(const std::string& path) {
                                      {"files", MaskSource::kFiles},
                                      {"network", MaskSource::kNetwork}},
                                     path, evidence.Name("masks"));
+  if (job.network_mask_sigma_px == 0) {
+    job.network_mask_sigma_px = job.keypoints == KeypointSource::kNetwork ? 2.0 : 16.0;
+  }
   evidence.RejectUnknownKeys();
 
   Section output = top.Child("output");

@@ -56,10 +56,12 @@ struct JobConfig {
   QualityThresholds quality;
   KeypointSource keypoints = KeypointSource::kNetwork;
   MaskSource masks = MaskSource::kFiles;
-  // Silhouette residual scale (pixels per unit) for the network's masks: coarser than
-  // files' masks (the mask head predicts on 4 x 4-pixel crop cells), so they count
-  // less (docs/labeling-jobs.md has the measurements behind the default).
-  double network_mask_sigma_px = 16.0;
+  // Silhouette residual scale (pixels per unit) for the network's masks. In the file
+  // 0 (the default) means: 2 px when the network's own 2D keypoints are the only
+  // evidence (they are weak, the masks help), else 16 px (good detections: the coarse
+  // masks must not pull against them); docs/labeling-jobs.md has the measurements.
+  // After loading it holds the resolved value.
+  double network_mask_sigma_px = 0;
 
   // outputs
   std::string output_dir;

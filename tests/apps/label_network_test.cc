@@ -99,7 +99,8 @@ TEST_F(LabelNetwork, RefinementFitsTheMaskHeadsSilhouettes) {
   const LabelRecord label =
       ReadLabelFile(LabelFilePath(dir_ + "/always-network", "000000"));
   EXPECT_EQ(label.fit.at("silhouettes"), "network");
-  EXPECT_EQ(label.fit.at("silhouette_sigma_px"), 16.0);  // the job default
+  // The default with the capture's detections among the evidence.
+  EXPECT_EQ(label.fit.at("silhouette_sigma_px"), 16.0);
   // Silhouette agreement is measured in the views that got a predicted mask.
   int measured = 0;
   for (const auto& iou : label.fit.at("view_iou")) measured += iou.is_number();

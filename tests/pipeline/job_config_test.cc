@@ -46,7 +46,12 @@ TEST(JobConfig, ReadsFieldsAndResolvesPathsAgainstTheJobFolder) {
   EXPECT_FALSE(job.overlays);
   EXPECT_TRUE(job.evaluate);  // default
   EXPECT_EQ(job.masks, MaskSource::kFiles);
-  EXPECT_DOUBLE_EQ(job.network_mask_sigma_px, 16.0);
+  // Default: the network's own keypoints are the only evidence -> its masks count.
+  EXPECT_EQ(job.keypoints, KeypointSource::kNetwork);
+  EXPECT_DOUBLE_EQ(job.network_mask_sigma_px, 2.0);
+  const JobConfig with_files = LoadJobConfig(
+      WriteJob(std::string(kValidJob) + "evidence: {keypoints_2d: both}\n"));
+  EXPECT_DOUBLE_EQ(with_files.network_mask_sigma_px, 16.0);
   const JobConfig with_masks =
       LoadJobConfig(WriteJob(std::string(kValidJob) +
                              "evidence: {masks: network, network_mask_sigma_px: 6.5}\n"));
@@ -84,7 +89,7 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
   ExpectError(
       "input: {path: c}\noutput: {dir: o, meshes: [stl]}\nnetwork: {weights: w}\n",
       "output.meshes", "ply and/or obj");
-  ExpectError(base + "refine: {mode: always}\nevidence: {network_mask_sigma_px: 0}\n",
+  ExpectError(base + "refine: {mode: always}\nevidence: {network_mask_sigma_px: -1}\n",
               "evidence.network_mask_sigma_px", "> 0 pixels");
 }
 
