@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "pipeline/mask_outline.h"
 
 namespace handlabel {
 namespace {
@@ -121,10 +122,7 @@ ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
       };
       for (int y = 1; y + 1 < th; ++y) {
         for (int x = 1; x + 1 < tw; ++x) {
-          if (on(x, y) &&
-              (!on(x - 1, y) || !on(x + 1, y) || !on(x, y - 1) || !on(x, y + 1))) {
-            PutPixel(&tile, x, y, outline);
-          }
+          if (OnMaskOutline(on, x, y)) PutPixel(&tile, x, y, outline);
         }
       }
     }

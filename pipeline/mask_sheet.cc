@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "pipeline/mask_outline.h"
 
 namespace handlabel {
 
@@ -44,9 +45,7 @@ ImageU8 MakeMaskSheet(const std::vector<TrainingSample>& samples,
             rgb[1] *= 0.5;
             rgb[2] *= 0.5;
           }
-          const bool edge = truth(x, y) && !(truth(x - 1, y) && truth(x + 1, y) &&
-                                             truth(x, y - 1) && truth(x, y + 1));
-          if (edge) rgb[0] = 0, rgb[1] = 255, rgb[2] = 0;
+          if (OnMaskOutline(truth, x, y)) rgb[0] = 0, rgb[1] = 255, rgb[2] = 0;
           for (int c = 0; c < 3; ++c)
             sheet.at(x0 + x, y0 + y, c) = static_cast<uint8_t>(std::lround(rgb[c]));
         }
