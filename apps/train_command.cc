@@ -24,6 +24,7 @@ int RunTrain(int argc, char** argv) {
   bool resume = false;
   int64_t steps = 0, stop_at = -1, init_step = 0;
   int threads = 0;
+  double learning_rate = 0;
   app.add_option("--config", config_path, "training config (YAML)")->required();
   app.add_flag("--resume", resume,
                "continue the run in the output folder from its latest checkpoint");
@@ -31,6 +32,9 @@ int RunTrain(int argc, char** argv) {
   app.add_option("--stop-at", stop_at,
                  "stop (with a checkpoint) once this step is reached; the schedule "
                  "still follows the total steps");
+  app.add_option("--learning-rate", learning_rate,
+                 "peak learning rate (overrides train.learning_rate); with --resume the "
+                 "schedule changes from the checkpoint on, the Adam state is kept");
   app.add_option("--out", out_dir, "run folder (overrides train.out_dir)");
   app.add_option("--threads", threads, "LibTorch threads (overrides train.threads)");
   app.add_option("--init-weights", init_weights,
@@ -46,6 +50,7 @@ int RunTrain(int argc, char** argv) {
     if (steps > 0) config.trainer.steps = steps;
     if (!out_dir.empty()) config.trainer.out_dir = out_dir;
     if (threads > 0) config.trainer.threads = threads;
+    if (learning_rate > 0) config.trainer.learning_rate = learning_rate;
     if (!init_weights.empty()) {
       config.trainer.init_weights = init_weights;
       config.trainer.init_step = init_step;

@@ -421,7 +421,9 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
         std::ostringstream header, row, line;
         header << "step,lr,total";
         row << step << "," << lr << "," << r.total;
-        line << "step " << step << "/" << o.steps << " loss " << r.total;
+        line << "step " << step << "/" << o.steps;
+        if (end < o.steps) line << " (stop at " << end << ")";
+        line << " loss " << r.total;
         for (const auto& [name, value] : r.terms) {
           header << "," << name;
           row << "," << value;
@@ -437,7 +439,7 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
         char rate_text[64];
         std::snprintf(rate_text, sizeof(rate_text), " | %.2f samples/s lr %.2g ETA ",
                       rate, lr);
-        line << rate_text << Duration(per_step * (o.steps - step));
+        line << rate_text << Duration(per_step * (end - step));
         AppendLine(s.Path("loss.csv"), header.str(), row.str());
         if (s.hooks.progress) s.hooks.progress(line.str());
         window_start = now;

@@ -45,6 +45,11 @@ TEST(LabelDataset, DexYcbSequenceThroughTheNetworkAndTheFallbackFit) {
   EXPECT_THAT(r.err, HasSubstr("2 labelled (fallback_fit 2)"));
   const LabelRecord label = ReadLabelFile(LabelFilePath(dir + "/out", "000001"));
   EXPECT_EQ(label.path, LabelPath::kFallbackFit);
+  // Fits to the labels files' 2D (the capsule hand drew them), not to the random
+  // network's: they land on the fixture's joint_3d.
+  const nlohmann::json summary =
+      nlohmann::json::parse(testing::ReadFileBytes(dir + "/out/summary.json"));
+  EXPECT_LT(summary.at("metrics").at("labels").at("mpjpe_mm").get<double>(), 5.0);
   EXPECT_TRUE(
       std::filesystem::exists(OverlayPath(dir + "/out", "000001", fx.rig[3].name)));
   EXPECT_EQ(testing::RunHandlabelCommand({"merge", "--job", dir + "/job.yaml"}).status,

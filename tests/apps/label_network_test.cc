@@ -105,13 +105,18 @@ TEST_F(LabelNetwork, RefinementFitsTheMaskHeadsSilhouettes) {
   int measured = 0;
   for (const auto& iou : label.fit.at("view_iou")) measured += iou.is_number();
   EXPECT_GT(measured, 0);
-  // Without `network` the same weights fit keypoints only.
+  // view_iou is measured after any solve; the silhouette term itself must have run.
+  EXPECT_TRUE(label.fit.at("term_costs").contains("silhouette"));
+  // Without `network` the same weights fit keypoints only, to a different answer.
   const auto plain = RunHandlabelCommand(
       {"label", "--job", NetworkJob(dir_, "always", "tiny_masks.pt", "none")});
   ASSERT_EQ(plain.status, 0) << plain.err;
-  EXPECT_EQ(
-      ReadLabelFile(LabelFilePath(dir_ + "/always-none", "000000")).fit.at("silhouettes"),
-      "none");
+  const LabelRecord plain_label =
+      ReadLabelFile(LabelFilePath(dir_ + "/always-none", "000000"));
+  EXPECT_EQ(plain_label.fit.at("silhouettes"), "none");
+  EXPECT_FALSE(plain_label.fit.at("term_costs").contains("silhouette"));
+  ASSERT_TRUE(label.params.has_value() && plain_label.params.has_value());
+  EXPECT_GT((label.mesh.vertices - plain_label.mesh.vertices).norm(), 1e-6);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "core/image.h"
 #include "tests/apps/run_command.h"
@@ -66,17 +67,46 @@ TEST(TrainCommand, TrainsExportsAndTrainsAMaskHeadOntoTheExport) {
   EXPECT_THAT(eval.out, HasSubstr("mask IoU (crop grid)"));
 }
 
+// Rows of loss.csv as step -> lr.
+std::map<int, double> LearningRates(const std::string& csv_path) {
+  std::ifstream csv(csv_path);
+  std::string line;
+  std::getline(csv, line);  // header: step,lr,...
+  std::map<int, double> lr;
+  while (std::getline(csv, line)) {
+    const size_t comma = line.find(',');
+    lr[std::stoi(line.substr(0, comma))] = std::stod(line.substr(comma + 1));
+  }
+  return lr;
+}
+
+TEST(TrainCommand, ResumesWithLongerScheduleAndNewLearningRate) {
+  const std::string dir = testing::ScratchDir();
+  const std::string config =
+      TrainConfigFile(dir, "run", "  learning_rate: 0.001\n  decay_at: 1.0\n", false);
+  ASSERT_EQ(RunHandlabelCommand({"train", "--config", config}).status, 0);
+  const auto resumed =
+      RunHandlabelCommand({"train", "--config", config, "--resume", "--steps", "4",
+                           "--learning-rate", "0.0002", "--stop-at", "3"});
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_THAT(resumed.out, HasSubstr("step 3/4 (stop at 3) loss "));
+  const std::map<int, double> lr = LearningRates(dir + "/run/loss.csv");
+  ASSERT_EQ(lr.size(), 3u);
+  EXPECT_DOUBLE_EQ(lr.at(2), 0.001);   // the first run's schedule, after warm-up
+  EXPECT_DOUBLE_EQ(lr.at(3), 0.0002);  // the resumed run's
+}
+
 TEST(TrainCommand, MaskPictureNeedsAMaskHead) {
   const std::string dir = testing::ScratchDir();
-  ASSERT_EQ(RunHandlabelCommand({"train", "--config",
-                                 TrainConfigFile(dir, "plain", "", false)})
-                .status,
-            0);
-  ASSERT_EQ(RunHandlabelCommand({"train", "--config",
-                                 TrainConfigFile(dir, "plain", "", false), "--export",
-                                 dir + "/plain.pt"})
-                .status,
-            0);
+  ASSERT_EQ(
+      RunHandlabelCommand({"train", "--config", TrainConfigFile(dir, "plain", "", false)})
+          .status,
+      0);
+  ASSERT_EQ(
+      RunHandlabelCommand({"train", "--config", TrainConfigFile(dir, "plain", "", false),
+                           "--export", dir + "/plain.pt"})
+          .status,
+      0);
   const auto r = RunHandlabelCommand({"eval-network", "--weights", dir + "/plain.pt",
                                       "--frames", "1", "--mask-png", dir + "/m.png"});
   EXPECT_EQ(r.status, 1);

@@ -208,10 +208,24 @@ TEST(PoemMaskHead, PredictionsCarryProbabilitiesAndIouCountsCells) {
   const std::vector<PoemPrediction> pred = PredictPoem(model, {sample});
   ASSERT_EQ(pred[0].masks.size(), 2u);
   ASSERT_EQ(pred[0].masks[0].size(), static_cast<size_t>(M * M));
-  for (float p : pred[0].masks[0]) {
-    EXPECT_GE(p, 0.0f);
-    EXPECT_LE(p, 1.0f);
+  // The probabilities are the sigmoid of the head's logits on these views, in view
+  // order, row-major cells.
+  torch::Tensor images = torch::empty({1, 2, 3, S, S});
+  for (int n = 0; n < 2; ++n) {
+    images[0][n].copy_(torch::from_blob(sample.views[n].image.data(), {3, S, S}));
   }
+  model->eval();
+  torch::Tensor expected;
+  {
+    torch::NoGradGuard no_grad;
+    expected = torch::sigmoid(model->MaskLogitsOnFrozenFeatures(images));
+  }
+  ASSERT_EQ(expected.sizes(), (std::vector<int64_t>{1, 2, M, M}));
+  auto e = expected.accessor<float, 4>();
+  for (int n = 0; n < 2; ++n)
+    for (int i = 0; i < M; ++i)
+      for (int j = 0; j < M; ++j)
+        ASSERT_NEAR(pred[0].masks[n][i * M + j], e[0][n][i][j], 1e-6) << n << i << j;
   // IoU by hand: predict the top quarter of rows -> 1/2 of the true half.
   std::vector<float> quarter(M * M, 0.0f);
   for (int i = 0; i < M / 4; ++i)
@@ -222,6 +236,38 @@ TEST(PoemMaskHead, PredictionsCarryProbabilitiesAndIouCountsCells) {
   counts.Add(std::vector<float>(M * M, 0.0f), std::vector<float>(S * S, 0.0f));
   EXPECT_DOUBLE_EQ(counts.Iou(), 0.5);  // empty views add nothing
   EXPECT_THROW(counts.Add(quarter, std::vector<float>(S * S - 1)), Error);
+}
+
+// The training target of each cell is the mean of the crop mask over its 4 x 4 block
+// (a mask that varies along both axes catches transposed or shifted pooling).
+TEST(PoemMaskHead, TargetsAreTheCropMasksBlockMeans) {
+  const PoemConfig c = TinyWithMasks(2);
+  const int S = c.crop_size, M = c.mask_size();
+  TrainingSample sample;
+  sample.joints_3d.setZero(21, 3);
+  sample.vertices_3d.setZero(778, 3);
+  for (int n = 0; n < 2; ++n) {
+    TrainingView v;
+    v.image.assign(3 * S * S, 0.0f);
+    v.intrinsics << 2 * S, 0, S / 2.0, 0, 2 * S, S / 2.0, 0, 0, 1;
+    v.mask.resize(S * S);
+    for (int y = 0; y < S; ++y)
+      for (int x = 0; x < S; ++x)
+        v.mask[y * S + x] = std::fmod(0.37f * x + 0.11f * y * y + 0.5f * n, 1.0f);
+    sample.views.push_back(v);
+  }
+  const PoemTrainingBatch tb = ToPoemTrainingBatch({sample});
+  ASSERT_TRUE(tb.targets.masks.defined());
+  ASSERT_EQ(tb.targets.masks.sizes(), (std::vector<int64_t>{1, 2, M, M}));
+  auto t = tb.targets.masks.accessor<float, 4>();
+  for (int n = 0; n < 2; ++n)
+    for (int i = 0; i < M; ++i)
+      for (int j = 0; j < M; ++j) {
+        double sum = 0;
+        for (int y = 4 * i; y < 4 * i + 4; ++y)
+          for (int x = 4 * j; x < 4 * j + 4; ++x) sum += sample.views[n].mask[y * S + x];
+        ASSERT_NEAR(t[0][n][i][j], sum / 16, 1e-6) << n << " " << i << " " << j;
+      }
 }
 
 }  // namespace

@@ -152,8 +152,15 @@ TEST(PoemTrainer, ResumeContinuesBitIdentically) {
     EXPECT_EQ(t.Run(false).end_step, 6);
   }
   {
-    PoemTrainer t(c, hand, train, &validation, TinyOptions(b));
+    std::vector<std::string> lines;
+    PoemTrainerHooks hooks;
+    hooks.progress = [&](const std::string& line) { lines.push_back(line); };
+    PoemTrainer t(c, hand, train, &validation, TinyOptions(b), hooks);
     EXPECT_EQ(t.Run(false, /*stop_at_step=*/3).end_step, 3);
+    // The progress line names the stop, and its ETA counts down to it, not to step 6.
+    ASSERT_FALSE(lines.empty());
+    EXPECT_NE(lines.front().find("step 1/6 (stop at 3) loss "), std::string::npos)
+        << lines.front();
   }
   EXPECT_EQ(LatestPoemCheckpointStep(b), 3);
   {

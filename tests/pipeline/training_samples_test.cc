@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/errors.h"
 #include "pipeline/capsule_hand.h"
 #include "tests/test_util.h"
@@ -49,6 +51,63 @@ TEST(TrainingSamples, FoldedAugmentationKeepsProjectionsOnThe2dTargets) {
         EXPECT_NEAR(uvw.x() / uvw.z(), v.joints_2d(k, 0), 1e-6);
         EXPECT_NEAR(uvw.y() / uvw.z(), v.joints_2d(k, 1), 1e-6);
       }
+    }
+  }
+}
+
+// The crop masks (the mask head's targets) cover exactly where the true hand lands:
+// the vertices projected through each view's crop camera fall on the mask, and the
+// mask stays inside the box of those projections. A mask warped differently from the
+// image (transposed, unrotated, from another view) fails both.
+TEST(TrainingSamples, CropMasksCoverTheProjectedHand) {
+  TrainingSampleOptions o = StrongAugmentation();
+  o.masks = true;
+  SynthCaptureOptions synth = SmallSynth(6);
+  synth.scene.objects = false;  // the masks are the visible hand: nothing in front
+  const SynthTrainingSamples source(MakeCapsuleHand(HandSide::kRight), synth, o);
+  const int S = o.crop_size;
+  for (int64_t index : {0, 3}) {
+    const TrainingSample s = source.Sample(index);
+    for (const TrainingView& v : s.views) {
+      ASSERT_EQ(v.mask.size(), static_cast<size_t>(S * S));
+      auto on = [&](int x, int y) {  // within a pixel of a mask pixel
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && yy >= 0 && xx < S && yy < S && v.mask[yy * S + xx] > 0.5f)
+              return true;
+          }
+        return false;
+      };
+      const Eigen::Matrix4d cam_from_master = v.master_from_cam.inverse();
+      Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e9), hi = -lo;
+      int inside = 0, on_mask = 0;
+      for (int i = 0; i < s.vertices_3d.rows(); ++i) {
+        const Eigen::Vector3d p =
+            (cam_from_master * s.vertices_3d.row(i).transpose().homogeneous()).head<3>();
+        const Eigen::Vector3d uvw = v.intrinsics * p;
+        const Eigen::Vector2d uv = uvw.head<2>() / uvw.z();
+        lo = lo.cwiseMin(uv);
+        hi = hi.cwiseMax(uv);
+        // Pixel centres are at integer coordinates.
+        const int x = static_cast<int>(std::lround(uv.x())),
+                  y = static_cast<int>(std::lround(uv.y()));
+        if (x < 0 || y < 0 || x >= S || y >= S) continue;
+        ++inside;
+        on_mask += on(x, y);
+      }
+      ASSERT_GT(inside, 100);
+      EXPECT_GE(on_mask, 0.98 * inside) << "sample " << index;
+      int mask_pixels = 0, in_box = 0;
+      for (int y = 0; y < S; ++y)
+        for (int x = 0; x < S; ++x) {
+          if (v.mask[y * S + x] <= 0.5f) continue;
+          ++mask_pixels;
+          in_box += x >= lo.x() - 1.5 && x <= hi.x() + 1.5 && y >= lo.y() - 1.5 &&
+                    y <= hi.y() + 1.5;
+        }
+      ASSERT_GT(mask_pixels, 50);
+      EXPECT_EQ(in_box, mask_pixels) << "sample " << index;
     }
   }
 }

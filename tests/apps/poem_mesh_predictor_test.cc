@@ -1,0 +1,119 @@
+// The labeling job's network stage against the network it wraps: its 3D answers are
+// the network's, carried from the master camera's frame to the rig's world frame; its
+// 2D answers are the network's crop pixels seen through the real cameras; and moving
+// the whole rig moves the 3D answers with it and leaves the 2D ones alone.
+
+#include "pipeline/poem_mesh_predictor.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "core/image_file.h"
+#include "network/poem_config.h"
+#include "pipeline/native_frame_source.h"
+#include "tests/apps/label_test_capture.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+class PoemMeshPredictorTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string dir = testing::ScratchDir();
+    testing::WriteTestCapture(dir + "/capture", 1, 12);
+    PoemConfig c = PoemConfigByName("tiny", 8);
+    c.mask_head = true;
+    weights_ = dir + "/tiny.pt";
+    WriteRandomPoemCheckpoint(c, 6, weights_);
+    const NativeFrameSource source(dir + "/capture");
+    frame_ = source.Load(source.FrameIds().at(0));
+  }
+  std::string weights_;
+  FrameInput frame_;
+};
+
+TEST_F(PoemMeshPredictorTest, AnswersAreTheNetworksInTheRigsFrames) {
+  PoemMeshPredictor stage(weights_, 1, 1);
+  const MeshPrediction p = stage.Predict({&frame_}).at(0);
+
+  // The wrapped network on the same crops.
+  HandMeshPredictorOptions options;
+  options.weights = weights_;
+  options.num_threads = 1;
+  const auto network = CreateHandMeshPredictor(options);
+  HandCropOptions crop_options;
+  crop_options.crop_size = network->crop_size();
+  HandMeshInput input;
+  std::vector<ViewCrop> crops;
+  const Rig& rig = frame_.rig;
+  for (size_t v = 0; v < rig.size(); ++v) {
+    const ImageU8 image = ReadImageFile(frame_.image_paths[v]);
+    HandEvidence evidence;
+    ASSERT_TRUE(frame_.keypoints_2d.at(v).has_value());
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      evidence.keypoints.push_back(frame_.keypoints_2d[v]->uv_px.row(k).transpose());
+      evidence.confidences.push_back(frame_.keypoints_2d[v]->confidence(k));
+    }
+    crops.push_back(CropForView({image.width, image.height, image.data.data()},
+                                rig[v].camera, evidence, crop_options));
+    HandMeshViewInput view;
+    view.pixels = crops.back().pixels;
+    view.intrinsics = crops.back().intrinsics;
+    view.cam_from_master = rig[v].cam_from_world * rig[0].cam_from_world.Inverse();
+    view.weight = crops.back().hand_visible ? 1.0 : 0.0;
+    input.views.push_back(std::move(view));
+  }
+  const HandMeshPrediction raw = network->Predict({input}).at(0);
+
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    // World -> camera 0 (the master frame) gives the network's joints back.
+    const Eigen::Vector3d in_master =
+        rig[0].cam_from_world * Eigen::Vector3d(p.keypoints.row(k).transpose());
+    EXPECT_LT((in_master - raw.joints.row(k).transpose()).norm(), 1e-9) << k;
+  }
+  ASSERT_EQ(p.keypoints_2d.size(), rig.size());
+  ASSERT_EQ(p.masks.size(), rig.size());
+  for (size_t v = 0; v < rig.size(); ++v) {
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      // Image pixel -> ray (undistorted) -> crop pixel gives the network's 2D back.
+      const Eigen::Vector3d ray =
+          rig[v].camera.Unproject(p.keypoints_2d[v].uv_px.row(k).transpose());
+      const Eigen::Vector3d crop = crops[v].intrinsics * ray;
+      EXPECT_NEAR(crop.x() / crop.z(), raw.joints_2d[v](k, 0), 1e-6) << v << "," << k;
+      EXPECT_NEAR(crop.y() / crop.z(), raw.joints_2d[v](k, 1), 1e-6) << v << "," << k;
+      EXPECT_DOUBLE_EQ(p.keypoints_2d[v].confidence(k), raw.joint_confidence[v](k));
+    }
+  }
+}
+
+TEST_F(PoemMeshPredictorTest, MovingTheRigMovesTheAnswerWithIt) {
+  PoemMeshPredictor stage(weights_, 1, 1);
+  const MeshPrediction a = stage.Predict({&frame_}).at(0);
+  // new_world = T * world: every camera sees the same, the world frame moved.
+  const Rigid3 T(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
+      Eigen::Vector3d(0.3, -1.2, 2.0));
+  FrameInput moved = frame_;
+  for (size_t v = 0; v < moved.rig.size(); ++v) {
+    moved.rig[v].cam_from_world = moved.rig[v].cam_from_world * T.Inverse();
+  }
+  const MeshPrediction b = stage.Predict({&moved}).at(0);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const Eigen::Vector3d expected = T * Eigen::Vector3d(a.keypoints.row(k).transpose());
+    EXPECT_LT((expected - b.keypoints.row(k).transpose()).norm(), 1e-6) << k;
+  }
+  for (int i = 0; i < a.vertices.rows(); i += 50) {
+    const Eigen::Vector3d expected = T * Eigen::Vector3d(a.vertices.row(i).transpose());
+    EXPECT_LT((expected - b.vertices.row(i).transpose()).norm(), 1e-6) << i;
+  }
+  for (size_t v = 0; v < a.keypoints_2d.size(); ++v) {
+    EXPECT_LT((a.keypoints_2d[v].uv_px - b.keypoints_2d[v].uv_px).cwiseAbs().maxCoeff(),
+              1e-4)
+        << v;
+  }
+}
+
+}  // namespace
+}  // namespace handlabel
