@@ -4,6 +4,8 @@
 
 #include <torch/torch.h>
 
+#include <vector>
+
 #include "core/rigid3.h"
 #include "network/hand_mesh_predictor.h"
 #include "network/poem_loss.h"
@@ -110,6 +112,15 @@ inline std::vector<HandMeshInput> ToInputs(const PoemBatch& b) {
     }
   }
   return frames;
+}
+
+// Mean of an S x S crop mask over the 4 x 4 block of mask-head cell (i, j), written
+// out with loops as the independent reference for the head's targets and IoU.
+inline double BlockMean(const std::vector<float>& mask, int S, int i, int j) {
+  double sum = 0;
+  for (int y = 4 * i; y < 4 * i + 4; ++y)
+    for (int x = 4 * j; x < 4 * j + 4; ++x) sum += mask[y * S + x];
+  return sum / 16;
 }
 
 }  // namespace handlabel::testing

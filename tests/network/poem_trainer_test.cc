@@ -11,6 +11,7 @@
 #include "core/rigid3.h"
 #include "network/poem_checkpoint.h"
 #include "network/poem_training_batch.h"
+#include "tests/network/poem_test_util.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -257,10 +258,7 @@ TEST(PoemTrainer, MaskHeadAloneOntoTrainedWeights) {
     for (size_t n = 0; n < sample.views.size(); ++n) {
       for (int ci = 0; ci < M; ++ci) {
         for (int cj = 0; cj < M; ++cj) {
-          double cover = 0;
-          for (int y = 4 * ci; y < 4 * ci + 4; ++y)
-            for (int x = 4 * cj; x < 4 * cj + 4; ++x)
-              cover += sample.views[n].mask[y * S + x] / 16.0;
+          const double cover = testing::BlockMean(sample.views[n].mask, S, ci, cj);
           const bool truth = cover > 0.5, predicted = p.masks[n][ci * M + cj] > 0.5f;
           intersection += truth && predicted;
           union_cells += truth || predicted;
