@@ -108,7 +108,9 @@ TEST(LabelCommand,
   for (int round = 0; round < rounds; ++round) {
     const pid_t pid =
         Spawn({"label", "--job", killed_job, "--resume"}, dir + "/killed.log");
-    const double kill_after_s = testing::Uniform(0.0, full_run_s);
+    // Round 0 kills well inside the run's time, so at least one kill lands mid-run.
+    const double kill_after_s = round == 0 ? testing::Uniform(0.2, 0.6) * full_run_s
+                                           : testing::Uniform(0.0, full_run_s);
     std::this_thread::sleep_for(std::chrono::duration<double>(kill_after_s));
     kill(pid, SIGKILL);
     killed_mid_run += Wait(pid) == -SIGKILL;
@@ -123,6 +125,7 @@ TEST(LabelCommand,
       << testing::ReadFileBytes(dir + "/killed.log");
   RecordProperty("kill_rounds", rounds);
   RecordProperty("killed_mid_run", killed_mid_run);
+  EXPECT_GE(killed_mid_run, 1);
 
   // Identical outputs, and no temporary left behind.
   const auto reference = testing::FilesUnder(dir + "/ref/labels");
