@@ -1,6 +1,7 @@
 // `handlabel train`: trains POEM on synthetic captures made on the fly
 // (docs/training.md).
 
+#include <cstdlib>
 #include <iostream>
 
 #include "apps/cli_util.h"
@@ -34,7 +35,13 @@ int RunTrain(int argc, char** argv) {
                  "still follows the total steps");
   app.add_option("--learning-rate", learning_rate,
                  "peak learning rate (overrides train.learning_rate); with --resume the "
-                 "schedule changes from the checkpoint on, the Adam state is kept");
+                 "schedule changes from the checkpoint on, the Adam state is kept")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            return std::strtod(value.c_str(), nullptr) > 0 ? std::string()
+                                                           : "must be > 0, got " + value;
+          },
+          "> 0"));
   app.add_option("--out", out_dir, "run folder (overrides train.out_dir)");
   app.add_option("--threads", threads, "LibTorch threads (overrides train.threads)");
   app.add_option("--init-weights", init_weights,

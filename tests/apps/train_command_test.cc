@@ -115,6 +115,11 @@ TEST(TrainCommand, ResumesWithLongerScheduleAndNewLearningRate) {
   ASSERT_EQ(lr.size(), 3u);
   EXPECT_DOUBLE_EQ(lr.at(2), 0.001);   // the first run's schedule, after warm-up
   EXPECT_DOUBLE_EQ(lr.at(3), 0.0002);  // the resumed run's
+  // A learning rate that is not positive is bad usage, not silently ignored.
+  const auto bad = RunHandlabelCommand(
+      {"train", "--config", config, "--resume", "--learning-rate", "0"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_THAT(bad.err, HasSubstr("--learning-rate"));
 }
 
 TEST(TrainCommand, MaskPictureNeedsAMaskHead) {
