@@ -3,6 +3,8 @@
 
 #include <cstdlib>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
@@ -48,9 +50,16 @@ int RunTrain(int argc, char** argv) {
                  "start a new run from these weights (optimizer state starts afresh)");
   app.add_option("--init-step", init_step,
                  "with --init-weights: the step those weights were saved at");
-  app.add_option("--export", export_path,
-                 "do not train: write the latest checkpoint's weights of the run folder "
-                 "with float16 storage to this file (about half the size) and exit");
+  auto* export_option = app.add_option(
+      "--export", export_path,
+      "do not train: write the latest checkpoint's weights of the run folder "
+      "with float16 storage to this file (about half the size) and exit");
+  std::vector<std::string> average;
+  app.add_option("--average", average,
+                 "with --export: write the mean of these checkpoints' weights instead "
+                 "of the latest (one config; e.g. the checkpoints kept by "
+                 "train.keep_every during a low-learning-rate phase)")
+      ->needs(export_option);
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("train", [&] {
     TrainConfig config = LoadTrainConfig(config_path);
@@ -66,6 +75,12 @@ int RunTrain(int argc, char** argv) {
       throw InputError(config_path, "train.out_dir", "a run folder (or --out)", "empty");
     }
     config.trainer.Check(config_path);
+    if (!export_path.empty() && !average.empty()) {
+      ExportPoemCheckpointAverageAsHalf(average, export_path);
+      std::cout << "wrote " << export_path << " (mean of " << average.size()
+                << " checkpoints, float16)\n";
+      return 0;
+    }
     if (!export_path.empty()) {
       const std::string latest = LatestPoemCheckpointModel(config.trainer.out_dir);
       if (latest.empty()) {

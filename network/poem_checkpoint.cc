@@ -170,4 +170,34 @@ void LoadPoemCheckpointInto(PoemModel& model, const std::string& path,
   LoadPoemStateDict(model, a.tensors, path);
 }
 
+PoemModel AveragePoemCheckpoints(const std::vector<std::string>& paths) {
+  if (paths.empty()) {
+    throw InputError("checkpoint average", "", "at least one checkpoint", "none");
+  }
+  PoemModel mean = LoadPoemCheckpoint(paths.front());
+  // Sums in float64 so that the order of the files does not change the result.
+  std::map<std::string, torch::Tensor> sums;
+  for (const auto& [key, value] : PoemStateDict(mean)) {
+    if (value.is_floating_point()) sums[key] = value.to(torch::kDouble);
+  }
+  for (size_t i = 1; i < paths.size(); ++i) {
+    PoemModel next(mean->config());
+    LoadPoemCheckpointInto(next, paths[i]);  // throws on another config
+    for (const auto& [key, value] : PoemStateDict(next)) {
+      if (value.is_floating_point()) {
+        sums.at(key) += value.to(torch::kDouble);
+      } else if (i + 1 == paths.size()) {
+        torch::NoGradGuard no_grad;
+        PoemStateDict(mean).at(key).copy_(value);
+      }
+    }
+  }
+  torch::NoGradGuard no_grad;
+  const double n = static_cast<double>(paths.size());
+  for (auto& [key, dst] : PoemStateDict(mean)) {
+    if (sums.count(key)) dst.copy_((sums.at(key) / n).to(dst.scalar_type()));
+  }
+  return mean;
+}
+
 }  // namespace handlabel

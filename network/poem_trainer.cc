@@ -1,9 +1,11 @@
 #include "network/poem_trainer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <exception>
 #include <filesystem>
@@ -183,6 +185,14 @@ void PoemTrainerOptions::Check(const std::string& source) const {
   non_negative("grad_clip_norm", grad_clip_norm);
   positive("checkpoint_every", checkpoint_every);
   positive("keep_checkpoints", keep_checkpoints);
+  non_negative("keep_every", keep_every);
+  if (keep_every > 0 && keep_every % checkpoint_every != 0) {
+    // Otherwise some or all of the steps it names never get a checkpoint.
+    throw InputError(
+        source, "keep_every",
+        "a multiple of checkpoint_every (" + std::to_string(checkpoint_every) + ")",
+        std::to_string(keep_every));
+  }
   positive("log_every", log_every);
   non_negative("validate_every", validate_every);
   non_negative("validation_samples", validation_samples);
@@ -288,7 +298,7 @@ struct PoemTrainer::State {
     latest["batch_size"] = options.batch_size;
     latest["steps"] = options.steps;
     WriteTextAtomic(Path("latest.json"), latest.dump(2) + "\n");
-    // Drop old checkpoints beyond keep_checkpoints.
+    // Drop old checkpoints beyond keep_checkpoints, but the weights at keep_every.
     std::vector<std::string> stems;
     for (const auto& e : fs::directory_iterator(Path("checkpoints"))) {
       const std::string name = e.path().filename().string();
@@ -299,7 +309,12 @@ struct PoemTrainer::State {
     }
     std::sort(stems.begin(), stems.end());
     for (size_t i = 0; i + options.keep_checkpoints < stems.size(); ++i) {
-      fs::remove(Path("checkpoints/" + stems[i] + ".pt"));
+      char* end = nullptr;
+      const int64_t stem_step = std::strtoll(stems[i].c_str() + 5, &end, 10);
+      const bool numbered = end != stems[i].c_str() + 5 && *end == '\0';
+      if (options.keep_every == 0 || !numbered || stem_step % options.keep_every != 0) {
+        fs::remove(Path("checkpoints/" + stems[i] + ".pt"));
+      }
       fs::remove(Path("checkpoints/" + stems[i] + ".optim"));
     }
   }
@@ -501,6 +516,13 @@ std::string LatestPoemCheckpointModel(const std::string& out_dir) {
 void ConvertPoemCheckpointToHalf(const std::string& in_path,
                                  const std::string& out_path) {
   PoemModel model = LoadPoemCheckpoint(in_path);
+  model->to(torch::kHalf);
+  SavePoemCheckpoint(model, out_path);
+}
+
+void ExportPoemCheckpointAverageAsHalf(const std::vector<std::string>& in_paths,
+                                       const std::string& out_path) {
+  PoemModel model = AveragePoemCheckpoints(in_paths);
   model->to(torch::kHalf);
   SavePoemCheckpoint(model, out_path);
 }

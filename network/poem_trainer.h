@@ -42,13 +42,16 @@ struct PoemTrainerOptions {
   double grad_clip_norm = 1.0;     // per-parameter L2 clip (reference); 0 = off
   int64_t checkpoint_every = 200;  // steps between checkpoints (>= 1)
   int keep_checkpoints = 3;        // older checkpoints are deleted (>= 1)
-  int64_t log_every = 10;          // steps between progress lines / CSV rows (>= 1)
-  int64_t validate_every = 1000;   // steps between validations; 0 = never
-  int validation_samples = 64;     // held-out samples per validation
-  uint64_t seed = 1;               // model initialisation and per-step torch seeds
-  int threads = 1;                 // LibTorch intra-op threads (>= 1)
-  int prefetch_batches = 2;        // batches made ahead on a producer thread; 0 = inline
-  std::string out_dir;             // run folder (created)
+  // Weights of checkpoints at multiples of keep_every are never deleted (their optimizer
+  // state is): material for `train --export --average`. 0 = off.
+  int64_t keep_every = 0;
+  int64_t log_every = 10;         // steps between progress lines / CSV rows (>= 1)
+  int64_t validate_every = 1000;  // steps between validations; 0 = never
+  int validation_samples = 64;    // held-out samples per validation
+  uint64_t seed = 1;              // model initialisation and per-step torch seeds
+  int threads = 1;                // LibTorch intra-op threads (>= 1)
+  int prefetch_batches = 2;       // batches made ahead on a producer thread; 0 = inline
+  std::string out_dir;            // run folder (created)
   // Start a new run (no checkpoint in out_dir yet) from these weights instead of random
   // ones, counting steps from init_step; the optimizer state starts afresh. Used to
   // continue from the small weights-only checkpoint committed to the repository.
@@ -125,5 +128,9 @@ std::string LatestPoemCheckpointModel(const std::string& out_dir);
 // Rewrites an own POEM checkpoint with float16 storage (about half the size; it loads
 // with LoadPoemCheckpoint like any other, converted back to float32).
 void ConvertPoemCheckpointToHalf(const std::string& in_path, const std::string& out_path);
+// Writes the mean of checkpoints of one config (AveragePoemCheckpoints) with float16
+// storage.
+void ExportPoemCheckpointAverageAsHalf(const std::vector<std::string>& in_paths,
+                                       const std::string& out_path);
 
 }  // namespace handlabel

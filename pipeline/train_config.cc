@@ -104,6 +104,7 @@ TrainConfig LoadTrainConfig(const std::string& path) {
   train.Read("grad_clip_norm", &t.grad_clip_norm);
   train.Read("checkpoint_every", &t.checkpoint_every);
   train.Read("keep_checkpoints", &t.keep_checkpoints);
+  train.Read("keep_every", &t.keep_every);
   train.Read("log_every", &t.log_every);
   train.Read("validate_every", &t.validate_every);
   train.Read("validation_samples", &t.validation_samples);

@@ -122,6 +122,28 @@ TEST(TrainCommand, ResumesWithLongerScheduleAndNewLearningRate) {
   EXPECT_THAT(bad.err, HasSubstr("--learning-rate"));
 }
 
+TEST(TrainCommand, KeepEveryAndExportTheAverageOfCheckpoints) {
+  const std::string dir = testing::ScratchDir();
+  const std::string config =
+      TrainConfigFile(dir, "run", "  keep_checkpoints: 1\n  keep_every: 1\n", false);
+  ASSERT_EQ(RunHandlabelCommand({"train", "--config", config}).status, 0);
+  const std::string one = dir + "/run/checkpoints/step_00000001.pt",
+                    two = dir + "/run/checkpoints/step_00000002.pt";
+  ASSERT_TRUE(std::filesystem::exists(one));  // kept by keep_every despite keep 1
+  EXPECT_FALSE(std::filesystem::exists(dir + "/run/checkpoints/step_00000001.optim"));
+  const auto averaged = RunHandlabelCommand(
+      {"train", "--config", config, "--export", dir + "/mean.pt", "--average", one, two});
+  ASSERT_EQ(averaged.status, 0) << averaged.err;
+  EXPECT_THAT(averaged.out, HasSubstr("mean of 2 checkpoints"));
+  const auto eval = RunHandlabelCommand({"eval-network", "--weights", dir + "/mean.pt",
+                                         "--preset", "dexycb", "--frames", "1"});
+  EXPECT_EQ(eval.status, 0) << eval.err;
+  // --average names checkpoints to export; alone it is bad usage.
+  const auto alone = RunHandlabelCommand({"train", "--config", config, "--average", one});
+  EXPECT_EQ(alone.status, 2);
+  EXPECT_THAT(alone.err, HasSubstr("--export"));
+}
+
 TEST(TrainCommand, MaskPictureNeedsAMaskHead) {
   const std::string dir = testing::ScratchDir();
   ASSERT_EQ(

@@ -107,6 +107,17 @@ TEST(HandCrop, ChoosesEvidenceInOrderAndMarksMissedViews) {
 
   c = CropForView(view, cam, HandEvidence(), o);  // no evidence: the whole image is meant
   EXPECT_TRUE(c.hand_visible);
+  EXPECT_EQ(c.source, "whole image");
+  // The window is the image's square: its centre pixel maps to the crop's centre and
+  // the crop's focal length shrinks by the window's 320 px over the crop's 16.
+  EXPECT_DOUBLE_EQ(c.window.center.x(), 159.5);
+  EXPECT_DOUBLE_EQ(c.window.center.y(), 119.5);
+  EXPECT_DOUBLE_EQ(c.window.side, 320);
+  EXPECT_NEAR(c.intrinsics(0, 0), 300.0 * 16 / 320, 1e-9);
+  const Eigen::Vector3d centre =
+      c.intrinsics * Eigen::Vector3d((159.5 - 160) / 300, (119.5 - 120) / 300, 1);
+  EXPECT_NEAR(centre.x(), 8, 1e-9);
+  EXPECT_NEAR(centre.y(), 8, 1e-9);
 }
 
 // A mask predicted on the crop grid comes back to the image where it was: warp a

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 
 #include "core/errors.h"
 #include "core/rigid3.h"
@@ -305,6 +306,74 @@ TEST(PoemTrainer, HalfCheckpointLoadsCloseToTheOriginal) {
   }
   EXPECT_LT(std::filesystem::file_size(dir + "/half.pt"),
             0.7 * std::filesystem::file_size(LatestPoemCheckpointModel(dir + "/run")));
+}
+
+TEST(PoemTrainer, KeepsEveryNthCheckpointsWeightsAndAveragesThem) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const FakeSamples train(c, 21, false);
+  const std::string dir = testing::ScratchDir();
+  PoemTrainerOptions o = TinyOptions(dir + "/run");
+  o.checkpoint_every = 1;
+  o.keep_checkpoints = 1;
+  o.keep_every = 2;
+  PoemTrainer(c, MakeRegressorModel(), train, nullptr, o).Run(false);
+  std::set<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir + "/run/checkpoints")) {
+    files.insert(e.path().filename().string());
+  }
+  // Steps 2 and 4 keep their weights only; step 6 is the latest (with its optimizer);
+  // the odd steps are gone.
+  const std::set<std::string> expected = {"step_00000002.pt", "step_00000004.pt",
+                                          "step_00000006.pt", "step_00000006.optim"};
+  EXPECT_EQ(files, expected);
+  // A keep_every that is no multiple of checkpoint_every would keep nothing it names.
+  PoemTrainerOptions odd = o;
+  odd.checkpoint_every = 2;
+  odd.keep_every = 3;
+  EXPECT_THROW(odd.Check("test"), InputError);
+  odd.keep_every = 4;
+  EXPECT_NO_THROW(odd.Check("test"));
+
+  const std::vector<std::string> paths = {dir + "/run/checkpoints/step_00000002.pt",
+                                          dir + "/run/checkpoints/step_00000004.pt",
+                                          dir + "/run/checkpoints/step_00000006.pt"};
+  PoemModel mean = AveragePoemCheckpoints(paths);
+  std::vector<std::map<std::string, torch::Tensor>> each;
+  std::vector<PoemModel> models;
+  for (const auto& p : paths) {
+    models.push_back(LoadPoemCheckpoint(p));
+    each.push_back(PoemStateDict(models.back()));
+  }
+  int differing = 0;
+  for (const auto& [key, value] : PoemStateDict(mean)) {
+    if (!value.is_floating_point()) {
+      EXPECT_TRUE(torch::equal(value, each[2].at(key))) << key;  // the last file's
+      continue;
+    }
+    // Element by element, with the sum taken in another order.
+    const auto a = each[0].at(key).flatten(), b = each[1].at(key).flatten(),
+               d = each[2].at(key).flatten(), m = value.flatten();
+    for (int64_t k = 0; k < m.numel(); k += std::max<int64_t>(1, m.numel() / 7)) {
+      const double want =
+          (d[k].item<double>() + b[k].item<double>() + a[k].item<double>()) / 3;
+      EXPECT_NEAR(m[k].item<double>(), want, 1e-6 * (1 + std::abs(want)))
+          << key << " " << k;
+    }
+    differing += !torch::equal(each[0].at(key), each[2].at(key));
+  }
+  EXPECT_GT(differing, 10);  // training moved the weights: the mean is not trivial
+
+  // One file averages to itself; files of another config are refused.
+  PoemModel one = AveragePoemCheckpoints({paths[1]});
+  for (const auto& [key, value] : PoemStateDict(one)) {
+    EXPECT_TRUE(torch::equal(value, each[1].at(key))) << key;
+  }
+  PoemConfig other = TinyPoemConfig(2);
+  other.num_decoder_blocks += 1;
+  PoemModel different(other);
+  SavePoemCheckpoint(different, dir + "/other.pt");
+  EXPECT_THROW(AveragePoemCheckpoints({paths[0], dir + "/other.pt"}), InputError);
+  EXPECT_THROW(AveragePoemCheckpoints({}), InputError);
 }
 
 }  // namespace
