@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/errors.h"
+#include "network/poem_loss.h"
 #include "tests/network/poem_test_util.h"
 
 namespace handlabel {
@@ -21,7 +25,7 @@ TEST(PoemBatch, FromFrameStructsReproducesTheTensors) {
   EXPECT_EQ(b.view_weights[0][2].item<float>(), 1.0f);
 }
 
-TEST(PoemBatch, TargetsFromEigenAndTrainStepRuns) {
+TEST(PoemBatch, TargetsFromEigenAndOneTrainStep) {
   const PoemConfig c = TinyPoemConfig(2);
   const PoemBatch batch =
       MakePoemBatch(testing::ToInputs(testing::MakeSyntheticBatch(c, 1, 3)), 0, 1, c);
@@ -38,9 +42,33 @@ TEST(PoemBatch, TargetsFromEigenAndTrainStepRuns) {
   EXPECT_FLOAT_EQ(t.joints_2d_weights[0][1][0].item<float>(), 0.0f);
   PoemModel model = MakeRandomPoemModel(c, 2);
   torch::optim::Adam adam(model->parameters(), torch::optim::AdamOptions(1e-4));
+  torch::manual_seed(17);  // the forward pass samples points
   const TrainStepResult r =
       TrainStep(model, adam, batch, t, testing::MakeTestRegressor());
   EXPECT_TRUE(std::isfinite(r.total));
+
+  // The reported loss is the loss of the weights before the step: a second model with
+  // the same weights, run by hand in training mode with the same seed, gives it.
+  PoemModel before = MakeRandomPoemModel(c, 2);
+  before->train();
+  torch::manual_seed(17);
+  const PoemLoss expected =
+      ComputePoemLoss(before->forward(batch), batch, t, testing::MakeTestRegressor());
+  EXPECT_NEAR(r.total, expected.total.item<double>(),
+              1e-5 * std::abs(expected.total.item<double>()));
+  // Adam's first step moves every parameter with a gradient by about the learning rate
+  // (m / sqrt(v) = sign of the gradient), never more.
+  const auto after_w = model->named_parameters(), before_w = before->named_parameters();
+  double largest = 0;
+  int moved = 0;
+  for (const auto& p : after_w) {
+    const double d = (p.value() - before_w[p.key()]).abs().max().item<double>();
+    largest = std::max(largest, d);
+    moved += d > 0;
+  }
+  EXPECT_LE(largest, 1e-4 * 1.001);
+  EXPECT_GE(largest, 1e-4 * 0.9);
+  EXPECT_GT(moved, static_cast<int>(after_w.size()) / 2);
 
   g.joints_2d.pop_back();
   try {
