@@ -60,6 +60,13 @@ int RunTrain(int argc, char** argv) {
                  "of the latest (one config; e.g. the checkpoints kept by "
                  "train.keep_every during a low-learning-rate phase)")
       ->needs(export_option);
+  int bn_samples = 0;
+  app.add_option("--bn-samples", bn_samples,
+                 "with --average: measure the mean's batch-norm statistics again on this "
+                 "many training samples of the config's data (SWA's batch-norm update) "
+                 "instead of averaging the checkpoints' statistics; 0 = average them")
+      ->needs("--average")
+      ->check(CLI::NonNegativeNumber);
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("train", [&] {
     TrainConfig config = LoadTrainConfig(config_path);
@@ -76,9 +83,21 @@ int RunTrain(int argc, char** argv) {
     }
     config.trainer.Check(config_path);
     if (!export_path.empty() && !average.empty()) {
-      ExportPoemCheckpointAverageAsHalf(average, export_path);
+      if (bn_samples == 0) {
+        ExportPoemCheckpointAverageAsHalf(average, export_path);
+      } else {
+        std::string hand_source;
+        const HandModel hand = LoadTrainingHandModel(config, &hand_source);
+        const SynthTrainingSamples train(hand, config.synth, config.samples);
+        ExportPoemCheckpointAverageAsHalf(average, export_path, &train, bn_samples,
+                                          config.trainer.batch_size);
+      }
       std::cout << "wrote " << export_path << " (mean of " << average.size()
-                << " checkpoints, float16)\n";
+                << " checkpoints"
+                << (bn_samples > 0 ? ", batch-norm statistics from " +
+                                         std::to_string(bn_samples) + " samples"
+                                   : std::string())
+                << ", float16)\n";
       return 0;
     }
     if (!export_path.empty()) {

@@ -17,6 +17,7 @@
 
 #include "core/errors.h"
 #include "core/metrics.h"
+#include "network/poem_batch_norm_update.h"
 #include "network/poem_checkpoint.h"
 #include "network/poem_training_batch.h"
 
@@ -521,8 +522,13 @@ void ConvertPoemCheckpointToHalf(const std::string& in_path,
 }
 
 void ExportPoemCheckpointAverageAsHalf(const std::vector<std::string>& in_paths,
-                                       const std::string& out_path) {
+                                       const std::string& out_path,
+                                       const TrainingSampleSource* bn_source,
+                                       int bn_samples, int batch_size) {
   PoemModel model = AveragePoemCheckpoints(in_paths);
+  if (bn_source != nullptr && bn_samples > 0) {
+    RecomputePoemBatchNorm(model, *bn_source, bn_samples, batch_size);
+  }
   model->to(torch::kHalf);
   SavePoemCheckpoint(model, out_path);
 }

@@ -129,8 +129,12 @@ std::string LatestPoemCheckpointModel(const std::string& out_dir);
 // with LoadPoemCheckpoint like any other, converted back to float32).
 void ConvertPoemCheckpointToHalf(const std::string& in_path, const std::string& out_path);
 // Writes the mean of checkpoints of one config (AveragePoemCheckpoints) with float16
-// storage.
+// storage. With `bn_source`, the mean's batch-norm statistics are then measured again on
+// its samples [0, bn_samples) in batches of `batch_size` (RecomputePoemBatchNorm)
+// instead of being the checkpoints' averaged ones.
 void ExportPoemCheckpointAverageAsHalf(const std::vector<std::string>& in_paths,
-                                       const std::string& out_path);
+                                       const std::string& out_path,
+                                       const TrainingSampleSource* bn_source = nullptr,
+                                       int bn_samples = 0, int batch_size = 4);
 
 }  // namespace handlabel

@@ -138,6 +138,17 @@ TEST(TrainCommand, KeepEveryAndExportTheAverageOfCheckpoints) {
   const auto eval = RunHandlabelCommand({"eval-network", "--weights", dir + "/mean.pt",
                                          "--preset", "dexycb", "--frames", "1"});
   EXPECT_EQ(eval.status, 0) << eval.err;
+  const auto updated =
+      RunHandlabelCommand({"train", "--config", config, "--export", dir + "/mean_bn.pt",
+                           "--average", one, two, "--bn-samples", "2"});
+  ASSERT_EQ(updated.status, 0) << updated.err;
+  EXPECT_THAT(updated.out, HasSubstr("batch-norm statistics from 2 samples"));
+  EXPECT_NE(testing::ReadFileBytes(dir + "/mean.pt"),
+            testing::ReadFileBytes(dir + "/mean_bn.pt"));
+  EXPECT_EQ(RunHandlabelCommand({"train", "--config", config, "--export", dir + "/x.pt",
+                                 "--bn-samples", "2"})
+                .status,
+            2);  // --bn-samples needs --average
   // --average names checkpoints to export; alone it is bad usage.
   const auto alone = RunHandlabelCommand({"train", "--config", config, "--average", one});
   EXPECT_EQ(alone.status, 2);

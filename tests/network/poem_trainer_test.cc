@@ -10,6 +10,7 @@
 
 #include "core/errors.h"
 #include "core/rigid3.h"
+#include "network/poem_batch_norm_update.h"
 #include "network/poem_checkpoint.h"
 #include "network/poem_training_batch.h"
 #include "tests/network/poem_test_util.h"
@@ -374,6 +375,54 @@ TEST(PoemTrainer, KeepsEveryNthCheckpointsWeightsAndAveragesThem) {
   SavePoemCheckpoint(different, dir + "/other.pt");
   EXPECT_THROW(AveragePoemCheckpoints({paths[0], dir + "/other.pt"}), InputError);
   EXPECT_THROW(AveragePoemCheckpoints({}), InputError);
+}
+
+// After the update, eval mode (running statistics) answers like training mode (the
+// batch's own statistics) on the batch the statistics were measured on; before it, the
+// initial statistics give other answers. Parameters do not move.
+TEST(PoemBatchNormUpdate, EvalModeMatchesTrainingModeOnTheMeasuredBatch) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const FakeSamples source(c, 31, false);
+  PoemModel model = MakeRandomPoemModel(c, 4);
+  const PoemBatch batch =
+      ToPoemTrainingBatch({source.Sample(0), source.Sample(1), source.Sample(2)}).batch;
+  auto heatmaps = [&](bool training) {
+    torch::NoGradGuard no_grad;
+    model->train(training);
+    torch::manual_seed(3);
+    return model->forward(batch).heatmaps.clone();
+  };
+  const torch::Tensor with_batch_statistics = heatmaps(true);
+  std::map<std::string, torch::Tensor> before;
+  for (const auto& [key, value] : PoemStateDict(model)) before[key] = value.clone();
+
+  const double gap_before =
+      (heatmaps(false) - with_batch_statistics).abs().max().item<double>();
+  EXPECT_GT(RecomputePoemBatchNorm(model, source, /*samples=*/3, /*batch_size=*/3), 0);
+  EXPECT_FALSE(model->is_training());
+  const double gap_after =
+      (heatmaps(false) - with_batch_statistics).abs().max().item<double>();
+  EXPECT_GT(gap_before, 1e-3);
+  // Not zero: running variances are unbiased, training mode divides by the biased one.
+  EXPECT_LT(gap_after, 0.1 * gap_before) << gap_before;
+
+  int running_changed = 0;
+  for (const auto& [key, value] : PoemStateDict(model)) {
+    const bool running = key.find("running_") != std::string::npos ||
+                         key.find("num_batches_tracked") != std::string::npos;
+    if (!running) {
+      EXPECT_TRUE(torch::equal(value, before.at(key))) << key;
+    } else {
+      running_changed += !torch::equal(value, before.at(key));
+    }
+  }
+  EXPECT_GT(running_changed, 0);
+  for (const auto& m : model->modules(false)) {
+    if (auto* bn = m->as<torch::nn::BatchNorm2d>()) {
+      ASSERT_TRUE(bn->options.momentum().has_value());  // restored for later training
+      EXPECT_DOUBLE_EQ(*bn->options.momentum(), 0.1);
+    }
+  }
 }
 
 }  // namespace
