@@ -58,7 +58,7 @@ int RunTrain(int argc, char** argv) {
   app.add_option("--average", average,
                  "with --export: write the mean of these checkpoints' weights instead "
                  "of the latest (one config; e.g. the checkpoints kept by "
-                 "train.keep_every during a low-learning-rate phase)")
+                 "train.keep_every during a constant-learning-rate phase)")
       ->needs(export_option);
   int bn_samples = 0;
   app.add_option("--bn-samples", bn_samples,

@@ -49,8 +49,9 @@ void LoadPoemCheckpointInto(PoemModel& model, const std::string& path,
 
 // The element-wise mean of the weights and batch-norm statistics of checkpoints written
 // for one config (num_batches_tracked: the last file's). The checkpoints of a
-// low-learning-rate phase wander around one basin; their mean lies nearer its middle.
-// Throws InputError if the list is empty or a file was written for another config.
+// constant-learning-rate phase wander around one basin; their mean lies nearer its
+// middle. Throws InputError if the list is empty or a file was written for another
+// config.
 PoemModel AveragePoemCheckpoints(const std::vector<std::string>& paths);
 
 }  // namespace handlabel
