@@ -24,11 +24,9 @@ int RecomputePoemBatchNorm(PoemModel& model, const TrainingSampleSource& source,
   torch::NoGradGuard no_grad;
   model->train();
   for (int first = 0; first < samples; first += batch_size) {
-    std::vector<TrainingSample> batch;
-    for (int i = first; i < std::min(samples, first + batch_size); ++i) {
-      batch.push_back(source.Sample(i));
-    }
-    model->forward(ToPoemTrainingBatch(batch).batch);
+    model->forward(ToPoemTrainingBatch(
+                       SampleRange(source, first, std::min(samples, first + batch_size)))
+                       .batch);
   }
   model->eval();
   for (size_t i = 0; i < norms.size(); ++i) norms[i]->options.momentum(momentum[i]);

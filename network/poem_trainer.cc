@@ -126,11 +126,7 @@ class BatchProducer {
 
  private:
   std::vector<TrainingSample> Make(int64_t step) const {
-    std::vector<TrainingSample> batch;
-    for (int i = 0; i < batch_size_; ++i) {
-      batch.push_back(source_.Sample(step * batch_size_ + i));
-    }
-    return batch;
+    return SampleRange(source_, step * batch_size_, (step + 1) * batch_size_);
   }
   void Loop() {
     try {
@@ -223,10 +219,8 @@ PoemValidation ValidatePoem(PoemModel& model, const TrainingSampleSource& source
   MaskIouCounts masks;
   bool any_mask = false;
   for (int first = 0; first < count; first += batch_size) {
-    std::vector<TrainingSample> samples;
-    for (int i = first; i < std::min(count, first + batch_size); ++i) {
-      samples.push_back(source.Sample(i));
-    }
+    const std::vector<TrainingSample> samples =
+        SampleRange(source, first, std::min(count, first + batch_size));
     const std::vector<PoemPrediction> pred = PredictPoem(model, samples);
     for (size_t i = 0; i < samples.size(); ++i) {
       joints += MeanPointError(pred[i].joints_3d, samples[i].joints_3d);
@@ -516,9 +510,7 @@ std::string LatestPoemCheckpointModel(const std::string& out_dir) {
 
 void ConvertPoemCheckpointToHalf(const std::string& in_path,
                                  const std::string& out_path) {
-  PoemModel model = LoadPoemCheckpoint(in_path);
-  model->to(torch::kHalf);
-  SavePoemCheckpoint(model, out_path);
+  ExportPoemCheckpointAverageAsHalf({in_path}, out_path);  // the mean of one is itself
 }
 
 void ExportPoemCheckpointAverageAsHalf(const std::vector<std::string>& in_paths,

@@ -36,4 +36,11 @@ bool MaskIouCounts::Add(const PoemPrediction& prediction, const TrainingSample& 
   return added;
 }
 
+std::vector<TrainingSample> SampleRange(const TrainingSampleSource& source, int64_t first,
+                                        int64_t end) {
+  std::vector<TrainingSample> samples;
+  for (int64_t i = first; i < end; ++i) samples.push_back(source.Sample(i));
+  return samples;
+}
+
 }  // namespace handlabel

@@ -71,4 +71,8 @@ class TrainingSampleSource {
   virtual TrainingSample Sample(int64_t index) const = 0;
 };
 
+// Samples [first, end) of `source`, in index order (one batch).
+std::vector<TrainingSample> SampleRange(const TrainingSampleSource& source, int64_t first,
+                                        int64_t end);
+
 }  // namespace handlabel

@@ -48,10 +48,8 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   MaskIouCounts mask_iou;
   Eigen::MatrixXd joint_errors(o.frames, 21), vertex_errors;
   for (int first = 0; first < o.frames; first += o.batch_size) {
-    std::vector<TrainingSample> samples;
-    for (int i = first; i < std::min(o.frames, first + o.batch_size); ++i) {
-      samples.push_back(source.Sample(i));
-    }
+    const std::vector<TrainingSample> samples =
+        SampleRange(source, first, std::min(o.frames, first + o.batch_size));
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<PoemPrediction> pred = predictor.Predict(samples);
     r.seconds +=

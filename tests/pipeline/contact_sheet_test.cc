@@ -9,18 +9,24 @@
 namespace handlabel {
 namespace {
 
-TEST(ContactSheet, TilesEveryViewAndDrawsKeypointsWhereTheyAre) {
+// One frame of the capsule hand seen by `cameras` random 120 x 90 cameras on a plain
+// grey background, so drawn colours stand out; returns the capture folder.
+std::string WriteGreyCapture(int cameras) {
   const std::string dir = testing::ScratchDir() + "/cap";
   SynthCaptureOptions o;
   o.rig.preset = "random";
-  o.rig.num_cameras = 3;
+  o.rig.num_cameras = cameras;
   o.rig.width = 120;
   o.rig.height = 90;
   o.num_frames = 1;
   o.num_threads = 1;
-  o.view.background.clutter = false;  // grey, so drawn colours stand out
+  o.view.background.clutter = false;
   WriteSynthCapture(MakeCapsuleHand(HandSide::kRight), o, dir, "builtin:capsule");
-  const CaptureReader capture(dir);
+  return dir;
+}
+
+TEST(ContactSheet, TilesEveryViewAndDrawsKeypointsWhereTheyAre) {
+  const CaptureReader capture(WriteGreyCapture(3));
   ContactSheetOptions so;
   so.columns = 2;
   so.tile_width = 120;  // 1:1 scale
@@ -43,17 +49,7 @@ TEST(ContactSheet, TilesEveryViewAndDrawsKeypointsWhereTheyAre) {
 // At 1:1 scale with keypoints off, camera 0's tile is its image with exactly the mask's
 // border pixels (on, with a 4-neighbour off) painted in the outline colour.
 TEST(ContactSheet, OutlinesExactlyTheMaskBorder) {
-  const std::string dir = testing::ScratchDir() + "/cap";
-  SynthCaptureOptions o;
-  o.rig.preset = "random";
-  o.rig.num_cameras = 2;
-  o.rig.width = 120;
-  o.rig.height = 90;
-  o.num_frames = 1;
-  o.num_threads = 1;
-  o.view.background.clutter = false;
-  WriteSynthCapture(MakeCapsuleHand(HandSide::kRight), o, dir, "builtin:capsule");
-  const CaptureReader capture(dir);
+  const CaptureReader capture(WriteGreyCapture(2));
   ContactSheetOptions so;
   so.columns = 2;
   so.tile_width = 120;
