@@ -70,6 +70,8 @@ int RunEvalNetwork(int argc, char** argv) {
         static_cast<unsigned long long>(o.synth.seed), r.mpjpe_mm, r.mpvpe_mm,
         r.pa_mpjpe_mm, r.pa_mpvpe_mm, r.joint_pck.auc, r.vertex_pck.auc,
         r.frames_per_second);
+    std::printf("MPJPE of keypoints read off the mesh %.2f mm (true mesh: %.2f mm)\n",
+                r.mpjpe_from_mesh_mm, r.true_mesh_keypoint_gap_mm);
     if (r.mask_iou >= 0) std::printf("mask IoU (crop grid)   %.3f\n", r.mask_iou);
     if (!o.mask_png.empty()) std::cout << "masks: " << o.mask_png << "\n";
     if (!pck_png.empty()) {

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "core/errors.h"
+#include "core/mesh_keypoints.h"
 #include "network/poem_sample_predictor.h"
 #include "pipeline/line_plot.h"
 #include "pipeline/mask_sheet.h"
@@ -61,6 +62,13 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
       joint_errors.row(f) = PointErrors(pred[i].joints_3d, s.joints_3d).transpose();
       vertex_errors.row(f) = PointErrors(pred[i].vertices_3d, s.vertices_3d).transpose();
       r.pa_mpjpe_mm += 1000 * ProcrustesMeanPointError(pred[i].joints_3d, s.joints_3d);
+      r.mpjpe_from_mesh_mm +=
+          1000 *
+          PointErrors(KeypointsFromMeshVertices(hand, pred[i].vertices_3d), s.joints_3d)
+              .mean();
+      r.true_mesh_keypoint_gap_mm +=
+          1000 *
+          PointErrors(KeypointsFromMeshVertices(hand, s.vertices_3d), s.joints_3d).mean();
       r.pa_mpvpe_mm +=
           1000 * ProcrustesMeanPointError(pred[i].vertices_3d, s.vertices_3d);
       mask_iou.Add(pred[i], s);
@@ -76,6 +84,8 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   r.mpvpe_mm = 1000 * vertex_errors.mean();
   r.pa_mpjpe_mm /= r.frames;
   r.pa_mpvpe_mm /= r.frames;
+  r.mpjpe_from_mesh_mm /= r.frames;
+  r.true_mesh_keypoint_gap_mm /= r.frames;
   r.joint_pck = ComputePck(joint_errors, o.pck);
   r.vertex_pck = ComputePck(vertex_errors, o.pck);
   if (so.masks) r.mask_iou = mask_iou.Iou();

@@ -34,9 +34,13 @@ struct NetworkEvalResult {
   int frames = 0;
   double mpjpe_mm = 0, mpvpe_mm = 0;        // mean over frames
   double pa_mpjpe_mm = 0, pa_mpvpe_mm = 0;  // Procrustes-aligned
-  PckCurve joint_pck, vertex_pck;           // thresholds in metres
-  double seconds = 0;                       // wall time of the forward passes
-  double frames_per_second = 0;             // network only (crops excluded)
+  // Keypoints read off the predicted mesh (core/mesh_keypoints.h) instead of the
+  // network's own joints, and the same reading of the true mesh against the true
+  // keypoints (the part of the first that no network can remove).
+  double mpjpe_from_mesh_mm = 0, true_mesh_keypoint_gap_mm = 0;
+  PckCurve joint_pck, vertex_pck;  // thresholds in metres
+  double seconds = 0;              // wall time of the forward passes
+  double frames_per_second = 0;    // network only (crops excluded)
   // Mask head: IoU of the predicted crop masks with the true ones (network/
   // training_sample.h MaskIouCounts, every view); -1 without a mask head.
   double mask_iou = -1;

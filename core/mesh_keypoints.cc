@@ -1,0 +1,25 @@
+#include "core/mesh_keypoints.h"
+
+#include <string>
+
+#include "core/errors.h"
+
+namespace handlabel {
+
+Points3d KeypointsFromMeshVertices(const HandModel& model, const Points3d& vertices) {
+  if (vertices.rows() != model.num_vertices()) {
+    throw InputError("mesh", "vertices", std::to_string(model.num_vertices()) + " rows",
+                     std::to_string(vertices.rows()));
+  }
+  const Points3d joints = model.joint_regressor * vertices;
+  Points3d keypoints(kNumHandKeypoints, 3);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const int native = kSnapFromNative[k];
+    keypoints.row(k) = native < kNumHandJoints
+                           ? joints.row(native)
+                           : vertices.row(model.tip_vertex_ids[native - kNumHandJoints]);
+  }
+  return keypoints;
+}
+
+}  // namespace handlabel
