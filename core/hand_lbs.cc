@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "core/mesh_keypoints.h"
 
 // Reference implementation with plain Eigen matrix algebra, written for clarity and
 // kept independent of the templated HandEvaluator (hand_evaluator.h) so that each can
@@ -87,14 +88,7 @@ HandMesh PoseHand(const HandModel& model, const HandParams& params) {
   for (int j = 0; j < kNumHandJoints; ++j) {
     mesh.joints.row(j) = (world_t[j] + params.transl).transpose();
   }
-  mesh.keypoints.resize(kNumHandKeypoints, 3);
-  for (int k = 0; k < kNumHandKeypoints; ++k) {
-    const int native = kSnapFromNative[k];
-    mesh.keypoints.row(k) =
-        native < kNumHandJoints
-            ? mesh.joints.row(native)
-            : mesh.vertices.row(model.tip_vertex_ids[native - kNumHandJoints]);
-  }
+  mesh.keypoints = SnapKeypoints(model, mesh.joints, mesh.vertices);
   return mesh;
 }
 

@@ -11,7 +11,12 @@ Points3d KeypointsFromMeshVertices(const HandModel& model, const Points3d& verti
     throw InputError("mesh", "vertices", std::to_string(model.num_vertices()) + " rows",
                      std::to_string(vertices.rows()));
   }
-  const Points3d joints = model.joint_regressor * vertices;
+  return SnapKeypoints(model, model.joint_regressor * vertices, vertices);
+}
+
+Points3d SnapKeypoints(const HandModel& model, const Points3d& joints,
+                       const Points3d& vertices) {
+  HL_CHECK(joints.rows() == kNumHandJoints, "16 joints");
   Points3d keypoints(kNumHandKeypoints, 3);
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     const int native = kSnapFromNative[k];

@@ -12,4 +12,10 @@ namespace handlabel {
 // vertices: model.num_vertices() x 3. Returns 21 x 3 in SNAP order.
 Points3d KeypointsFromMeshVertices(const HandModel& model, const Points3d& vertices);
 
+// The 21 SNAP keypoints from 16 joints (native order) and the mesh's tip vertices: the
+// one place that knows how the two are interleaved (PoseHand uses it with the skinned
+// joints).
+Points3d SnapKeypoints(const HandModel& model, const Points3d& joints,
+                       const Points3d& vertices);
+
 }  // namespace handlabel
