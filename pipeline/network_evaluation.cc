@@ -62,6 +62,8 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
       joint_errors.row(f) = PointErrors(pred[i].joints_3d, s.joints_3d).transpose();
       vertex_errors.row(f) = PointErrors(pred[i].vertices_3d, s.vertices_3d).transpose();
       r.pa_mpjpe_mm += 1000 * ProcrustesMeanPointError(pred[i].joints_3d, s.joints_3d);
+      r.pa_mpvpe_mm +=
+          1000 * ProcrustesMeanPointError(pred[i].vertices_3d, s.vertices_3d);
       r.mpjpe_from_mesh_mm +=
           1000 *
           PointErrors(KeypointsFromMeshVertices(hand, pred[i].vertices_3d), s.joints_3d)
@@ -69,8 +71,6 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
       r.true_mesh_keypoint_gap_mm +=
           1000 *
           PointErrors(KeypointsFromMeshVertices(hand, s.vertices_3d), s.joints_3d).mean();
-      r.pa_mpvpe_mm +=
-          1000 * ProcrustesMeanPointError(pred[i].vertices_3d, s.vertices_3d);
       mask_iou.Add(pred[i], s);
       if (!o.mask_png.empty() && f < o.mask_png_frames) {
         sheet_samples.push_back(s);

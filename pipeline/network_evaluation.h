@@ -34,9 +34,9 @@ struct NetworkEvalResult {
   int frames = 0;
   double mpjpe_mm = 0, mpvpe_mm = 0;        // mean over frames
   double pa_mpjpe_mm = 0, pa_mpvpe_mm = 0;  // Procrustes-aligned
-  // Keypoints read off the predicted mesh (core/mesh_keypoints.h) instead of the
-  // network's own joints, and the same reading of the true mesh against the true
-  // keypoints (the part of the first that no network can remove).
+  // MPJPE of keypoints read off the predicted mesh (core/mesh_keypoints.h) instead of
+  // the network's own joints, and of the same reading of the true mesh (the reading's
+  // own error, which a perfect mesh would still carry).
   double mpjpe_from_mesh_mm = 0, true_mesh_keypoint_gap_mm = 0;
   PckCurve joint_pck, vertex_pck;  // thresholds in metres
   double seconds = 0;              // wall time of the forward passes

@@ -46,6 +46,13 @@ std::string MetricLines(const std::string& report) {
   return out;
 }
 
+// eval-network's "(true mesh: X mm)": keypoints read off the true mesh vs the true ones.
+double TrueMeshReadingMm(const std::string& report) {
+  const std::string key = "(true mesh: ";
+  const size_t at = report.find(key);
+  return at == std::string::npos ? -1 : std::stod(report.substr(at + key.size()));
+}
+
 TEST(TrainCommand, TrainsExportsAndTrainsAMaskHeadOntoTheExport) {
   const std::string dir = testing::ScratchDir();
   const auto base =
@@ -86,6 +93,13 @@ TEST(TrainCommand, TrainsExportsAndTrainsAMaskHeadOntoTheExport) {
   ASSERT_EQ(eval_base.status, 0) << eval_base.err;
   EXPECT_EQ(MetricLines(eval.out), MetricLines(eval_base.out));
   ASSERT_FALSE(MetricLines(eval.out).empty());
+  // Keypoints read off the true mesh sit within the joint regressor's small error of the
+  // true keypoints (the open hand: about 0.5 mm; a wrong joint order or tip vertex would
+  // be tens of mm), and that reading does not depend on the weights.
+  const double true_mesh = TrueMeshReadingMm(eval.out);
+  EXPECT_GT(true_mesh, 0);
+  EXPECT_LT(true_mesh, 2.0);
+  EXPECT_EQ(true_mesh, TrueMeshReadingMm(eval_base.out));
 }
 
 // Rows of loss.csv as step -> lr.
