@@ -4,7 +4,7 @@
 #include "apps/cli_util.h"
 #include "apps/commands.h"
 #include "core/errors.h"
-#include "pipeline/capture_reader.h"
+#include "capture/capture_reader.h"
 #include "pipeline/fit_capture.h"
 #include "pipeline/hand_model_source.h"
 

@@ -6,7 +6,7 @@
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_stage_factory.h"
-#include "pipeline/sha256.h"
+#include "core/sha256.h"
 
 namespace handlabel {
 

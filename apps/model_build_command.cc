@@ -1,5 +1,5 @@
 // `handlabel model build` and `handlabel model render`: the project's open hand model
-// (pipeline/open_hand_builder.h) and preview pictures of any hand model.
+// (openhand/builder.h) and preview pictures of any hand model.
 
 #include <iostream>
 #include <string>
@@ -10,9 +10,9 @@
 #include "core/errors.h"
 #include "core/hand_model_io.h"
 #include "core/image.h"
-#include "pipeline/hand_preview.h"
-#include "pipeline/mesh_checks.h"
-#include "pipeline/open_hand_builder.h"
+#include "core/hand_preview.h"
+#include "openhand/mesh_checks.h"
+#include "openhand/builder.h"
 
 namespace handlabel {
 

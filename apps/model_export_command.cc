@@ -10,8 +10,8 @@
 #include "core/errors.h"
 #include "core/hand_lbs.h"
 #include "core/hand_model_io.h"
-#include "pipeline/atomic_file.h"
-#include "pipeline/hand_preview.h"
+#include "core/atomic_file.h"
+#include "core/hand_preview.h"
 #include "pipeline/label_record.h"
 
 namespace handlabel {

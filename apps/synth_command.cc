@@ -5,11 +5,11 @@
 #include "apps/cli_util.h"
 #include "apps/commands.h"
 #include "core/errors.h"
-#include "pipeline/capture_reader.h"
-#include "pipeline/contact_sheet.h"
+#include "capture/capture_reader.h"
+#include "capture/contact_sheet.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/progress.h"
-#include "pipeline/synth_capture.h"
+#include "capture/synth_capture.h"
 
 namespace handlabel {
 

@@ -10,7 +10,7 @@
 #include "apps/commands.h"
 #include "core/errors.h"
 #include "network/poem_trainer.h"
-#include "pipeline/loss_plot.h"
+#include "network/loss_plot.h"
 #include "pipeline/train_config.h"
 #include "pipeline/training_samples.h"
 

@@ -7,8 +7,8 @@
 
 #include "network/poem_loss.h"
 #include "network/poem_training_batch.h"
-#include "pipeline/capsule_hand.h"
-#include "pipeline/open_hand_builder.h"
+#include "core/capsule_hand.h"
+#include "openhand/builder.h"
 #include "pipeline/training_samples.h"
 
 namespace handlabel {

@@ -15,9 +15,9 @@
 #include <benchmark/benchmark.h>
 
 #include "core/image.h"
-#include "pipeline/capsule_hand.h"
+#include "core/capsule_hand.h"
 #include "pipeline/hand_model_source.h"
-#include "pipeline/synth_capture.h"
+#include "capture/synth_capture.h"
 
 namespace handlabel {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 // A right-hand rest skeleton in the MANO layout (metres): the 16 native joints, then the
 // 5 fingertips (thumb, index, middle, ring, pinky). Fingers along -x, back of the hand
-// +y, thumb +z, as MANO and the open hand. The capsule hand (pipeline/capsule_hand.h)
+// +y, thumb +z, as MANO and the open hand. The capsule hand (core/capsule_hand.h)
 // and the tests' stick hand are built on it.
 
 namespace handlabel {

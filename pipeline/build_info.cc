@@ -6,13 +6,14 @@
 #include "calib/calib_versions.h"
 #include "fitting/fitting_versions.h"
 #include "network/network_versions.h"
+#include "core/version.h"
 #include "pipeline/build_config.h"
 #include "pipeline/git_hash.h"
 
 namespace handlabel {
 
 BuildInfo GetBuildInfo() {
-  BuildInfo info{HANDLABEL_VERSION, HANDLABEL_GIT_HASH, HANDLABEL_BUILD_TYPE, {}};
+  BuildInfo info{HandlabelVersion(), HANDLABEL_GIT_HASH, HANDLABEL_BUILD_TYPE, {}};
   auto append = [&info](const VersionList& list) {
     for (const auto& entry : list) {
       bool seen = false;

@@ -14,8 +14,8 @@
 #include "core/hand_anatomy.h"
 #include "core/metrics.h"
 #include "fitting/silhouette_render.h"
-#include "pipeline/atomic_file.h"
-#include "pipeline/capture_reader.h"
+#include "core/atomic_file.h"
+#include "capture/capture_reader.h"
 #include "pipeline/fit_overlay.h"
 
 namespace handlabel {

@@ -1,6 +1,6 @@
 #pragma once
 // `handlabel fit`: fits the hand model (fitting/ceres_hand_fitter.h) to every chosen
-// frame of a capture in the native layout (pipeline/capture_reader.h), from its 2D
+// frame of a capture in the native layout (capture/capture_reader.h), from its 2D
 // keypoints (simulated detections or ground-truth projections) and masks, and writes
 //   <out>/frames/<frame>.json   parameters (MANO-compatible), 21 keypoints, vertices,
 //                               per-term costs, per-view reprojection RMS and IoU,

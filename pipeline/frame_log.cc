@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "core/errors.h"
-#include "pipeline/atomic_file.h"
+#include "core/atomic_file.h"
 
 namespace handlabel {
 namespace {

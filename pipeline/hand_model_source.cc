@@ -6,7 +6,7 @@
 #include "core/errors.h"
 #include "core/hand_model_io.h"
 #include "pipeline/build_config.h"
-#include "pipeline/capsule_hand.h"
+#include "core/capsule_hand.h"
 
 namespace handlabel {
 namespace {

@@ -3,7 +3,7 @@
 //   1. the --hand-model flag: a model file (MANO pickle, .npz) or "capsule"
 //   2. the environment variable HANDLABEL_HAND_MODEL (same values)
 //   3. the shipped open hand <source>/models/open_hand_<side>.npz
-//   4. the built-in capsule hand (pipeline/capsule_hand.h), with a note saying so
+//   4. the built-in capsule hand (core/capsule_hand.h), with a note saying so
 // The left hand is the mirror of the right for the built-ins.
 
 #include <string>

@@ -13,13 +13,13 @@
 #include <sstream>
 
 #include "core/errors.h"
-#include "pipeline/atomic_file.h"
+#include "core/atomic_file.h"
 #include "pipeline/build_info.h"
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/progress.h"
-#include "pipeline/sha256.h"
+#include "core/sha256.h"
 
 namespace handlabel {
 namespace {

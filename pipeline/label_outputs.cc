@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <set>
 
-#include "pipeline/atomic_file.h"
+#include "core/atomic_file.h"
 #include "pipeline/label_record.h"
 
 namespace handlabel {

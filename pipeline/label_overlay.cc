@@ -4,7 +4,7 @@
 
 #include "core/image_file.h"
 #include "core/rasterizer.h"
-#include "pipeline/atomic_file.h"
+#include "core/atomic_file.h"
 #include "pipeline/label_outputs.h"
 
 namespace handlabel {

@@ -2,12 +2,12 @@
 
 #include "core/errors.h"
 #include "pipeline/ceres_label_fitter.h"
-#include "pipeline/dexycb_frame_source.h"
+#include "capture/dexycb_frame_source.h"
 #include "pipeline/hand_model_source.h"
-#include "pipeline/ho3d_frame_source.h"
+#include "capture/ho3d_frame_source.h"
 #include "pipeline/label_overlay.h"
-#include "pipeline/native_frame_source.h"
-#include "pipeline/oakink_frame_source.h"
+#include "capture/native_frame_source.h"
+#include "capture/oakink_frame_source.h"
 #include "pipeline/poem_mesh_predictor.h"
 
 namespace handlabel {

@@ -5,8 +5,8 @@
 #include "core/errors.h"
 #include "core/mesh_keypoints.h"
 #include "network/poem_sample_predictor.h"
-#include "pipeline/line_plot.h"
-#include "pipeline/mask_sheet.h"
+#include "core/line_plot.h"
+#include "network/mask_sheet.h"
 
 namespace handlabel {
 

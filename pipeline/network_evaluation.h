@@ -10,7 +10,7 @@
 
 #include "core/hand_model.h"
 #include "core/metrics.h"
-#include "pipeline/synth_capture.h"
+#include "capture/synth_capture.h"
 #include "pipeline/training_samples.h"
 
 namespace handlabel {
@@ -24,7 +24,7 @@ struct NetworkEvalOptions {
   double box_scale = 2.0;     // crop side / keypoint box side
   PckOptions pck;             // thresholds of the PCK curve (POEM: 0-20 mm, 20 steps)
   // With a mask head: write the first mask_png_frames frames' crops with predicted and
-  // true masks to this PNG (pipeline/mask_sheet.h); empty = none.
+  // true masks to this PNG (network/mask_sheet.h); empty = none.
   std::string mask_png;
   int mask_png_frames = 3;
   void Check() const;

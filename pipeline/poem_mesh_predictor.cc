@@ -5,7 +5,7 @@
 #include "core/errors.h"
 #include "core/image.h"
 #include "core/image_file.h"
-#include "pipeline/sha256.h"
+#include "core/sha256.h"
 
 namespace handlabel {
 

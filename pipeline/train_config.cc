@@ -9,7 +9,7 @@
 #include "core/errors.h"
 #include "core/hand_model_io.h"
 #include "pipeline/build_config.h"
-#include "pipeline/open_hand_builder.h"
+#include "openhand/builder.h"
 #include "pipeline/yaml_section.h"
 
 namespace handlabel {

@@ -9,7 +9,7 @@
 #include "core/hand_model.h"
 #include "network/poem_config.h"
 #include "network/poem_trainer.h"
-#include "pipeline/synth_capture.h"
+#include "capture/synth_capture.h"
 #include "pipeline/training_samples.h"
 
 namespace handlabel {

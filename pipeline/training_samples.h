@@ -1,6 +1,6 @@
 #pragma once
 // POEM training samples cut from synthetic captures made on the fly
-// (pipeline/synth_capture.h): per-view hand crops with their crop intrinsics, the
+// (capture/synth_capture.h): per-view hand crops with their crop intrinsics, the
 // camera -> master extrinsics, and exact targets (21 keypoints and all vertices in the
 // master frame, 2D keypoints per view in crop pixels).
 //
@@ -33,7 +33,7 @@
 
 #include "core/hand_model.h"
 #include "network/training_sample.h"
-#include "pipeline/synth_capture.h"
+#include "capture/synth_capture.h"
 
 namespace handlabel {
 

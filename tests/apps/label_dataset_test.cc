@@ -10,11 +10,11 @@
 
 #include "network/hand_mesh_predictor.h"
 #include "network/poem_config.h"
-#include "pipeline/capsule_hand.h"
+#include "core/capsule_hand.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_record.h"
 #include "tests/apps/run_command.h"
-#include "tests/pipeline/dexycb_fixture.h"
+#include "tests/capture/dexycb_fixture.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
-#include "pipeline/capsule_hand.h"
-#include "pipeline/synth_capture.h"
+#include "core/capsule_hand.h"
+#include "capture/synth_capture.h"
 
 namespace handlabel::testing {
 

@@ -5,7 +5,7 @@
 
 #include "core/hand_lbs.h"
 #include "core/hand_model_io.h"
-#include "pipeline/hand_preview.h"
+#include "core/hand_preview.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 

@@ -11,7 +11,7 @@
 
 #include "core/image_file.h"
 #include "network/poem_config.h"
-#include "pipeline/native_frame_source.h"
+#include "capture/native_frame_source.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/test_util.h"
 

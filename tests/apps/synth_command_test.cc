@@ -2,7 +2,7 @@
 
 #include <filesystem>
 
-#include "pipeline/capture_reader.h"
+#include "capture/capture_reader.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 

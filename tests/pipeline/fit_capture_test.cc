@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
-#include "pipeline/capsule_hand.h"
-#include "pipeline/synth_capture.h"
+#include "core/capsule_hand.h"
+#include "capture/synth_capture.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

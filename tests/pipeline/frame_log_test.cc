@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "core/errors.h"
-#include "pipeline/atomic_file.h"
+#include "core/atomic_file.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "core/errors.h"
-#include "pipeline/capsule_hand.h"
+#include "core/capsule_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

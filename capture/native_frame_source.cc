@@ -1,0 +1,98 @@
+#include "capture/native_frame_source.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "calib/rig_io.h"
+#include "core/errors.h"
+
+namespace handlabel {
+
+Rig ReadCamerasFile(const std::string& path, const std::string& job_file) {
+  if (!std::filesystem::exists(path)) {
+    throw InputError(job_file, "cameras.file", "an existing rig file or COLMAP folder",
+                     "'" + path + "'");
+  }
+  return ReadRig({std::filesystem::is_directory(path) ? "colmap" : "json", path});
+}
+
+NativeFrameSource::NativeFrameSource(const std::string& capture_dir,
+                                     const std::optional<Rig>& cameras)
+    : reader_(capture_dir), rig_(reader_.rig()) {
+  if (cameras) {
+    Rig reordered;
+    for (const RigCamera& camera : reader_.rig().cameras()) {
+      reordered.Add(cameras->Find(camera.name));  // InputError lists the known names
+    }
+    rig_ = reordered;
+  }
+  if (reader_.Has(kFileDetections)) {
+    keypoint_kind_ = kFileDetections;
+  } else if (reader_.Has(kFileKeypoints)) {
+    keypoint_kind_ = kFileKeypoints;
+  }
+  if (reader_.Has(kFileDetectionMask)) {
+    mask_kind_ = kFileDetectionMask;
+  } else if (reader_.Has(kFileMask)) {
+    mask_kind_ = kFileMask;
+  }
+}
+
+std::vector<std::string> NativeFrameSource::FrameIds() const {
+  std::vector<std::string> ids = reader_.manifest().frames;
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+std::string NativeFrameSource::Describe() const {
+  return "native capture " + reader_.dir() + " (" + std::to_string(rig_.size()) +
+         " cameras, " + std::to_string(reader_.num_frames()) +
+         " frames, 2D keypoints: " + (keypoint_kind_.empty() ? "none" : keypoint_kind_) +
+         ", masks: " + (mask_kind_.empty() ? "none" : mask_kind_) +
+         ", ground truth: " + (reader_.Has(kFileGroundTruth) ? "yes" : "no") + ")";
+}
+
+std::optional<HandSide> NativeFrameSource::Side() const {
+  return reader_.manifest().hand_side == "left" ? HandSide::kLeft : HandSide::kRight;
+}
+
+FrameInput NativeFrameSource::Load(const std::string& id) const {
+  const int f = reader_.FrameIndex(id);
+  if (f < 0)
+    throw InputError(reader_.dir() + "/capture.json", "frames", "frame '" + id + "'");
+  FrameInput frame;
+  frame.id = id;
+  frame.rig = rig_;
+  for (int c = 0; c < reader_.num_cameras(); ++c) {
+    frame.image_paths.push_back(reader_.Path(kFileImage, f, c));
+    if (!mask_kind_.empty()) frame.mask_paths.push_back(reader_.Path(mask_kind_, f, c));
+  }
+  if (!keypoint_kind_.empty()) {
+    const std::vector<ViewKeypoints> views = keypoint_kind_ == kFileDetections
+                                                 ? reader_.ReadDetections(f)
+                                                 : reader_.ReadKeypoints(f);
+    for (const ViewKeypoints& view : views) {
+      Keypoints2dView out;
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        const bool known = std::isfinite(view.keypoints(k, 0)) &&
+                           std::isfinite(view.keypoints(k, 1)) &&
+                           (keypoint_kind_ == kFileDetections || view.visibility[k] > 0);
+        if (known) out.uv_px.row(k) = view.keypoints.row(k);
+        out.confidence(k) = known ? view.confidence[k] : 0.0;
+      }
+      frame.keypoints_2d.push_back(out);
+    }
+  }
+  if (reader_.Has(kFileGroundTruth)) {
+    const HandGroundTruth gt = reader_.ReadGroundTruth(f);
+    FrameGroundTruth truth;
+    truth.keypoints = gt.keypoints;
+    truth.vertices = gt.vertices;
+    truth.params = gt.params;
+    frame.ground_truth = truth;
+  }
+  return frame;
+}
+
+}  // namespace handlabel

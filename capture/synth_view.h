@@ -1,0 +1,59 @@
+#pragma once
+// Renders one camera's view of a synthetic scene with exact ground truth: RGB over a
+// procedural background, the hand mask (visible hand pixels), the object label mask,
+// depth, and the 21 keypoints projected with their visibility.
+//
+// Keypoint visibility (COCO-like codes):
+//   0 kOutOfFrame  the projection falls outside the image (or behind the camera)
+//   1 kOccluded    inside the image, but an object is nearer at that pixel, or the hand
+//                  surface there is more than `self_occlusion_tolerance` in front of
+//                  the keypoint (joints lie inside the finger, so a small margin is
+//                  normal)
+//   2 kVisible     otherwise
+// View status: "visible" (some hand pixel is visible), "occluded" (the hand projects
+// into the image but no hand pixel is visible), "out_of_frame" (no hand pixel and no
+// keypoint inside the image).
+
+#include <Eigen/Core>
+#include <array>
+#include <random>
+#include <string>
+
+#include "core/image.h"
+#include "core/rasterizer.h"
+#include "core/rig.h"
+#include "capture/synth_background.h"
+#include "capture/synth_scene.h"
+
+namespace handlabel {
+
+enum KeypointVisibility : int { kOutOfFrame = 0, kOccluded = 1, kVisible = 2 };
+
+struct SynthViewOptions {
+  BackgroundOptions background;
+  // Metres the hand surface may lie in front of a keypoint before it counts as
+  // self-occluded (> 0).
+  double self_occlusion_tolerance = 0.025;
+  // Whether to keep the depth image in the result.
+  bool depth = true;
+  void Check() const;
+};
+
+struct SynthView {
+  ImageU8 rgb;          // 3 channels
+  ImageU8 hand_mask;    // 255 = visible hand pixel
+  ImageU8 object_mask;  // 0 = none, k = scene.objects[k - 1]
+  ImageF depth;         // camera z in metres, 0 where nothing was drawn (if requested)
+  Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor> keypoints;  // pixels
+  std::array<int, kNumHandKeypoints> visibility{};
+  int hand_pixels = 0;             // visible hand pixels
+  int hand_pixels_unoccluded = 0;  // hand pixels if there were no objects
+  std::string status;              // "visible", "occluded" or "out_of_frame"
+};
+
+// `rays` must belong to `camera.camera`. The background is drawn from `background_rng`.
+SynthView RenderSynthView(const SynthScene& scene, const RigCamera& camera,
+                          const PixelRays& rays, const SynthViewOptions& options,
+                          std::mt19937_64& background_rng);
+
+}  // namespace handlabel

@@ -1,0 +1,165 @@
+#include "capture/synth_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "core/capsule_hand.h"
+#include "capture/rig_presets.h"
+#include "capture/synth_detections.h"
+#include "capture/synth_view.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+using testing::TestRng;
+
+struct SceneFixture {
+  HandModel model = MakeCapsuleHand(HandSide::kRight);
+  HandAnatomy anatomy = ComputeHandAnatomy(model);
+  HandLimits limits = DefaultHandLimits();
+  Rig rig = MakePresetRig(RigPresetOptions(), 0);
+};
+
+TEST(SynthScene, PosesStayWithinTheLimitsAndEveryKindOccurs) {
+  SceneFixture s;
+  SynthSceneOptions o;
+  std::map<std::string, int> kinds;
+  for (int i = 0; i < 120; ++i) {
+    const SynthScene scene =
+        SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, TestRng());
+    ++kinds[scene.pose_kind];
+    HandPoseVector angles;
+    HandAnatomicalAngles(s.anatomy, scene.params.hand_pose.data(), angles.data());
+    EXPECT_LT(MaxLimitViolationDeg(s.limits, angles), 0.5) << scene.pose_kind;
+    EXPECT_LE(scene.params.betas.cwiseAbs().maxCoeff(), 2.5);
+  }
+  for (const std::string& k : SynthPoseKindNames()) EXPECT_GT(kinds[k], 0) << k;
+}
+
+TEST(SynthScene, MostCamerasSeeTheWholeHand) {
+  SceneFixture s;
+  SynthSceneOptions o;
+  int total = 0;
+  const int n = 30;
+  for (int i = 0; i < n; ++i) {
+    const SynthScene scene =
+        SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, TestRng());
+    total += scene.cameras_seeing_hand;
+    // cameras_seeing_hand is what the posed keypoints say.
+    int seen = 0;
+    for (const RigCamera& cam : s.rig.cameras()) {
+      bool all = true;
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        Eigen::Vector2d uv;
+        all = all && cam.ProjectWorld(scene.hand.keypoints.row(k).transpose(), &uv) &&
+              cam.camera.InImage(uv, 2.0);
+      }
+      seen += all;
+    }
+    EXPECT_EQ(seen, scene.cameras_seeing_hand);
+  }
+  EXPECT_GT(static_cast<double>(total) / n, 7.0) << "of 8 DexYCB-like cameras";
+}
+
+TEST(SynthScene, ObjectsAreHeldNearTheHand) {
+  SceneFixture s;
+  SynthSceneOptions o;
+  o.objects = true;
+  o.max_objects = 3;
+  for (int i = 0; i < 20; ++i) {
+    const SynthScene scene =
+        SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, TestRng());
+    ASSERT_GE(scene.objects.size(), 1u);
+    ASSERT_LE(scene.objects.size(), 3u);
+    const Eigen::Vector3d palm = scene.hand.keypoints.row(9).transpose();
+    for (const SynthObject& obj : scene.objects) {
+      EXPECT_LT((obj.world_from_object.translation - palm).norm(), 0.25) << obj.kind;
+    }
+  }
+}
+
+TEST(SynthView, OccludedAndOutOfFrameKeypointsAreMarked) {
+  SceneFixture s;
+  SynthSceneOptions o;
+  o.objects = true;
+  SynthViewOptions vo;
+  vo.background.clutter = false;
+  int occluded = 0, visible = 0;
+  for (int i = 0; i < 10; ++i) {
+    const SynthScene scene =
+        SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, TestRng());
+    const PixelRays rays(s.rig[0].camera);
+    std::mt19937_64 bg(1);
+    const SynthView view = RenderSynthView(scene, s.rig[0], rays, vo, bg);
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      occluded += view.visibility[k] == kOccluded;
+      visible += view.visibility[k] == kVisible;
+    }
+    EXPECT_LE(view.hand_pixels, view.hand_pixels_unoccluded);
+  }
+  EXPECT_GT(occluded, 5);
+  EXPECT_GT(visible, 50);
+
+  // A hand far outside every view is out of frame.
+  SynthScene scene = SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, TestRng());
+  for (Eigen::Index r = 0; r < scene.hand.keypoints.rows(); ++r)
+    scene.hand.keypoints(r, 2) += 50;
+  scene.hand_render.vertices.col(2).array() += 50;
+  scene.objects.clear();
+  const PixelRays rays(s.rig[0].camera);
+  std::mt19937_64 bg(1);
+  const SynthView view = RenderSynthView(scene, s.rig[0], rays, vo, bg);
+  EXPECT_EQ(view.status, "out_of_frame");
+  EXPECT_EQ(view.hand_pixels, 0);
+  for (int v : view.visibility) EXPECT_EQ(v, kOutOfFrame);
+}
+
+TEST(SynthDetections, NoiseFreeDetectionsEqualTheGroundTruthAndNoiseHasItsSigma) {
+  SceneFixture s;
+  SynthViewOptions vo;
+  vo.background.clutter = false;
+  const SynthScene scene = SampleSynthScene(s.model, s.anatomy, s.limits, s.rig,
+                                            SynthSceneOptions(), TestRng());
+  const PixelRays rays(s.rig[0].camera);
+  std::mt19937_64 bg(1);
+  const SynthView view = RenderSynthView(scene, s.rig[0], rays, vo, bg);
+  DetectionNoiseOptions exact;
+  exact.keypoint_sigma_px = 0;
+  exact.outlier_rate = exact.dropout_rate = exact.occluded_dropout_rate = 0;
+  exact.mask_morph_radius = exact.mask_blobs = 0;
+  const ViewDetections clean = SimulateDetections(view, exact, TestRng());
+  EXPECT_EQ(clean.mask.data, view.hand_mask.data);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (view.visibility[k] == kOutOfFrame) continue;
+    EXPECT_EQ(clean.keypoints(k, 0), view.keypoints(k, 0));
+    EXPECT_GT(clean.confidence[k], 0.19);
+  }
+  // Noise: the spread of visible-keypoint errors is sigma.
+  DetectionNoiseOptions noisy = exact;
+  noisy.keypoint_sigma_px = 3.0;
+  double sum2 = 0;
+  int n = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const ViewDetections d = SimulateDetections(view, noisy, TestRng());
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (view.visibility[k] != kVisible) continue;
+      sum2 += (d.keypoints.row(k) - view.keypoints.row(k)).squaredNorm() / 2;
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 500);
+  EXPECT_NEAR(std::sqrt(sum2 / n), 3.0, 0.2);
+  // Dropouts: everything missing at rate 1.
+  DetectionNoiseOptions drop = exact;
+  drop.dropout_rate = drop.occluded_dropout_rate = 1.0;
+  const ViewDetections none = SimulateDetections(view, drop, TestRng());
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    EXPECT_EQ(none.confidence[k], 0.0);
+    EXPECT_TRUE(std::isnan(none.keypoints(k, 0)));
+  }
+}
+
+}  // namespace
+}  // namespace handlabel
