@@ -61,7 +61,7 @@ int RunFit(int argc, char** argv) {
   app.add_flag("--fixed-shape", fixed_shape, "keep betas at their initial values");
   app.add_option("--hand-model", hand_model,
                  "model file or 'capsule'; default: $HANDLABEL_HAND_MODEL, then "
-                 "models/open_hand_<side>.npz, then the built-in capsule hand");
+                 "<data dir>/models/open_hand_<side>.npz, then the open hand built in memory");
   app.add_option("--overlay", o.overlay_png,
                  "also write a PNG of the first fitted frame: every view with the fitted "
                  "silhouette, keypoints and the 2D evidence");

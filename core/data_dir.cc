@@ -11,7 +11,8 @@ std::string DataDir() {
   // /proc/self/exe names the executable with symlinks resolved, so a link to an
   // installed binary (e.g. from /usr/local/bin) still finds the install's data.
   std::error_code error;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  const std::filesystem::path exe =
+      std::filesystem::read_symlink("/proc/self/exe", error);
   if (error) return "";
   return (exe.parent_path() / ".." / "share" / "handlabel").lexically_normal().string();
 }

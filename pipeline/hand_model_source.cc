@@ -12,16 +12,14 @@
 namespace handlabel {
 namespace {
 
-const char* SideName(HandSide side) {
-  return side == HandSide::kLeft ? "left" : "right";
-}
+const char* SideName(HandSide side) { return side == HandSide::kLeft ? "left" : "right"; }
 
 // A file given by flag, field or variable, checked against the side asked for.
 ResolvedHandModel FromFile(const std::string& path, std::optional<HandSide> side,
                            const HandModelOrigin& origin) {
   if (!std::filesystem::exists(path)) {
-    throw InputError(origin.source, origin.field,
-                     "an existing model file or \"capsule\"", path);
+    throw InputError(origin.source, origin.field, "an existing model file or \"capsule\"",
+                     path);
   }
   // The file's own side (own format, or MANO_LEFT / MANO_RIGHT in the name) wins; a
   // file that records no side is taken as the side asked for.
@@ -59,7 +57,8 @@ ResolvedHandModel BuildDefaultOpenHand(HandSide side, const std::string& shipped
   ResolvedHandModel out;
   out.model = BuildOpenHand(DefaultOpenHandDesign(), options);
   out.source = std::string("builtin:open_hand_") + SideName(side) + " (built in memory)";
-  out.note = "no hand model file given and " + (shipped.empty() ? "no data folder" : shipped) +
+  out.note = "no hand model file given and " +
+             (shipped.empty() ? "no data folder" : shipped) +
              " not found (set HANDLABEL_DATA_DIR): built the open hand in memory";
   return out;
 }

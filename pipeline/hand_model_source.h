@@ -6,8 +6,8 @@
 //      capsule hand, core/capsule_hand.h)
 //   2. the environment variable HANDLABEL_HAND_MODEL (same values)
 //   3. the shipped open hand <data dir>/models/open_hand_<side>.npz (core/data_dir.h)
-//   4. the open hand built in memory from its default design (the same model as the
-//      shipped file, bit for bit; takes about half a minute), with a note saying so
+//   4. the open hand built in memory from its default design and options (what the
+//      shipped file holds; about 6 s), with a note saying so
 // The left hand is the mirror of the right for the shipped and built-in models.
 
 #include <optional>

@@ -184,8 +184,8 @@ TrainConfig LoadTrainConfig(const std::string& path) {
 
 HandModel LoadTrainingHandModel(const TrainConfig& config, std::string* source) {
   // No side asked for: a given file trains with its own side.
-  ResolvedHandModel r =
-      ResolveHandModel(config.hand_model, std::nullopt, {config.source_file, "hand_model"});
+  ResolvedHandModel r = ResolveHandModel(config.hand_model, std::nullopt,
+                                         {config.source_file, "hand_model"});
   *source = r.source;
   return std::move(r.model);
 }

@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <string>
 
+#include "capture/synth_capture.h"
 #include "core/hand_model.h"
 #include "network/poem_config.h"
 #include "network/poem_trainer.h"
-#include "capture/synth_capture.h"
 #include "pipeline/training_samples.h"
 
 namespace handlabel {
@@ -37,7 +37,7 @@ TrainConfig LoadTrainConfig(const std::string& path);
 // The hand model of a config, chosen by ResolveHandModel (pipeline/hand_model_source.h):
 // `hand_model` if set (a file trains with its own side), else $HANDLABEL_HAND_MODEL,
 // else the shipped models/open_hand_right.npz of the data folder, else the open hand
-// built in memory from its default design (the same model, bit for bit). `source`
+// built in memory from its default design (what the shipped file holds). `source`
 // receives where it came from.
 HandModel LoadTrainingHandModel(const TrainConfig& config, std::string* source);
 
