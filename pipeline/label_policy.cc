@@ -52,6 +52,14 @@ std::vector<std::optional<Keypoints2dView>> FitEvidence(
       if (!evidence[v]) evidence[v] = prediction->keypoints_2d[v];
     }
   }
+  for (const std::string& name : job.ignore_views) {
+    const int v = frame.rig.IndexOf(name);
+    if (v < 0) {
+      throw InputError(job.source_file, "evidence.ignore_views",
+                       "camera names of the capture", "'" + name + "'");
+    }
+    evidence[v].reset();
+  }
   for (const auto& view : evidence) {
     if (view) return evidence;
   }
@@ -66,7 +74,8 @@ std::vector<std::optional<Keypoints2dView>> FitEvidence(
 }
 
 FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
-                        const MeshPrediction* prediction, uint64_t seed) {
+                        const MeshPrediction* prediction, uint64_t seed,
+                        const HandParams* previous) {
   const JobConfig& job = *context.job;
   FrameOutcome outcome;
   LabelRecord& label = outcome.label;
@@ -89,6 +98,7 @@ FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
     request.keypoints_2d = FitEvidence(job, frame, prediction);
     if (job.masks == MaskSource::kNetwork && prediction)
       request.masks = prediction->masks;
+    request.previous = previous;
     request.seed = seed;
     return context.fitter->Fit(request);
   };
