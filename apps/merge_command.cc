@@ -2,11 +2,11 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "core/sha256.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_stage_factory.h"
-#include "core/sha256.h"
 
 namespace handlabel {
 

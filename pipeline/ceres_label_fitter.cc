@@ -133,8 +133,8 @@ HandFitInput CeresLabelFitter::Evidence(const LabelFitRequest& request,
     *silhouettes = "files";
     for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
       if (!request.keypoints_2d[v]) continue;
-      input.masks.push_back(frame.mask_paths[v].empty() ? MaskImage()
-                                                         : ReadMaskPng(frame.mask_paths[v]));
+      input.masks.push_back(
+          frame.mask_paths[v].empty() ? MaskImage() : ReadMaskPng(frame.mask_paths[v]));
     }
   }
   return input;

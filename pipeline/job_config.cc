@@ -33,7 +33,8 @@ std::string Resolve(const std::string& path, const fs::path& base) {
 // Fields that are absent stay unset (the fitter's default).
 template <typename T>
 void ReadOptional(Section& section, const char* key, std::optional<T>* value) {
-  if (!section.Raw(key)) return;
+  const YAML::Node node = section.Raw(key);
+  if (!node || node.IsNull()) return;
   T read{};
   section.Read(key, &read);
   *value = read;
@@ -45,9 +46,10 @@ bool IsFitInitKeyword(const std::string& init) {
 
 void CheckFitSettings(const FitSettings& fit, const std::string& f) {
   if (!IsFitInitKeyword(fit.init) && !fs::is_directory(fit.init)) {
-    throw InputError(f, "fit.init",
-                     "triangulate | gt | previous | a folder of per-frame parameter files",
-                     "'" + fit.init + "'");
+    throw InputError(
+        f, "fit.init",
+        "triangulate | gt | previous | a folder of per-frame parameter files",
+        "'" + fit.init + "'");
   }
   if (fit.keypoint_loss && *fit.keypoint_loss != "cauchy" &&
       *fit.keypoint_loss != "huber" && *fit.keypoint_loss != "trivial") {
@@ -120,10 +122,10 @@ void ReadRefineSection(Section& top, const std::string& path, JobConfig* job) {
   std::string mode = "fallback";
   refine.Read("mode", &mode);
   job->refine_mode = ParseEnum<RefineMode>(mode,
-                                          {{"off", RefineMode::kOff},
-                                           {"always", RefineMode::kAlways},
-                                           {"fallback", RefineMode::kFallback}},
-                                          path, refine.Name("mode"));
+                                           {{"off", RefineMode::kOff},
+                                            {"always", RefineMode::kAlways},
+                                            {"fallback", RefineMode::kFallback}},
+                                           path, refine.Name("mode"));
   refine.Read("max_reprojection_px", &job->quality.max_reprojection_px);
   refine.Read("max_view_disagreement_mm", &job->quality.max_view_disagreement_mm);
   refine.Read("min_confidence", &job->quality.min_confidence);
@@ -148,15 +150,15 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
                      std::to_string(job->network_mask_sigma_px));
   }
   job->keypoints = ParseEnum<KeypointSource>(keypoints,
-                                            {{"network", KeypointSource::kNetwork},
-                                             {"files", KeypointSource::kFiles},
-                                             {"both", KeypointSource::kBoth}},
-                                            path, evidence.Name("keypoints_2d"));
+                                             {{"network", KeypointSource::kNetwork},
+                                              {"files", KeypointSource::kFiles},
+                                              {"both", KeypointSource::kBoth}},
+                                             path, evidence.Name("keypoints_2d"));
   job->masks = ParseEnum<MaskSource>(masks,
-                                    {{"none", MaskSource::kNone},
-                                     {"files", MaskSource::kFiles},
-                                     {"network", MaskSource::kNetwork}},
-                                    path, evidence.Name("masks"));
+                                     {{"none", MaskSource::kNone},
+                                      {"files", MaskSource::kFiles},
+                                      {"network", MaskSource::kNetwork}},
+                                     path, evidence.Name("masks"));
   if (job->network_mask_sigma_px == 0) {
     job->network_mask_sigma_px = job->keypoints == KeypointSource::kNetwork ? 2.0 : 16.0;
   }

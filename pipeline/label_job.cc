@@ -13,14 +13,14 @@
 #include <set>
 #include <sstream>
 
-#include "core/errors.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/sha256.h"
 #include "pipeline/build_info.h"
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/progress.h"
-#include "core/sha256.h"
 
 namespace handlabel {
 namespace {
@@ -99,7 +99,7 @@ nlohmann::json FitSettingsJson(const FitSettings& f) {
 
 std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   const QualityThresholds& q = job.quality;
-  const nlohmann::json j = {
+  nlohmann::json j = {
       {"label_format", kLabelFormatVersion},
       {"input", {job.input_format, job.input_path, job.frames}},
       {"cameras", {job.cameras_source, job.cameras_file}},
@@ -268,9 +268,9 @@ class LabelJobRun {
     if (!options_.log) return;
     *options_.log << "label: job '" << job_.name << "', shard "
                   << options_.shard.ToString() << ": " << mine_.size() << " of "
-                  << all_frames_.size() << " frames, " << done_before_
-                  << " done before, " << todo_.size() << " to label; "
-                  << (in_order_ ? 1 : threads_) << " thread(s)"
+                  << all_frames_.size() << " frames, " << done_before_ << " done before, "
+                  << todo_.size() << " to label; " << (in_order_ ? 1 : threads_)
+                  << " thread(s)"
                   << (in_order_ ? " (fit.init previous: frames in order)" : "")
                   << "\n  input: " << stages_.source->Describe() << "\n  network: "
                   << (stages_.predictor ? stages_.predictor->ModelName()
@@ -389,13 +389,14 @@ class LabelJobRun {
     const MeshPrediction* prediction =
         batch.predictions[i] ? &*batch.predictions[i] : nullptr;
     const std::optional<HandParams> previous = PreviousParams(frame.id);
-    FrameOutcome outcome = LabelFrame(context_, frame, prediction,
-                                      FrameSeed(job_.seed, frame.id),
-                                      previous ? &*previous : nullptr);
+    FrameOutcome outcome =
+        LabelFrame(context_, frame, prediction, FrameSeed(job_.seed, frame.id),
+                   previous ? &*previous : nullptr);
     if (!batch.network_errors[i].empty()) {
       outcome.label.fit["why"] = batch.network_errors[i];
     }
-    if (stages_.overlays && job_.overlays) stages_.overlays->Write(out_, frame, outcome.label);
+    if (stages_.overlays && job_.overlays)
+      stages_.overlays->Write(out_, frame, outcome.label);
     WriteLabelFiles(out_, outcome.label, stages_.faces, job_.meshes);
     record->status = "ok";
     record->path = ToString(outcome.label.path);
@@ -411,13 +412,12 @@ class LabelJobRun {
     arena.execute([&] {
       tbb::parallel_pipeline(
           static_cast<size_t>(2 * threads_),
-          tbb::make_filter<void, BatchPtr>(
-              tbb::filter_mode::serial_in_order,
-              [&](tbb::flow_control& control) {
-                BatchPtr batch = NextBatch(batch_size);
-                if (!batch) control.stop();
-                return batch;
-              }) &
+          tbb::make_filter<void, BatchPtr>(tbb::filter_mode::serial_in_order,
+                                           [&](tbb::flow_control& control) {
+                                             BatchPtr batch = NextBatch(batch_size);
+                                             if (!batch) control.stop();
+                                             return batch;
+                                           }) &
               tbb::make_filter<BatchPtr, BatchPtr>(
                   tbb::filter_mode::parallel,
                   [&](BatchPtr batch) {

@@ -1,13 +1,13 @@
 #include "pipeline/label_stage_factory.h"
 
-#include "core/errors.h"
-#include "pipeline/ceres_label_fitter.h"
 #include "capture/dexycb_frame_source.h"
-#include "pipeline/hand_model_source.h"
 #include "capture/ho3d_frame_source.h"
-#include "pipeline/label_overlay.h"
 #include "capture/native_frame_source.h"
 #include "capture/oakink_frame_source.h"
+#include "core/errors.h"
+#include "pipeline/ceres_label_fitter.h"
+#include "pipeline/hand_model_source.h"
+#include "pipeline/label_overlay.h"
 #include "pipeline/poem_mesh_predictor.h"
 
 namespace handlabel {
@@ -89,8 +89,8 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
                          : "network, but no network.weights");
   }
   if (job.refine_mode != RefineMode::kOff || job.baseline) {
-    built.fitter = std::make_unique<CeresLabelFitter>(built.hand_model,
-                                                      FitterOptions(job));
+    built.fitter =
+        std::make_unique<CeresLabelFitter>(built.hand_model, FitterOptions(job));
   }
   if (job.overlays)
     built.overlays = std::make_unique<RasterOverlayWriter>(built.hand_model);
