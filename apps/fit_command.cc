@@ -40,6 +40,91 @@ void PrintSummary(const FitCaptureSummary& s) {
             << " deg\nsummary: " << s.summary_path << "\n";
 }
 
+// The command's flags; fitter settings start at the fitter's defaults (for --help).
+struct FitFlags {
+  FitCaptureOptions options;
+  std::string frames, ignore, loss = "cauchy";
+  double loss_scale = HandFitOptions().keypoint_loss.scale;
+  double keypoint_sigma = HandFitOptions().keypoint_sigma_px;
+  double silhouette_sigma = HandFitOptions().silhouette_sigma_px;
+  int silhouette_rounds = HandFitOptions().silhouette_rounds;
+  int pca = HandFitConfig().pose_pca_comps;
+  bool no_silhouettes = false, no_limits = false, fixed_shape = false;
+};
+
+void AddEvidenceFlags(CLI::App& app, FitFlags* f) {
+  FitCaptureOptions& o = f->options;
+  app.add_option("--capture", o.capture_dir, "capture folder (native layout)")
+      ->required();
+  app.add_option("--out", o.out_dir, "output folder (created)")->required();
+  app.add_option("--frames", f->frames, "comma-separated frame ids (default: all)");
+  app.add_option("--ignore-views", f->ignore,
+                 "comma-separated camera names whose keypoints and masks are ignored");
+  app.add_option("--max-frames", o.max_frames, "fit only the first N chosen frames")
+      ->capture_default_str();
+  app.add_option("--init", o.fit.init,
+                 "triangulate | gt | previous | FOLDER of <frame>.json parameter files "
+                 "(or a job's labels)")
+      ->capture_default_str();
+  app.add_option("--evidence", o.evidence,
+                 "2D keypoints: auto | detections | keypoints (exact projections)")
+      ->capture_default_str();
+  app.add_option("--masks", o.masks, "masks: auto | detections | truth | none")
+      ->capture_default_str();
+  app.add_flag("--no-silhouettes", f->no_silhouettes, "ignore masks (as --masks none)");
+}
+
+void AddFitterFlags(CLI::App& app, FitFlags* f) {
+  app.add_option("--loss", f->loss, "robust keypoint loss: cauchy | huber | trivial")
+      ->capture_default_str();
+  app.add_option("--loss-scale", f->loss_scale,
+                 "robust loss scale, in units of --keypoint-sigma")
+      ->capture_default_str();
+  app.add_option("--keypoint-sigma", f->keypoint_sigma, "keypoint error scale in pixels")
+      ->capture_default_str();
+  app.add_option("--silhouette-sigma", f->silhouette_sigma,
+                 "silhouette error scale in pixels")
+      ->capture_default_str();
+  app.add_option("--silhouette-rounds", f->silhouette_rounds,
+                 "outline re-matching rounds with silhouettes (0 = keypoints only)")
+      ->capture_default_str();
+  app.add_option("--pca", f->pca,
+                 "pose as PCA coefficients: 0 (45 axis-angle values), 12 or 45")
+      ->capture_default_str();
+  app.add_flag("--no-limits", f->no_limits, "no anatomical joint limits");
+  app.add_flag("--fixed-shape", f->fixed_shape, "keep betas at their initial values");
+}
+
+void AddRunFlags(CLI::App& app, FitFlags* f) {
+  FitCaptureOptions& o = f->options;
+  app.add_option("--hand-model", o.hand_model,
+                 "model file or 'capsule'; default: $HANDLABEL_HAND_MODEL, then "
+                 "models/open_hand_<side>.npz, then the built-in capsule hand");
+  app.add_flag("--overlay", o.overlays,
+               "also write the label job's overlay pictures: every view of every frame "
+               "with the fitted mesh and keypoints, <out>/overlays/<frame>/<camera>.png");
+  app.add_option("--threads", o.num_threads, "frames in parallel, 0 = all cores")
+      ->capture_default_str();
+}
+
+// The parsed flags as options; fitter flags that were not given stay unset.
+FitCaptureOptions ToOptions(const CLI::App& app, const FitFlags& f) {
+  FitCaptureOptions o = f.options;
+  o.frames = SplitCommas(f.frames);
+  o.ignore_views = SplitCommas(f.ignore);
+  RobustLossFromName(f.loss, "--loss");  // names the flag when the loss is unknown
+  SetIfGiven(app, "--loss", f.loss, &o.fit.keypoint_loss);
+  SetIfGiven(app, "--loss-scale", f.loss_scale, &o.fit.keypoint_loss_scale);
+  SetIfGiven(app, "--keypoint-sigma", f.keypoint_sigma, &o.fit.keypoint_sigma_px);
+  SetIfGiven(app, "--silhouette-sigma", f.silhouette_sigma, &o.fit.silhouette_sigma_px);
+  SetIfGiven(app, "--silhouette-rounds", f.silhouette_rounds, &o.fit.silhouette_rounds);
+  SetIfGiven(app, "--pca", f.pca, &o.fit.pose_pca_comps);
+  if (f.no_limits) o.fit.joint_limits = false;
+  if (f.fixed_shape) o.fit.optimise_shape = false;
+  if (f.no_silhouettes) o.masks = "none";
+  return o;
+}
+
 }  // namespace
 
 int RunFit(int argc, char** argv) {
@@ -53,75 +138,13 @@ int RunFit(int argc, char** argv) {
       "Example: handlabel fit --capture captures/dexycb_synth --max-frames 50 "
       "--out fits/dexycb",
       "fit");
-  FitCaptureOptions o;
-  const HandFitOptions fit_defaults;
-  const HandFitConfig config_defaults;
-  std::string frames, ignore, loss = "cauchy";
-  double loss_scale = fit_defaults.keypoint_loss.scale;
-  double keypoint_sigma = fit_defaults.keypoint_sigma_px;
-  double silhouette_sigma = fit_defaults.silhouette_sigma_px;
-  int silhouette_rounds = fit_defaults.silhouette_rounds;
-  int pca = config_defaults.pose_pca_comps;
-  bool no_silhouettes = false, no_limits = false, fixed_shape = false;
-  app.add_option("--capture", o.capture_dir, "capture folder (native layout)")
-      ->required();
-  app.add_option("--out", o.out_dir, "output folder (created)")->required();
-  app.add_option("--frames", frames, "comma-separated frame ids (default: all)");
-  app.add_option("--ignore-views", ignore,
-                 "comma-separated camera names whose keypoints and masks are ignored");
-  app.add_option("--max-frames", o.max_frames, "fit only the first N chosen frames")
-      ->capture_default_str();
-  app.add_option("--init", o.fit.init,
-                 "triangulate | gt | previous | FOLDER of <frame>.json parameter files "
-                 "(or a job's labels)")
-      ->capture_default_str();
-  app.add_option("--evidence", o.evidence,
-                 "2D keypoints: auto | detections | keypoints (exact projections)")
-      ->capture_default_str();
-  app.add_option("--masks", o.masks, "masks: auto | detections | truth | none")
-      ->capture_default_str();
-  app.add_option("--loss", loss, "robust keypoint loss: cauchy | huber | trivial")
-      ->capture_default_str();
-  app.add_option("--loss-scale", loss_scale,
-                 "robust loss scale, in units of --keypoint-sigma")
-      ->capture_default_str();
-  app.add_option("--keypoint-sigma", keypoint_sigma, "keypoint error scale in pixels")
-      ->capture_default_str();
-  app.add_option("--silhouette-sigma", silhouette_sigma,
-                 "silhouette error scale in pixels")
-      ->capture_default_str();
-  app.add_option("--silhouette-rounds", silhouette_rounds,
-                 "outline re-matching rounds with silhouettes (0 = keypoints only)")
-      ->capture_default_str();
-  app.add_option("--pca", pca,
-                 "pose as PCA coefficients: 0 (45 axis-angle values), 12 or 45")
-      ->capture_default_str();
-  app.add_flag("--no-silhouettes", no_silhouettes, "ignore masks (as --masks none)");
-  app.add_flag("--no-limits", no_limits, "no anatomical joint limits");
-  app.add_flag("--fixed-shape", fixed_shape, "keep betas at their initial values");
-  app.add_option("--hand-model", o.hand_model,
-                 "model file or 'capsule'; default: $HANDLABEL_HAND_MODEL, then "
-                 "models/open_hand_<side>.npz, then the built-in capsule hand");
-  app.add_flag("--overlay", o.overlays,
-               "also write the label job's overlay pictures: every view of every frame "
-               "with the fitted mesh and keypoints, <out>/overlays/<frame>/<camera>.png");
-  app.add_option("--threads", o.num_threads, "frames in parallel, 0 = all cores")
-      ->capture_default_str();
+  FitFlags flags;
+  AddEvidenceFlags(app, &flags);
+  AddFitterFlags(app, &flags);
+  AddRunFlags(app, &flags);
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("fit", [&] {
-    o.frames = SplitCommas(frames);
-    o.ignore_views = SplitCommas(ignore);
-    RobustLossFromName(loss, "--loss");  // names the flag when the loss is unknown
-    SetIfGiven(app, "--loss", loss, &o.fit.keypoint_loss);
-    SetIfGiven(app, "--loss-scale", loss_scale, &o.fit.keypoint_loss_scale);
-    SetIfGiven(app, "--keypoint-sigma", keypoint_sigma, &o.fit.keypoint_sigma_px);
-    SetIfGiven(app, "--silhouette-sigma", silhouette_sigma, &o.fit.silhouette_sigma_px);
-    SetIfGiven(app, "--silhouette-rounds", silhouette_rounds, &o.fit.silhouette_rounds);
-    SetIfGiven(app, "--pca", pca, &o.fit.pose_pca_comps);
-    if (no_limits) o.fit.joint_limits = false;
-    if (fixed_shape) o.fit.optimise_shape = false;
-    if (no_silhouettes) o.masks = "none";
-    const FitCaptureSummary s = FitCapture(o, &std::cerr);
+    const FitCaptureSummary s = FitCapture(ToOptions(app, flags), &std::cerr);
     PrintSummary(s);
     return s.job.failed > 0 && s.job.ok == 0 ? 1 : 0;
   });

@@ -57,6 +57,25 @@ TEST(FitCaptureTest, ExactKeypointsRecoverGroundTruth) {
   EXPECT_EQ(ReadLabelFile(LabelFilePath(again.out_dir, "000001")).fit.at("init"), "file");
 }
 
+// --init previous: frames run in order, each fit starting from the previous label.
+TEST(FitCaptureTest, PreviousStartsFromThePreviousLabel) {
+  const std::string scratch = testing::ScratchDir();
+  FitCaptureOptions o;
+  o.capture_dir = SmallCapture(scratch, 3);
+  o.out_dir = scratch + "/fit";
+  o.evidence = "keypoints";
+  o.masks = "none";
+  o.hand_model = "capsule";
+  o.fit.init = "previous";
+  const FitCaptureSummary s = FitCapture(o);
+  EXPECT_EQ(s.job.ok, 3);
+  EXPECT_LT(s.mpjpe, 0.003);  // the temporal pull costs a little against exact keypoints
+  EXPECT_EQ(ReadLabelFile(LabelFilePath(o.out_dir, "000000")).fit.at("init"),
+            "triangulated_views");
+  EXPECT_EQ(ReadLabelFile(LabelFilePath(o.out_dir, "000002")).fit.at("init"),
+            "previous_label");
+}
+
 TEST(FitCaptureTest, BadOptionsNameTheFlag) {
   FitCaptureOptions o;
   o.capture_dir = "x";
