@@ -1,7 +1,10 @@
 #pragma once
 // The labeling runner: for the frames of one shard, read -> batched network
 // inference -> quality checks -> refine or fallback fit (label_policy.h) -> atomic
-// writes (label_record.h), with TBB over frames.
+// writes (label_record.h), with TBB over frames (four pipeline stages: hand out
+// batches, read, network, label and write). With fit.init previous the same steps run
+// one frame at a time in the job's frame order. `handlabel fit` is this runner on a
+// job without a network (fit_capture.h).
 //
 //  - Resume: a frame is finished once its files are renamed into place and its record
 //    appended to the shard log (frame_log.h). A re-run with resume skips finished
