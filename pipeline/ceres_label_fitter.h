@@ -15,8 +15,12 @@
 // network), or when use_masks is set and the frame has mask files (read with the one
 // mask rule of core/mask_image.h).
 
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/hand_model.h"
 #include "fitting/ceres_hand_fitter.h"
@@ -53,10 +57,20 @@ class CeresLabelFitter : public LabelFitter {
   HandParams Start(const LabelFitRequest& request, const CeresHandFitter& fitter,
                    HandFitInput* input, std::string* start) const;
 
+  // Pixel rays of the views' cameras, for the IoU of fits with silhouettes; computed
+  // once per set of cameras (a capture's rig) for up to kMaxRigs sets, then per fit.
+  std::shared_ptr<const std::vector<PixelRays>> Rays(
+      const std::vector<KeypointView>& views) const;
+  static constexpr size_t kMaxRigs = 4;
+
   CeresHandFitter fitter_;
   std::optional<CeresHandFitter> network_mask_fitter_;
   int num_vertices_;
   CeresLabelFitterOptions options_;
+  mutable std::mutex rays_mutex_;
+  // Cameras' model, size and parameters -> their rays.
+  mutable std::map<std::vector<double>, std::shared_ptr<const std::vector<PixelRays>>>
+      rays_;
 };
 
 }  // namespace handlabel
