@@ -238,7 +238,7 @@ FrameInput DexYcbFrameSource::Load(const std::string& id) const {
         FindArray(arrays, "joint_2d", {1, kNumHandKeypoints, 2}, file).ToDoubles();
     const std::vector<double> xyz =
         FindArray(arrays, "joint_3d", {1, kNumHandKeypoints, 3}, file).ToDoubles();
-    std::optional<Keypoints2dView> view;
+    std::optional<Keypoints2d> view;
     if (HasHand(uv)) {
       view.emplace();
       for (int k = 0; k < kNumHandKeypoints; ++k) {

@@ -94,12 +94,12 @@ KeypointView ToKeypointView(const ViewKeypoints& v, const RigCamera& camera,
   KeypointView out;
   out.camera = camera;
   for (int k = 0; k < kNumHandKeypoints; ++k) {
-    const double u = v.keypoints(k, 0), w = v.keypoints(k, 1);
+    const double u = v.keypoints.uv_px(k, 0), w = v.keypoints.uv_px(k, 1);
     const bool finite = std::isfinite(u) && std::isfinite(w);
-    out.uv_px(k, 0) = finite ? u : 0.0;
-    out.uv_px(k, 1) = finite ? w : 0.0;
-    const double confidence = exact_projections ? 1.0 : v.confidence[k];
-    out.confidence[k] = finite ? std::max(0.0, confidence) : 0.0;
+    out.keypoints.uv_px(k, 0) = finite ? u : 0.0;
+    out.keypoints.uv_px(k, 1) = finite ? w : 0.0;
+    const double confidence = exact_projections ? 1.0 : v.keypoints.confidence[k];
+    out.keypoints.confidence[k] = finite ? std::max(0.0, confidence) : 0.0;
   }
   return out;
 }

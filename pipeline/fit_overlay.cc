@@ -79,8 +79,8 @@ ImageU8 MakeFitOverlay(const std::vector<ImageU8>& images,
       return Eigen::Vector2d((uv - origin) / scale);
     };
     for (int k = 0; k < kNumHandKeypoints; ++k) {
-      if (!(views[v].confidence[k] > 0.0)) continue;
-      const Eigen::Vector2d p = to_tile(views[v].uv_px.row(k).transpose());
+      if (!(views[v].keypoints.confidence[k] > 0.0)) continue;
+      const Eigen::Vector2d p = to_tile(views[v].keypoints.uv_px.row(k).transpose());
       for (int d = -2; d <= 2; ++d) {
         Put(&tile, static_cast<int>(p.x()) + d, static_cast<int>(p.y()) + d, red);
         Put(&tile, static_cast<int>(p.x()) + d, static_cast<int>(p.y()) - d, red);

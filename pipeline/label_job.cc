@@ -151,7 +151,7 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
   const std::string& out = job.output_dir;
 
   const std::string weights_sha =
-      stages.predictor ? stages.predictor->WeightsSha256() : "";
+      stages.predictor ? stages.predictor->weights_sha256 : "";
   const std::string job_hash = JobHash(job, weights_sha);
   const std::vector<std::string> all_frames =
       SelectFrames(stages.source->FrameIds(), job.frames, job.source_file);
@@ -192,7 +192,7 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
   context.job = &job;
   context.fitter = stages.fitter;
   context.side = stages.side;
-  context.provenance = {stages.predictor ? stages.predictor->ModelName() : "",
+  context.provenance = {stages.predictor ? stages.predictor->model_name : "",
                         weights_sha,
                         stages.hand_model_name,
                         job_hash,
@@ -207,7 +207,7 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
                  << done_before << " done before, " << todo.size() << " to label; "
                  << threads << " thread(s)\n  input: " << stages.source->Describe()
                  << "\n  network: "
-                 << (stages.predictor ? stages.predictor->ModelName()
+                 << (stages.predictor ? stages.predictor->model_name
                                       : std::string("none"))
                  << ", refine: " << ToString(job.refine_mode) << ", fitter: "
                  << (stages.fitter ? stages.fitter->Describe() : std::string("none"))
@@ -315,7 +315,7 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
                   bool batch_ok = false;
                   try {
                     std::vector<MeshPrediction> predictions =
-                        stages.predictor->Predict(frames);
+                        stages.predictor->predict(frames);
                     HL_CHECK(predictions.size() == frames.size(),
                              "one prediction per frame");
                     for (size_t k = 0; k < ready.size(); ++k) {
@@ -327,7 +327,7 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
                   if (!batch_ok) {  // find the bad frame(s): one by one
                     for (size_t k = 0; k < ready.size(); ++k) {
                       try {
-                        auto single = stages.predictor->Predict({frames[k]});
+                        auto single = stages.predictor->predict({frames[k]});
                         HL_CHECK(single.size() == 1, "one prediction per frame");
                         batch->predictions[ready[k]] = std::move(single[0]);
                       } catch (...) {

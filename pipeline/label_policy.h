@@ -33,7 +33,7 @@ struct FrameOutcome {
 // The 2D evidence for the fitter per job field evidence.keypoints_2d: the network's
 // keypoints, the capture's keypoint files, or both (files where a view has one, else
 // the network's). Throws Error when the chosen source has nothing for this frame.
-std::vector<std::optional<Keypoints2dView>> FitEvidence(const JobConfig& job,
+std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
                                                         const FrameInput& frame,
                                                         const MeshPrediction* prediction);
 

@@ -8,14 +8,14 @@
 #include "pipeline/label_overlay.h"
 #include "capture/native_frame_source.h"
 #include "capture/oakink_frame_source.h"
-#include "pipeline/poem_mesh_predictor.h"
+#include "pipeline/network_stage.h"
 
 namespace handlabel {
 
 LabelStageSet BuiltLabelStages::Set() const {
   LabelStageSet set;
   set.source = source.get();
-  set.predictor = predictor.get();
+  set.predictor = predictor ? &*predictor : nullptr;
   set.fitter = fitter.get();
   set.overlays = overlays.get();
   set.hand_model_name = hand_model.name;
@@ -50,11 +50,10 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   const HandSide side = built.source->Side().value_or(HandSide::kRight);
   built.hand_model = ResolveHandModel(job.hand_model, side).model;
   if (!job.network_weights.empty()) {
-    built.predictor = std::make_unique<PoemMeshPredictor>(job.network_weights,
-                                                          job.batch_size, job.threads);
+    built.predictor = LoadNetworkStage(job.network_weights, job.batch_size, job.threads);
   }
   if (job.masks == MaskSource::kNetwork &&
-      !(built.predictor && built.predictor->PredictsMasks())) {
+      !(built.predictor && built.predictor->predicts_masks)) {
     throw InputError(job.source_file, "evidence.masks",
                      "files or none (network needs network.weights with a mask head)",
                      built.predictor
