@@ -49,7 +49,7 @@ class FrameSource {
   virtual std::string Describe() const = 0;
   // Which hand the capture shows, when it says (the hand model is built for it);
   // nullopt: the right hand.
-  virtual std::optional<HandSide> Side() const { return std::nullopt; }
+  virtual std::optional<HandSide> side() const { return std::nullopt; }
 };
 
 }  // namespace handlabel

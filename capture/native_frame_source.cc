@@ -52,7 +52,7 @@ std::string NativeFrameSource::Describe() const {
          ", ground truth: " + (reader_.Has(kFileGroundTruth) ? "yes" : "no") + ")";
 }
 
-std::optional<HandSide> NativeFrameSource::Side() const {
+std::optional<HandSide> NativeFrameSource::side() const {
   return reader_.manifest().hand_side == "left" ? HandSide::kLeft : HandSide::kRight;
 }
 

@@ -100,7 +100,8 @@ ViewDetections SimulateDetections(const SynthView& view, const DetectionNoiseOpt
     const double sigma = o.keypoint_sigma_px * (vis == kVisible ? 1.0 : 2.0);
     det.keypoints.uv_px(k, 0) = view.keypoints(k, 0) + sigma * nx;
     det.keypoints.uv_px(k, 1) = view.keypoints(k, 1) + sigma * ny;
-    det.keypoints.confidence[k] = vis == kVisible ? 0.6 + 0.4 * u_conf : 0.2 + 0.4 * u_conf;
+    det.keypoints.confidence[k] =
+        vis == kVisible ? 0.6 + 0.4 * u_conf : 0.2 + 0.4 * u_conf;
   }
 
   // Noisy mask.

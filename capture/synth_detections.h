@@ -15,9 +15,9 @@
 
 #include <random>
 
+#include "capture/synth_view.h"
 #include "core/image.h"
 #include "core/keypoints2d.h"
-#include "capture/synth_view.h"
 
 namespace handlabel {
 

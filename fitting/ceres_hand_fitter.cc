@@ -546,7 +546,8 @@ HandParams CeresHandFitter::InitFromViews(const std::vector<KeypointView>& views
     std::vector<ViewObservation> observations;
     for (size_t v = 0; v < views.size(); ++v) {
       if (!(views[v].keypoints.confidence[k] > 0.0)) continue;
-      observations.push_back({static_cast<int>(v), views[v].keypoints.uv_px.row(k).transpose(),
+      observations.push_back({static_cast<int>(v),
+                              views[v].keypoints.uv_px.row(k).transpose(),
                               views[v].keypoints.confidence[k]});
     }
     if (observations.size() < 2) continue;

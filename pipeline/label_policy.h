@@ -34,8 +34,8 @@ struct FrameOutcome {
 // keypoints, the capture's keypoint files, or both (files where a view has one, else
 // the network's). Throws Error when the chosen source has nothing for this frame.
 std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
-                                                        const FrameInput& frame,
-                                                        const MeshPrediction* prediction);
+                                                    const FrameInput& frame,
+                                                    const MeshPrediction* prediction);
 
 // Labels one frame. `prediction` is nullptr when the job has no network. Throws when
 // the frame cannot be labelled (the runner records the message as the reason).

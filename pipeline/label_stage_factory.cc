@@ -47,7 +47,7 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
 BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   BuiltLabelStages built;
   built.source = BuildFrameSource(job);
-  const HandSide side = built.source->Side().value_or(HandSide::kRight);
+  const HandSide side = built.source->side().value_or(HandSide::kRight);
   built.hand_model = ResolveHandModel(job.hand_model, side).model;
   if (!job.network_weights.empty()) {
     built.predictor = LoadNetworkStage(job.network_weights, job.batch_size, job.threads);

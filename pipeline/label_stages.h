@@ -15,19 +15,19 @@
 #include <string>
 #include <vector>
 
+#include "capture/frame_source.h"
 #include "core/distance_transform.h"
 #include "core/hand_lbs.h"
 #include "core/rig.h"
-#include "capture/frame_source.h"
 
 namespace handlabel {
 
 // The network's answer for one frame.
 struct MeshPrediction {
-  Points3d vertices;                          // V x 3
-  Points3d keypoints;                         // 21 x 3
+  Points3d vertices;                      // V x 3
+  Points3d keypoints;                     // 21 x 3
   std::vector<Keypoints2d> keypoints_2d;  // one per rig camera: the network's own 2D
-  std::optional<HandParams> params;           // when the network regresses them
+  std::optional<HandParams> params;       // when the network regresses them
   // One per rig camera: the network's hand silhouette in the full image (255 = hand;
   // a 0 x 0 mask where it found none); empty when the network has no mask head.
   std::vector<MaskImage> masks;
@@ -38,8 +38,8 @@ struct MeshPrediction {
 // network/hand_mesh_predictor.h, pipeline/network_stage.h makes this stage from it,
 // and tests set their own `predict`.
 struct NetworkStage {
-  std::string model_name;      // recorded in provenance and logs
-  std::string weights_sha256;  // SHA-256 of the weights file (recorded in every label)
+  std::string model_name;       // recorded in provenance and logs
+  std::string weights_sha256;   // SHA-256 of the weights file (recorded in every label)
   bool predicts_masks = false;  // predictions carry silhouettes (MeshPrediction::masks)
   // One batch; called by one thread at a time (it may use threads itself). Returns one
   // prediction per frame, in order. Throws if the whole batch fails; the runner then

@@ -12,8 +12,7 @@ namespace handlabel {
 namespace {
 
 // Points from the master camera's frame to the world frame.
-Points3d ToWorld(const Rigid3& world_from_master,
-                 const Points3d& points) {
+Points3d ToWorld(const Rigid3& world_from_master, const Points3d& points) {
   Points3d out(points.rows(), 3);
   for (int i = 0; i < points.rows(); ++i) {
     out.row(i) = (world_from_master * points.row(i).transpose()).transpose();
@@ -102,7 +101,8 @@ std::vector<MeshPrediction> PredictFramesInRig(
   std::vector<HandMeshInput> inputs;
   std::vector<std::vector<ViewCrop>> crops(frames.size());
   for (size_t f = 0; f < frames.size(); ++f) {
-    inputs.push_back(CropFrameForNetwork(*frames[f], network.num_views(), crop, &crops[f]));
+    inputs.push_back(
+        CropFrameForNetwork(*frames[f], network.num_views(), crop, &crops[f]));
   }
   const std::vector<HandMeshPrediction> outputs = network.Predict(inputs);
   HL_CHECK(outputs.size() == frames.size(), "one prediction per frame");

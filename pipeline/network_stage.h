@@ -29,8 +29,8 @@ MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& 
                                const std::vector<ViewCrop>& crops, int crop_size);
 
 // The two above around one Predict call of `network`.
-std::vector<MeshPrediction> PredictFramesInRig(HandMeshPredictor& network,
-                                               const std::vector<const FrameInput*>& frames);
+std::vector<MeshPrediction> PredictFramesInRig(
+    HandMeshPredictor& network, const std::vector<const FrameInput*>& frames);
 
 // The job's network stage on POEM weights: loads and validates them (InputError naming
 // the file) and hashes them.

@@ -9,9 +9,9 @@
 
 #include <Eigen/Geometry>
 
+#include "capture/native_frame_source.h"
 #include "core/image_file.h"
 #include "network/poem_config.h"
-#include "capture/native_frame_source.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/test_util.h"
 

@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "core/capsule_hand.h"
 #include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

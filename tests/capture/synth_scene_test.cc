@@ -4,10 +4,10 @@
 
 #include <map>
 
-#include "core/capsule_hand.h"
 #include "capture/rig_presets.h"
 #include "capture/synth_detections.h"
 #include "capture/synth_view.h"
+#include "core/capsule_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -53,7 +53,7 @@ TEST(SynthScene, MostCamerasSeeTheWholeHand) {
       bool all = true;
       for (int k = 0; k < kNumHandKeypoints; ++k) {
         Eigen::Vector2d uv;
-        all = all && cam.ProjectWorld(scene.hand.keypoints.uv_px.row(k).transpose(), &uv) &&
+        all = all && cam.ProjectWorld(scene.hand.keypoints.row(k).transpose(), &uv) &&
               cam.camera.InImage(uv, 2.0);
       }
       seen += all;

@@ -42,8 +42,7 @@ inline Rig MakeFourCameraRig() {
   return rig;
 }
 
-inline Keypoints2d ProjectKeypoints(const RigCamera& camera,
-                                        const Points3d& keypoints) {
+inline Keypoints2d ProjectKeypoints(const RigCamera& camera, const Points3d& keypoints) {
   Keypoints2d view;
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     Eigen::Vector2d uv;
