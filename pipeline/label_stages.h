@@ -1,9 +1,9 @@
 #pragma once
-// The stages a labeling job is made of, as small interfaces, so that the runner
-// (label_job.h) does not depend on how frames are read (capture/frame_source.h), how
-// the network predicts or how the fitter fits. pipeline/label_stage_factory.h builds
-// them from a job (capture readers, the POEM network, the Ceres fitter); tests pass
-// their own.
+// The stages a labeling job is made of, as small interfaces (the network stage as a
+// value), so that the runner (label_job.h) does not depend on how frames are read
+// (capture/frame_source.h), how the network predicts or how the fitter fits.
+// pipeline/label_stage_factory.h builds them from a job (capture readers, the POEM
+// network, the Ceres fitter); tests pass their own.
 //
 // Every point is in the rig's world frame (metres); 2D keypoints are distorted pixels
 // in the full image. Keypoints are in the 21-point SNAP order (core/hand_model.h).
