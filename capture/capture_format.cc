@@ -184,7 +184,8 @@ json ViewKeypointsToJson(const std::string& frame,
     jv["camera"] = v.camera;
     json kp = json::array();
     for (int k = 0; k < kNumHandKeypoints; ++k) {
-      kp.push_back({NumberOrNull(v.keypoints(k, 0)), NumberOrNull(v.keypoints(k, 1))});
+      kp.push_back(
+          {NumberOrNull(v.keypoints.uv_px(k, 0)), NumberOrNull(v.keypoints.uv_px(k, 1))});
     }
     jv["keypoints"] = kp;
     if (ground_truth) {
@@ -192,7 +193,8 @@ json ViewKeypointsToJson(const std::string& frame,
       jv["status"] = v.status;
       jv["hand_pixels"] = v.hand_pixels;
     } else {
-      jv["confidence"] = v.confidence;
+      const KeypointConfidences& c = v.keypoints.confidence;
+      jv["confidence"] = std::vector<double>(c.data(), c.data() + c.size());
     }
     out["views"].push_back(jv);
   }
@@ -219,11 +221,11 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
         throw InputError(source, where + "keypoints", "[x, y] or [null, null]",
                          kp[k].dump());
       }
-      v.keypoints(k, 0) = NumberOrNan(kp[k][0], source, where + "keypoints");
-      v.keypoints(k, 1) = NumberOrNan(kp[k][1], source, where + "keypoints");
+      v.keypoints.uv_px(k, 0) = NumberOrNan(kp[k][0], source, where + "keypoints");
+      v.keypoints.uv_px(k, 1) = NumberOrNan(kp[k][1], source, where + "keypoints");
     }
     v.visibility.fill(-1);
-    v.confidence.fill(1.0);
+    v.keypoints.confidence.setOnes();
     if (jv.contains("visibility")) {
       const Eigen::VectorXd vis =
           VectorFrom(jv["visibility"], source, where + "visibility", 21);
@@ -238,7 +240,7 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
     if (jv.contains("confidence")) {
       const Eigen::VectorXd c =
           VectorFrom(jv["confidence"], source, where + "confidence", 21);
-      for (int k = 0; k < kNumHandKeypoints; ++k) v.confidence[k] = c[k];
+      v.keypoints.confidence = c;
     }
     if (jv.contains("status")) v.status = String(jv, "status", source, where);
     if (jv.contains("hand_pixels")) {

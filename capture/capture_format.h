@@ -28,6 +28,7 @@
 
 #include "core/hand_lbs.h"
 #include "core/hand_model.h"
+#include "core/keypoints2d.h"
 #include "core/rigid3.h"
 
 namespace handlabel {
@@ -68,15 +69,14 @@ std::string ExpandPattern(const std::string& pattern, const std::string& camera,
 // "000042" for 42.
 std::string FrameId(int index);
 
-// 2D keypoints of one view, SNAP order. Ground truth has visibility (0 out of frame,
-// 1 occluded, 2 visible; synth_view.h) and confidence 1; detections have confidence
-// (0 = missing) and visibility -1. Missing positions are NaN (null in JSON).
+// The file record of one view's 2D keypoints (SNAP order). Ground truth has visibility
+// (0 out of frame, 1 occluded, 2 visible; synth_view.h) and confidence 1; detections
+// have confidence (0 = missing) and visibility -1. Missing positions are NaN (null in
+// JSON): the record keeps what the file says, readers decide what is known.
 struct ViewKeypoints {
   std::string camera;
-  Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor> keypoints =
-      Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor>::Zero();
+  Keypoints2d keypoints;
   std::array<int, kNumHandKeypoints> visibility{};
-  std::array<double, kNumHandKeypoints> confidence{};
   std::string status;    // ground truth: "visible", "occluded", "out_of_frame"
   int hand_pixels = -1;  // ground truth: visible hand pixels; -1 = unknown
 };

@@ -88,8 +88,8 @@ ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
       Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
       for (int k = 0; k < kNumHandKeypoints; ++k) {
         if (kps[c].visibility[k] == 0) continue;
-        lo = lo.cwiseMin(kps[c].keypoints.row(k).transpose());
-        hi = hi.cwiseMax(kps[c].keypoints.row(k).transpose());
+        lo = lo.cwiseMin(kps[c].keypoints.uv_px.row(k).transpose());
+        hi = hi.cwiseMax(kps[c].keypoints.uv_px.row(k).transpose());
       }
       if (lo.x() <= hi.x()) {
         const double side = std::max(48.0, 1.6 * (hi - lo).maxCoeff());
@@ -133,13 +133,13 @@ ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
       for (const auto& bone : kBones) {
         const int a = bone[0], b = bone[1];
         if (v.visibility[a] == 0 || v.visibility[b] == 0) continue;
-        DrawLine(&tile, px(v.keypoints(a, 0)), py(v.keypoints(a, 1)),
-                 px(v.keypoints(b, 0)), py(v.keypoints(b, 1)),
+        DrawLine(&tile, px(v.keypoints.uv_px(a, 0)), py(v.keypoints.uv_px(a, 1)),
+                 px(v.keypoints.uv_px(b, 0)), py(v.keypoints.uv_px(b, 1)),
                  kFingerColors[FingerOf(b)]);
       }
       for (int k = 0; k < kNumHandKeypoints; ++k) {
         if (v.visibility[k] == 0) continue;
-        DrawDot(&tile, px(v.keypoints(k, 0)), py(v.keypoints(k, 1)), 3,
+        DrawDot(&tile, px(v.keypoints.uv_px(k, 0)), py(v.keypoints.uv_px(k, 1)), 3,
                 kFingerColors[FingerOf(k)], v.visibility[k] == 2);
       }
     }
@@ -147,8 +147,8 @@ ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
       const uint8_t white[3] = {255, 255, 255};
       const ViewKeypoints& d = dets[c];
       for (int k = 0; k < kNumHandKeypoints; ++k) {
-        if (!(d.confidence[k] > 0)) continue;
-        const double x = px(d.keypoints(k, 0)), y = py(d.keypoints(k, 1));
+        if (!(d.keypoints.confidence[k] > 0)) continue;
+        const double x = px(d.keypoints.uv_px(k, 0)), y = py(d.keypoints.uv_px(k, 1));
         DrawLine(&tile, x - 3, y - 3, x + 3, y + 3, white);
         DrawLine(&tile, x - 3, y + 3, x + 3, y - 3, white);
       }

@@ -172,7 +172,7 @@ std::vector<std::string> DexYcbFrameSource::FrameIds() const {
   return ids;
 }
 
-std::optional<HandSide> DexYcbFrameSource::Side() const {
+std::optional<HandSide> DexYcbFrameSource::side() const {
   return sequences_.front().side;
 }
 
@@ -187,7 +187,7 @@ std::string DexYcbFrameSource::Describe() const {
          (sequences_.size() == 1 ? "" : "s") + ", " +
          std::to_string(sequences_.front().rig.size()) + " cameras, " +
          std::to_string(frames) + " frames, " +
-         (Side() == HandSide::kLeft ? "left" : "right") +
+         (side() == HandSide::kLeft ? "left" : "right") +
          " hand, 2D keypoints and ground truth keypoints: " +
          (labels ? "labels_*.npz" : "none") + ", masks: none)";
 }
@@ -238,7 +238,7 @@ FrameInput DexYcbFrameSource::Load(const std::string& id) const {
         FindArray(arrays, "joint_2d", {1, kNumHandKeypoints, 2}, file).ToDoubles();
     const std::vector<double> xyz =
         FindArray(arrays, "joint_3d", {1, kNumHandKeypoints, 3}, file).ToDoubles();
-    std::optional<Keypoints2dView> view;
+    std::optional<Keypoints2d> view;
     if (HasHand(uv)) {
       view.emplace();
       for (int k = 0; k < kNumHandKeypoints; ++k) {

@@ -50,7 +50,7 @@ class DexYcbFrameSource : public FrameSource {
   std::vector<std::string> FrameIds() const override;
   FrameInput Load(const std::string& id) const override;
   std::string Describe() const override;
-  std::optional<HandSide> Side() const override;
+  std::optional<HandSide> side() const override;
   const std::vector<DexYcbSequence>& sequences() const { return sequences_; }
 
  private:

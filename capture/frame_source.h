@@ -12,18 +12,10 @@
 #include <vector>
 
 #include "core/hand_lbs.h"
+#include "core/keypoints2d.h"
 #include "core/rig.h"
 
 namespace handlabel {
-
-// One view's 2D keypoints.
-struct Keypoints2dView {
-  Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor> uv_px =
-      Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor>::Zero();
-  // Per keypoint, in [0, 1]; 0 = not detected.
-  Eigen::Matrix<double, kNumHandKeypoints, 1> confidence =
-      Eigen::Matrix<double, kNumHandKeypoints, 1>::Zero();
-};
 
 struct FrameGroundTruth {
   Points3d keypoints;                // 21 x 3
@@ -39,8 +31,9 @@ struct FrameInput {
   std::vector<std::string> image_paths;  // one per rig camera
   std::vector<std::string> mask_paths;   // one per rig camera, or empty
   // 2D keypoints from files, one entry per rig camera (nullopt: none for that view);
-  // empty when the capture has no keypoint files.
-  std::vector<std::optional<Keypoints2dView>> keypoints_2d;
+  // empty when the capture has no keypoint files. Unknown keypoints: confidence 0 and
+  // position 0.
+  std::vector<std::optional<Keypoints2d>> keypoints_2d;
   std::optional<FrameGroundTruth> ground_truth;
 };
 
@@ -56,7 +49,7 @@ class FrameSource {
   virtual std::string Describe() const = 0;
   // Which hand the capture shows, when it says (the hand model is built for it);
   // nullopt: the right hand.
-  virtual std::optional<HandSide> Side() const { return std::nullopt; }
+  virtual std::optional<HandSide> side() const { return std::nullopt; }
 };
 
 }  // namespace handlabel

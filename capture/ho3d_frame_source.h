@@ -44,7 +44,7 @@ class Ho3dFrameSource : public FrameSource {
   std::vector<std::string> FrameIds() const override;
   FrameInput Load(const std::string& id) const override;
   std::string Describe() const override;
-  std::optional<HandSide> Side() const override { return HandSide::kRight; }
+  std::optional<HandSide> side() const override { return HandSide::kRight; }
   const std::vector<Ho3dSequence>& sequences() const { return sequences_; }
 
  private:

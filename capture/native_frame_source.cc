@@ -1,7 +1,6 @@
 #include "capture/native_frame_source.h"
 
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
 
 #include "calib/rig_io.h"
@@ -63,7 +62,7 @@ std::string NativeFrameSource::Describe() const {
          ", ground truth: " + (reader_.Has(kFileGroundTruth) ? "yes" : "no") + ")";
 }
 
-std::optional<HandSide> NativeFrameSource::Side() const {
+std::optional<HandSide> NativeFrameSource::side() const {
   return reader_.manifest().hand_side == "left" ? HandSide::kLeft : HandSide::kRight;
 }
 
@@ -83,13 +82,14 @@ FrameInput NativeFrameSource::Load(const std::string& id) const {
                                                  ? reader_.ReadDetections(f)
                                                  : reader_.ReadKeypoints(f);
     for (const ViewKeypoints& view : views) {
-      Keypoints2dView out;
+      // Known: a finite position that the ground truth does not mark out of frame.
+      Keypoints2d out;
       for (int k = 0; k < kNumHandKeypoints; ++k) {
-        const bool known = std::isfinite(view.keypoints(k, 0)) &&
-                           std::isfinite(view.keypoints(k, 1)) &&
+        const bool known = view.keypoints.uv_px.row(k).allFinite() &&
                            (keypoint_kind_ == kFileDetections || view.visibility[k] > 0);
-        if (known) out.uv_px.row(k) = view.keypoints.row(k);
-        out.confidence(k) = known ? view.confidence[k] : 0.0;
+        if (!known) continue;
+        out.uv_px.row(k) = view.keypoints.uv_px.row(k);
+        out.confidence(k) = view.keypoints.confidence(k);
       }
       frame.keypoints_2d.push_back(out);
     }

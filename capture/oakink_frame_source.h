@@ -35,7 +35,7 @@ class OakInkFrameSource : public FrameSource {
   std::vector<std::string> FrameIds() const override;
   FrameInput Load(const std::string& id) const override;
   std::string Describe() const override;
-  std::optional<HandSide> Side() const override { return HandSide::kRight; }
+  std::optional<HandSide> side() const override { return HandSide::kRight; }
   const std::string& image_dir() const { return image_dir_; }
 
  private:

@@ -235,9 +235,9 @@ SynthCaptureSummary WriteSynthCapture(const HandModel& model,
       }
       ViewKeypoints kp;
       kp.camera = cam;
-      kp.keypoints = view.keypoints;
+      kp.keypoints.uv_px = view.keypoints;
       kp.visibility = view.visibility;
-      kp.confidence.fill(1.0);
+      kp.keypoints.confidence.setOnes();
       kp.status = view.status;
       kp.hand_pixels = view.hand_pixels;
       gt2d.push_back(kp);
@@ -250,7 +250,6 @@ SynthCaptureSummary WriteSynthCapture(const HandModel& model,
         ViewKeypoints d;
         d.camera = cam;
         d.keypoints = det.keypoints;
-        d.confidence = det.confidence;
         d.visibility.fill(-1);
         det2d.push_back(d);
       }

@@ -68,7 +68,7 @@ ViewDetections SimulateDetections(const SynthView& view, const DetectionNoiseOpt
                                   std::mt19937_64& rng) {
   ViewDetections det;
   const double nan = std::nan("");
-  det.keypoints.setConstant(nan);
+  det.keypoints.uv_px.setConstant(nan);
   // The hand's box from in-frame keypoints, for outliers.
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
   for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -90,17 +90,18 @@ ViewDetections SimulateDetections(const SynthView& view, const DetectionNoiseOpt
     const double drop = vis == kVisible ? o.dropout_rate : o.occluded_dropout_rate;
     if (u_drop < drop) continue;
     if (u_out < o.outlier_rate) {
-      det.keypoints(k, 0) =
+      det.keypoints.uv_px(k, 0) =
           std::clamp(centre.x() + ox * half.x(), 0.0, view.rgb.width - 1.0);
-      det.keypoints(k, 1) =
+      det.keypoints.uv_px(k, 1) =
           std::clamp(centre.y() + oy * half.y(), 0.0, view.rgb.height - 1.0);
-      det.confidence[k] = 0.1 + 0.5 * u_conf;
+      det.keypoints.confidence[k] = 0.1 + 0.5 * u_conf;
       continue;
     }
     const double sigma = o.keypoint_sigma_px * (vis == kVisible ? 1.0 : 2.0);
-    det.keypoints(k, 0) = view.keypoints(k, 0) + sigma * nx;
-    det.keypoints(k, 1) = view.keypoints(k, 1) + sigma * ny;
-    det.confidence[k] = vis == kVisible ? 0.6 + 0.4 * u_conf : 0.2 + 0.4 * u_conf;
+    det.keypoints.uv_px(k, 0) = view.keypoints(k, 0) + sigma * nx;
+    det.keypoints.uv_px(k, 1) = view.keypoints(k, 1) + sigma * ny;
+    det.keypoints.confidence[k] =
+        vis == kVisible ? 0.6 + 0.4 * u_conf : 0.2 + 0.4 * u_conf;
   }
 
   // Noisy mask.

@@ -13,12 +13,11 @@
 // Mask: the hand mask eroded or dilated by up to `mask_morph_radius` pixels, then
 // `mask_blobs` random ellipses at the boundary added or cut out.
 
-#include <Eigen/Core>
-#include <array>
 #include <random>
 
-#include "core/image.h"
 #include "capture/synth_view.h"
+#include "core/image.h"
+#include "core/keypoints2d.h"
 
 namespace handlabel {
 
@@ -33,9 +32,8 @@ struct DetectionNoiseOptions {
 };
 
 struct ViewDetections {
-  Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor> keypoints;  // NaN = none
-  std::array<double, kNumHandKeypoints> confidence{};                      // 0 = none
-  ImageU8 mask;                                                            // 0/255
+  Keypoints2d keypoints;  // dropped ones: confidence 0, position NaN (as written)
+  ImageU8 mask;           // 0/255
 };
 
 ViewDetections SimulateDetections(const SynthView& view,

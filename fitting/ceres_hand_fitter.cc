@@ -432,10 +432,10 @@ class FitRun {
       double sum = 0.0;
       int n = 0;
       for (int k = 0; k < kNumHandKeypoints; ++k) {
-        if (!(view.confidence[k] > 0.0)) continue;
+        if (!(view.keypoints.confidence[k] > 0.0)) continue;
         Eigen::Vector2d uv;
         if (!view.camera.ProjectWorld(mesh.keypoints.row(k).transpose(), &uv)) continue;
-        sum += (uv - view.uv_px.row(k).transpose()).squaredNorm();
+        sum += (uv - view.keypoints.uv_px.row(k).transpose()).squaredNorm();
         ++n;
       }
       result.view_rms_px.push_back(n > 0 ? std::sqrt(sum / n) : kNaN);
@@ -546,9 +546,10 @@ HandParams CeresHandFitter::InitFromViews(const std::vector<KeypointView>& views
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     std::vector<ViewObservation> observations;
     for (size_t v = 0; v < views.size(); ++v) {
-      if (!(views[v].confidence[k] > 0.0)) continue;
-      observations.push_back({static_cast<int>(v), views[v].uv_px.row(k).transpose(),
-                              views[v].confidence[k]});
+      if (!(views[v].keypoints.confidence[k] > 0.0)) continue;
+      observations.push_back({static_cast<int>(v),
+                              views[v].keypoints.uv_px.row(k).transpose(),
+                              views[v].keypoints.confidence[k]});
     }
     if (observations.size() < 2) continue;
     const RobustTriangulation t = TriangulateRobust(rig, observations, tri);

@@ -50,8 +50,8 @@ inline std::vector<KeypointViewData> MakeKeypointViewData(
       out[v].intrinsics[i] = cam.params()[i];
     out[v].rotation = views[v].camera.cam_from_world.rotation.toRotationMatrix();
     out[v].translation = views[v].camera.cam_from_world.translation;
-    out[v].uv_px = views[v].uv_px;
-    out[v].weight = views[v].confidence.cwiseMax(0.0).cwiseSqrt() / sigma_px;
+    out[v].uv_px = views[v].keypoints.uv_px;
+    out[v].weight = views[v].keypoints.confidence.cwiseMax(0.0).cwiseSqrt() / sigma_px;
     out[v].camera = cam;
   }
   return out;

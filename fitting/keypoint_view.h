@@ -1,22 +1,17 @@
 #pragma once
-// 2D keypoint evidence of one camera view: the camera and 21 detected keypoints (SNAP
-// order) with confidences.
+// 2D keypoint evidence of one camera view for the fitter: the camera and its 21
+// detected keypoints (core/keypoints2d.h).
 
-#include <Eigen/Core>
-
-#include "core/hand_model.h"
+#include "core/keypoints2d.h"
 #include "core/rig.h"
 
 namespace handlabel {
 
-using KeypointPixels = Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor>;
-using KeypointConfidences = Eigen::Matrix<double, kNumHandKeypoints, 1>;
-
 struct KeypointView {
   RigCamera camera;  // intrinsics (with distortion) and cam_from_world
-  KeypointPixels uv_px = KeypointPixels::Zero();  // distorted pixels, as detected
-  // >= 0 each; 0 = not detected (ignored). Multiplies the squared error.
-  KeypointConfidences confidence = KeypointConfidences::Zero();
+  // Distorted pixels, as detected. Confidence >= 0 each (0 = not detected, ignored);
+  // it multiplies the squared error.
+  Keypoints2d keypoints;
 };
 
 }  // namespace handlabel

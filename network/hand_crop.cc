@@ -31,22 +31,16 @@ CropWindow CropFromBox(const Eigen::Vector2d& box_min, const Eigen::Vector2d& bo
   return w;
 }
 
-std::optional<CropWindow> CropFromKeypoints(const std::vector<Eigen::Vector2d>& keypoints,
-                                            const std::vector<double>& confidences,
+std::optional<CropWindow> CropFromKeypoints(const Keypoints2d& keypoints,
                                             const HandCropOptions& options) {
-  if (confidences.size() != keypoints.size()) {
-    throw InputError("hand evidence", "confidences",
-                     "one per keypoint (" + std::to_string(keypoints.size()) + ")",
-                     std::to_string(confidences.size()));
-  }
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY);
   Eigen::Vector2d hi = Eigen::Vector2d::Constant(-INFINITY);
   int used = 0;
-  for (size_t i = 0; i < keypoints.size(); ++i) {
-    if (!(confidences[i] >= options.min_confidence) || !keypoints[i].allFinite())
-      continue;
-    lo = lo.cwiseMin(keypoints[i]);
-    hi = hi.cwiseMax(keypoints[i]);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const Eigen::Vector2d uv = keypoints.uv_px.row(k).transpose();
+    if (!(keypoints.confidence(k) >= options.min_confidence) || !uv.allFinite()) continue;
+    lo = lo.cwiseMin(uv);
+    hi = hi.cwiseMax(uv);
     ++used;
   }
   if (used < options.min_keypoints) return std::nullopt;
@@ -142,8 +136,8 @@ ViewCrop CropForView(const RgbImageView& image, const Camera& camera,
   options.Check();
   ViewCrop crop;
   std::optional<CropWindow> window;
-  if (!evidence.keypoints.empty()) {
-    window = CropFromKeypoints(evidence.keypoints, evidence.confidences, options);
+  if (evidence.keypoints) {
+    window = CropFromKeypoints(*evidence.keypoints, options);
     crop.source = "keypoints";
   }
   if (!window && evidence.box) {
@@ -156,7 +150,7 @@ ViewCrop CropForView(const RgbImageView& image, const Camera& camera,
   }
   // Evidence that failed to find the hand marks the view as not visible; no evidence
   // at all means the whole image is the intended input.
-  const bool had_evidence = !evidence.keypoints.empty() || evidence.box.has_value() ||
+  const bool had_evidence = evidence.keypoints.has_value() || evidence.box.has_value() ||
                             !evidence.prior_points_in_cam.empty();
   crop.hand_visible = window.has_value() || !had_evidence;
   if (!window) {

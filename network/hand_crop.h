@@ -23,6 +23,7 @@
 
 #include "core/camera.h"
 #include "core/distance_transform.h"
+#include "core/keypoints2d.h"
 #include "core/rigid3.h"
 
 namespace handlabel {
@@ -47,9 +48,9 @@ struct HandCropOptions {
 // Window around an axis-aligned box (min and max corner, pixels).
 CropWindow CropFromBox(const Eigen::Vector2d& box_min, const Eigen::Vector2d& box_max,
                        const HandCropOptions& options);
-// Window around the confident keypoints; nullopt if fewer than options.min_keypoints.
-std::optional<CropWindow> CropFromKeypoints(const std::vector<Eigen::Vector2d>& keypoints,
-                                            const std::vector<double>& confidences,
+// Window around the confident keypoints (full-image pixels); nullopt if fewer than
+// options.min_keypoints.
+std::optional<CropWindow> CropFromKeypoints(const Keypoints2d& keypoints,
                                             const HandCropOptions& options);
 // Window around the projection of 3D points (camera frame of `camera`); nullopt if
 // fewer than two points project in front of the camera or the box misses the image.
@@ -87,8 +88,7 @@ struct ViewCrop {
 
 // Per-view evidence of where the hand is; all optional.
 struct HandEvidence {
-  std::vector<Eigen::Vector2d> keypoints;  // 2D detections (pixels)
-  std::vector<double> confidences;         // one per keypoint
+  std::optional<Keypoints2d> keypoints;  // 2D detections (full-image pixels)
   std::optional<std::pair<Eigen::Vector2d, Eigen::Vector2d>> box;  // min, max corner
   std::vector<Eigen::Vector3d> prior_points_in_cam;  // e.g. last frame's joints
 };

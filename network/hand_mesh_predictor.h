@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/keypoints2d.h"
 #include "core/rigid3.h"
 #include "network/poem_config.h"
 
@@ -32,16 +33,14 @@ struct HandMeshInput {
   std::vector<HandMeshViewInput> views;  // exactly num_views(), master first
 };
 
-using Keypoints3 = Eigen::Matrix<double, 21, 3, Eigen::RowMajor>;
-using Keypoints2 = Eigen::Matrix<double, 21, 2, Eigen::RowMajor>;
+using Keypoints3 = Eigen::Matrix<double, kNumHandKeypoints, 3, Eigen::RowMajor>;
 
 struct HandMeshPrediction {
   Keypoints3 joints;  // master frame, metres, SNAP/OpenPose order (last decoder layer)
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> vertices;  // 778 x 3
-  Keypoints3 triangulated_joints;     // from the per-view 2D joints (DLT)
-  std::vector<Keypoints2> joints_2d;  // per view, crop pixels
-  // Per view and joint: the heatmap's peak value (sigmoid output, 0..1).
-  std::vector<Eigen::Matrix<double, 21, 1>> joint_confidence;
+  Keypoints3 triangulated_joints;  // from the per-view 2D joints (DLT)
+  // Per view, in crop pixels; confidence = the heatmap's peak value (sigmoid, 0..1).
+  std::vector<Keypoints2d> joints_2d;
   int64_t points_inside_ball = 0;  // frustum points near the initial mesh
   // Per view, the mask head's hand probability (0..1) on an M x M grid over the crop,
   // M = crop_size / 4: cell (row i, column j) covers crop pixels [4j, 4j + 4) x

@@ -16,7 +16,7 @@ namespace handlabel {
 struct HandMeshTargets {
   Keypoints3 joints;                                                   // SNAP order
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> vertices;  // 778 x 3
-  std::vector<Keypoints2> joints_2d;  // per view, crop pixels
+  std::vector<KeypointPixels> joints_2d;  // per view, crop pixels
   // Optional per view: 0 drops the view from the 2D terms (hand not visible).
   std::vector<double> view_weights;
 };

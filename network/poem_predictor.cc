@@ -105,9 +105,10 @@ class PoemPredictor : public HandMeshPredictor {
               verts[b].data_ptr<double>(), PoemConfig::kNumVertices, 3);
       p.triangulated_joints = Eigen::Map<const Keypoints3>(tri[b].data_ptr<double>());
       for (int64_t n = 0; n < N; ++n) {
-        p.joints_2d.push_back(Eigen::Map<const Keypoints2>(uv[b][n].data_ptr<double>()));
-        p.joint_confidence.push_back(Eigen::Map<const Eigen::Matrix<double, 21, 1>>(
-            peak[b][n].data_ptr<double>()));
+        Keypoints2d& view = p.joints_2d.emplace_back();
+        view.uv_px = Eigen::Map<const KeypointPixels>(uv[b][n].data_ptr<double>());
+        view.confidence =
+            Eigen::Map<const KeypointConfidences>(peak[b][n].data_ptr<double>());
         if (masks.defined()) {
           const int64_t M = masks.size(2);
           p.masks.push_back(

@@ -115,11 +115,7 @@ HandFitInput CeresLabelFitter::Evidence(const LabelFitRequest& request,
   HandFitInput input;
   for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
     if (!request.keypoints_2d[v]) continue;
-    KeypointView view;
-    view.camera = frame.rig[v];
-    view.uv_px = request.keypoints_2d[v]->uv_px;
-    view.confidence = request.keypoints_2d[v]->confidence;
-    input.views.push_back(view);
+    input.views.push_back({frame.rig[v], *request.keypoints_2d[v]});
   }
   // Masks follow the order of input.views.
   *silhouettes = "none";

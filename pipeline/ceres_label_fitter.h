@@ -1,7 +1,7 @@
 #pragma once
 // The labeling job's fitting stage: the LabelFitter interface (label_stages.h)
 // implemented on the Ceres hand fitter of fitting/ceres_hand_fitter.h. Names follow the
-// other stages (NativeFrameSource, PoemMeshPredictor): CeresHandFitter solves the
+// other stages (NativeFrameSource, NetworkStage): CeresHandFitter solves the
 // problem; CeresLabelFitter turns a frame and its evidence into that problem.
 //   refine (request.init set)  start from the network's 3D keypoints (IK alignment),
 //                              keep a 3D pull towards the network's keypoints (and a

@@ -220,7 +220,7 @@ class LabelJobRun {
   // The job's frames, this shard's part of them, the job hash and the claim on the
   // output folder.
   void Plan() {
-    weights_sha_ = stages_.predictor ? stages_.predictor->WeightsSha256() : "";
+    weights_sha_ = stages_.predictor ? stages_.predictor->weights_sha256 : "";
     job_hash_ = JobHash(job_, weights_sha_);
     all_frames_ = JobFrames(job_, *stages_.source);
     mine_ = FramesOfShard(all_frames_, options_.shard);
@@ -233,7 +233,7 @@ class LabelJobRun {
     context_.job = &job_;
     context_.fitter = stages_.fitter;
     context_.side = stages_.side;
-    context_.provenance = {stages_.predictor ? stages_.predictor->ModelName() : "",
+    context_.provenance = {stages_.predictor ? stages_.predictor->model_name : "",
                            weights_sha_,
                            stages_.hand_model_name,
                            job_hash_,
@@ -273,7 +273,7 @@ class LabelJobRun {
                   << " thread(s)"
                   << (in_order_ ? " (fit.init previous: frames in order)" : "")
                   << "\n  input: " << stages_.source->Describe() << "\n  network: "
-                  << (stages_.predictor ? stages_.predictor->ModelName()
+                  << (stages_.predictor ? stages_.predictor->model_name
                                         : std::string("none"))
                   << ", refine: " << ToString(job_.refine_mode) << ", fitter: "
                   << (stages_.fitter ? stages_.fitter->Describe() : std::string("none"))
@@ -322,7 +322,7 @@ class LabelJobRun {
     if (frames.empty()) return;
     const Clock::time_point t = Clock::now();
     try {
-      std::vector<MeshPrediction> predictions = stages_.predictor->Predict(frames);
+      std::vector<MeshPrediction> predictions = stages_.predictor->predict(frames);
       HL_CHECK(predictions.size() == frames.size(), "one prediction per frame");
       for (size_t k = 0; k < ready.size(); ++k) {
         batch.predictions[ready[k]] = std::move(predictions[k]);
@@ -330,7 +330,7 @@ class LabelJobRun {
     } catch (...) {
       for (size_t k = 0; k < ready.size(); ++k) {
         try {
-          auto single = stages_.predictor->Predict({frames[k]});
+          auto single = stages_.predictor->predict({frames[k]});
           HL_CHECK(single.size() == 1, "one prediction per frame");
           batch.predictions[ready[k]] = std::move(single[0]);
         } catch (...) {

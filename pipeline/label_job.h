@@ -39,7 +39,7 @@ class OverlayWriter {
 // What a job runs with; built from the job by label_stage_factory.h, or by tests.
 struct LabelStageSet {
   const FrameSource* source = nullptr;      // required
-  MeshPredictor* predictor = nullptr;       // nullptr: the job has no network
+  const NetworkStage* predictor = nullptr;  // nullptr: the job has no network
   const LabelFitter* fitter = nullptr;      // nullptr: refine off and no baseline
   const OverlayWriter* overlays = nullptr;  // nullptr: no overlay pictures
   std::string hand_model_name;              // recorded in provenance

@@ -36,10 +36,11 @@ Points3d NativeJointsFromKeypoints(const Points3d& keypoints) {
   return joints;
 }
 
-std::vector<std::optional<Keypoints2dView>> FitEvidence(
-    const JobConfig& job, const FrameInput& frame, const MeshPrediction* prediction) {
+std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
+                                                    const FrameInput& frame,
+                                                    const MeshPrediction* prediction) {
   const size_t views = frame.rig.size();
-  std::vector<std::optional<Keypoints2dView>> evidence(views);
+  std::vector<std::optional<Keypoints2d>> evidence(views);
   const bool use_files = job.keypoints != KeypointSource::kNetwork;
   const bool use_network = job.keypoints != KeypointSource::kFiles;
   if (use_files && !frame.keypoints_2d.empty()) {

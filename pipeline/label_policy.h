@@ -34,7 +34,7 @@ struct FrameOutcome {
 // keypoints, the capture's keypoint files, or both (files where a view has one, else
 // the network's); none for the cameras of evidence.ignore_views. Throws Error when the
 // chosen source has nothing for this frame, InputError for an unknown camera name.
-std::vector<std::optional<Keypoints2dView>> FitEvidence(const JobConfig& job,
+std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
                                                         const FrameInput& frame,
                                                         const MeshPrediction* prediction);
 

@@ -8,7 +8,7 @@
 #include "pipeline/ceres_label_fitter.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/label_overlay.h"
-#include "pipeline/poem_mesh_predictor.h"
+#include "pipeline/network_stage.h"
 
 namespace handlabel {
 namespace {
@@ -41,7 +41,7 @@ CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
 LabelStageSet BuiltLabelStages::Set() const {
   LabelStageSet set;
   set.source = source.get();
-  set.predictor = predictor.get();
+  set.predictor = predictor ? &*predictor : nullptr;
   set.fitter = fitter.get();
   set.overlays = overlays.get();
   set.hand_model_name = hand_model.name;
@@ -74,14 +74,13 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
 BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   BuiltLabelStages built;
   built.source = BuildFrameSource(job);
-  const HandSide side = built.source->Side().value_or(HandSide::kRight);
+  const HandSide side = built.source->side().value_or(HandSide::kRight);
   built.hand_model = ResolveHandModel(job.hand_model, side).model;
   if (!job.network_weights.empty()) {
-    built.predictor = std::make_unique<PoemMeshPredictor>(job.network_weights,
-                                                          job.batch_size, job.threads);
+    built.predictor = LoadNetworkStage(job.network_weights, job.batch_size, job.threads);
   }
   if (job.masks == MaskSource::kNetwork &&
-      !(built.predictor && built.predictor->PredictsMasks())) {
+      !(built.predictor && built.predictor->predicts_masks)) {
     throw InputError(job.source_file, "evidence.masks",
                      "files or none (network needs network.weights with a mask head)",
                      built.predictor

@@ -4,6 +4,7 @@
 // output.baseline), the hand model and the overlay writer.
 
 #include <memory>
+#include <optional>
 
 #include "core/hand_model.h"
 #include "pipeline/job_config.h"
@@ -13,7 +14,7 @@ namespace handlabel {
 
 struct BuiltLabelStages {
   std::unique_ptr<FrameSource> source;
-  std::unique_ptr<MeshPredictor> predictor;
+  std::optional<NetworkStage> predictor;
   std::unique_ptr<LabelFitter> fitter;
   std::unique_ptr<OverlayWriter> overlays;
   HandModel hand_model;

@@ -1,49 +1,51 @@
 #pragma once
-// The stages a labeling job is made of, as small interfaces, so that the runner
-// (label_job.h) does not depend on how frames are read (capture/frame_source.h), how
-// the network predicts or how the fitter fits. Implementations: pipeline/label_stage_factory.h builds them from
-// a job (capture readers, the POEM network, the Ceres fitter); tests pass their own.
+// The stages a labeling job is made of, as small interfaces (the network stage as a
+// value), so that the runner (label_job.h) does not depend on how frames are read
+// (capture/frame_source.h), how the network predicts or how the fitter fits.
+// pipeline/label_stage_factory.h builds them from a job (capture readers, the POEM
+// network, the Ceres fitter); tests pass their own.
 //
 // Every point is in the rig's world frame (metres); 2D keypoints are distorted pixels
 // in the full image. Keypoints are in the 21-point SNAP order (core/hand_model.h).
 
 #include <Eigen/Core>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "capture/frame_source.h"
 #include "core/distance_transform.h"
 #include "core/hand_lbs.h"
 #include "core/rig.h"
-#include "capture/frame_source.h"
 
 namespace handlabel {
 
 // The network's answer for one frame.
 struct MeshPrediction {
-  Points3d vertices;                          // V x 3
-  Points3d keypoints;                         // 21 x 3
-  std::vector<Keypoints2dView> keypoints_2d;  // one per rig camera: the network's own 2D
-  std::optional<HandParams> params;           // when the network regresses them
+  Points3d vertices;                      // V x 3
+  Points3d keypoints;                     // 21 x 3
+  std::vector<Keypoints2d> keypoints_2d;  // one per rig camera: the network's own 2D
+  std::optional<HandParams> params;       // when the network regresses them
   // One per rig camera: the network's hand silhouette in the full image (255 = hand;
   // a 0 x 0 mask where it found none); empty when the network has no mask head.
   std::vector<MaskImage> masks;
 };
 
-class MeshPredictor {
- public:
-  virtual ~MeshPredictor() = default;
-  virtual std::string ModelName() const = 0;
-  // SHA-256 of the weights file (recorded in every label).
-  virtual std::string WeightsSha256() const = 0;
-  // True when predictions carry silhouettes (MeshPrediction::masks).
-  virtual bool PredictsMasks() const { return false; }
+// The network stage: the network's answer per frame in the rig's conventions. A value
+// rather than a class to derive from: the one network interface is
+// network/hand_mesh_predictor.h, pipeline/network_stage.h makes this stage from it,
+// and tests set their own `predict`.
+struct NetworkStage {
+  std::string model_name;       // recorded in provenance and logs
+  std::string weights_sha256;   // SHA-256 of the weights file (recorded in every label)
+  bool predicts_masks = false;  // predictions carry silhouettes (MeshPrediction::masks)
   // One batch; called by one thread at a time (it may use threads itself). Returns one
   // prediction per frame, in order. Throws if the whole batch fails; the runner then
   // retries the frames one by one so that one bad frame fails alone.
-  virtual std::vector<MeshPrediction> Predict(
-      const std::vector<const FrameInput*>& frames) = 0;
+  std::function<std::vector<MeshPrediction>(const std::vector<const FrameInput*>&)>
+      predict;
 };
 
 struct LabelFitRequest {
@@ -52,7 +54,7 @@ struct LabelFitRequest {
   // alone (fallback fit and the fit-only baseline).
   const MeshPrediction* init = nullptr;
   // 2D evidence, one entry per rig camera (job field evidence.keypoints_2d).
-  std::vector<std::optional<Keypoints2dView>> keypoints_2d;
+  std::vector<std::optional<Keypoints2d>> keypoints_2d;
   // Silhouettes to fit to instead of the capture's mask files, one per rig camera
   // (evidence.masks: network); empty = the fitter's own choice.
   std::vector<MaskImage> masks;

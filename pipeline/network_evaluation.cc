@@ -1,14 +1,43 @@
 #include "pipeline/network_evaluation.h"
 
 #include <chrono>
+#include <memory>
 
 #include "core/errors.h"
-#include "core/mesh_keypoints.h"
-#include "network/poem_sample_predictor.h"
 #include "core/line_plot.h"
+#include "core/mesh_keypoints.h"
+#include "network/hand_mesh_predictor.h"
 #include "network/mask_sheet.h"
 
 namespace handlabel {
+namespace {
+
+// A sample's crops as the network's input; every view takes part in triangulation.
+HandMeshInput NetworkInput(const TrainingSample& sample) {
+  HandMeshInput input;
+  for (const TrainingView& v : sample.views) {
+    HandMeshViewInput view;
+    view.pixels = v.image;
+    view.intrinsics = v.intrinsics;
+    view.cam_from_master = Rigid3::FromMatrix(v.master_from_cam.topRows<3>()).Inverse();
+    input.views.push_back(std::move(view));
+  }
+  return input;
+}
+
+// The mask grids in the row-major layout the mask metrics read (MaskIouCounts,
+// MakeMaskSheet); no joints.
+PoemPrediction MaskGrids(const HandMeshPrediction& prediction) {
+  PoemPrediction out;
+  for (const Eigen::MatrixXf& mask : prediction.masks) {
+    const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows =
+        mask;
+    out.masks.emplace_back(rows.data(), rows.data() + rows.size());
+  }
+  return out;
+}
+
+}  // namespace
 
 void NetworkEvalOptions::Check() const {
   if (weights.empty()) throw InputError("eval-network", "--weights", "a checkpoint", "");
@@ -27,23 +56,27 @@ void NetworkEvalOptions::Check() const {
 NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOptions& o,
                                       const std::function<void(int, int)>& progress) {
   o.Check();
-  PoemSamplePredictor predictor(o.weights, o.threads);
+  HandMeshPredictorOptions po;
+  po.weights = o.weights;
+  po.num_threads = o.threads;
+  po.batch_size = o.batch_size;  // one forward pass per batch of samples
+  const std::unique_ptr<HandMeshPredictor> predictor = CreateHandMeshPredictor(po);
   TrainingSampleOptions so;
-  so.crop_size = predictor.config().crop_size;
+  so.crop_size = predictor->crop_size();
   so.box_scale = o.box_scale;
   so.augment.enabled = false;
   so.augment_seed = o.synth.seed;
-  so.masks = predictor.config().mask_head;
+  so.masks = predictor->predicts_masks();
   if (!o.mask_png.empty() && !so.masks) {
     throw InputError(o.weights, "--mask-png", "weights with a mask head", "no mask head");
   }
   std::vector<TrainingSample> sheet_samples;
   std::vector<PoemPrediction> sheet_predictions;
   const SynthTrainingSamples source(hand, o.synth, so);
-  if (source.num_views() != predictor.config().num_views) {
+  if (source.num_views() != predictor->num_views()) {
     throw InputError(o.weights, "num_views",
                      std::to_string(source.num_views()) + " (the rig's views)",
-                     std::to_string(predictor.config().num_views));
+                     std::to_string(predictor->num_views()));
   }
   NetworkEvalResult r;
   MaskIouCounts mask_iou;
@@ -51,30 +84,33 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   for (int first = 0; first < o.frames; first += o.batch_size) {
     const std::vector<TrainingSample> samples =
         SampleRange(source, first, std::min(o.frames, first + o.batch_size));
+    std::vector<HandMeshInput> inputs;
+    for (const TrainingSample& s : samples) inputs.push_back(NetworkInput(s));
     const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<PoemPrediction> pred = predictor.Predict(samples);
+    const std::vector<HandMeshPrediction> pred = predictor->Predict(inputs);
     r.seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (size_t i = 0; i < samples.size(); ++i) {
       const int f = first + static_cast<int>(i);
       const TrainingSample& s = samples[i];
       if (vertex_errors.size() == 0) vertex_errors.resize(o.frames, s.vertices_3d.rows());
-      joint_errors.row(f) = PointErrors(pred[i].joints_3d, s.joints_3d).transpose();
-      vertex_errors.row(f) = PointErrors(pred[i].vertices_3d, s.vertices_3d).transpose();
-      r.pa_mpjpe_mm += 1000 * ProcrustesMeanPointError(pred[i].joints_3d, s.joints_3d);
-      r.pa_mpvpe_mm +=
-          1000 * ProcrustesMeanPointError(pred[i].vertices_3d, s.vertices_3d);
+      const Points3d joints = pred[i].joints;
+      joint_errors.row(f) = PointErrors(joints, s.joints_3d).transpose();
+      vertex_errors.row(f) = PointErrors(pred[i].vertices, s.vertices_3d).transpose();
+      r.pa_mpjpe_mm += 1000 * ProcrustesMeanPointError(joints, s.joints_3d);
+      r.pa_mpvpe_mm += 1000 * ProcrustesMeanPointError(pred[i].vertices, s.vertices_3d);
       r.mpjpe_from_mesh_mm +=
           1000 *
-          PointErrors(KeypointsFromMeshVertices(hand, pred[i].vertices_3d), s.joints_3d)
+          PointErrors(KeypointsFromMeshVertices(hand, pred[i].vertices), s.joints_3d)
               .mean();
       r.true_mesh_keypoint_gap_mm +=
           1000 *
           PointErrors(KeypointsFromMeshVertices(hand, s.vertices_3d), s.joints_3d).mean();
-      mask_iou.Add(pred[i], s);
+      const PoemPrediction grids = MaskGrids(pred[i]);
+      mask_iou.Add(grids, s);
       if (!o.mask_png.empty() && f < o.mask_png_frames) {
         sheet_samples.push_back(s);
-        sheet_predictions.push_back(pred[i]);
+        sheet_predictions.push_back(grids);
       }
     }
     r.frames += static_cast<int>(samples.size());

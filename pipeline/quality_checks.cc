@@ -22,7 +22,7 @@ int CountNonFinite(const MeshPrediction& p) {
   int bad = 0;
   bad += static_cast<int>((!p.vertices.array().isFinite()).count());
   bad += static_cast<int>((!p.keypoints.array().isFinite()).count());
-  for (const Keypoints2dView& view : p.keypoints_2d) {
+  for (const Keypoints2d& view : p.keypoints_2d) {
     bad += static_cast<int>((!view.uv_px.array().isFinite()).count());
     bad += static_cast<int>((!view.confidence.array().isFinite()).count());
   }

@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "core/capsule_hand.h"
 #include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -36,8 +36,8 @@ TEST(ContactSheet, TilesEveryViewAndDrawsKeypointsWhereTheyAre) {
   // The wrist dot (red, filled when visible) of camera 0 sits at its keypoint.
   const ViewKeypoints kp = capture.ReadKeypoints(0)[0];
   ASSERT_EQ(kp.visibility[0], 2);
-  const int x = 4 + static_cast<int>(std::lround(kp.keypoints(0, 0)));
-  const int y = 4 + static_cast<int>(std::lround(kp.keypoints(0, 1)));
+  const int x = 4 + static_cast<int>(std::lround(kp.keypoints.uv_px(0, 0)));
+  const int y = 4 + static_cast<int>(std::lround(kp.keypoints.uv_px(0, 1)));
   EXPECT_EQ(sheet.at(x, y, 0), 255);
   EXPECT_EQ(sheet.at(x, y, 1), 60);
   // Crops are square tiles.

@@ -11,9 +11,9 @@
 #include <fstream>
 #include <functional>
 
+#include "core/capsule_hand.h"
 #include "core/errors.h"
 #include "core/image_file.h"
-#include "core/capsule_hand.h"
 #include "tests/capture/dexycb_fixture.h"
 #include "tests/test_util.h"
 
@@ -47,7 +47,7 @@ TEST(DexYcbFrameSource, LoadsTheRigImagesKeypointsAndTruthThatWereWritten) {
       WriteDexYcbFixture(testing::ScratchDir(), MakeCapsuleHand(HandSide::kRight));
   const DexYcbFrameSource source(fx.sequence);
   EXPECT_EQ(source.FrameIds(), (std::vector<std::string>{"000000", "000001", "000002"}));
-  EXPECT_EQ(source.Side(), HandSide::kRight);
+  EXPECT_EQ(source.side(), HandSide::kRight);
   EXPECT_THAT(source.Describe(), HasSubstr("4 cameras, 3 frames"));
   int worst_level = 0;
   for (int f = 0; f < 3; ++f) {
@@ -102,7 +102,7 @@ TEST(DexYcbFrameSource, WithoutLabelsFilesThereIsNoEvidenceOrTruth) {
   const DexYcbFixture fx =
       WriteDexYcbFixture(testing::ScratchDir(), MakeCapsuleHand(HandSide::kLeft), o);
   const DexYcbFrameSource source(fx.sequence);
-  EXPECT_EQ(source.Side(), HandSide::kLeft);
+  EXPECT_EQ(source.side(), HandSide::kLeft);
   const FrameInput frame = source.Load("000000");
   EXPECT_EQ(frame.image_paths.size(), 4u);
   EXPECT_TRUE(frame.keypoints_2d.empty());

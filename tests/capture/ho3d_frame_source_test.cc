@@ -12,12 +12,12 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
+#include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
 #include "core/errors.h"
 #include "core/image_file.h"
-#include "core/capsule_hand.h"
-#include "capture/synth_capture.h"
-#include "tests/core/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/capture/ho3d_fixture.h"
+#include "tests/core/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -31,7 +31,7 @@ TEST(Ho3dFrameSource, LoadsTheRigImagesAndTruthThatWereWritten) {
   const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir());
   const Ho3dFrameSource source(fx.split + "/ABF1");
   EXPECT_EQ(source.FrameIds(), (std::vector<std::string>{"0000", "0001"}));
-  EXPECT_EQ(source.Side(), HandSide::kRight);
+  EXPECT_EQ(source.side(), HandSide::kRight);
   EXPECT_THAT(source.Describe(), HasSubstr("3 cameras, 2 frames"));
   for (int f = 0; f < 2; ++f) {
     const FrameInput frame = source.Load(Fid(f));

@@ -11,13 +11,13 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
+#include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
 #include "core/errors.h"
 #include "core/image.h"
 #include "core/image_file.h"
-#include "core/capsule_hand.h"
-#include "capture/synth_capture.h"
-#include "tests/core/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/capture/oakink_fixture.h"
+#include "tests/core/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -31,7 +31,7 @@ TEST(OakInkFrameSource, LoadsTheRigImagesAndTruthThatWereWritten) {
   const OakInkFixture fx = WriteOakInkFixture(testing::ScratchDir());
   const OakInkFrameSource source(fx.image_dir);
   EXPECT_EQ(source.FrameIds(), fx.ids);
-  EXPECT_EQ(source.Side(), HandSide::kRight);
+  EXPECT_EQ(source.side(), HandSide::kRight);
   for (size_t f = 0; f < fx.ids.size(); ++f) {
     const FrameInput frame = source.Load(fx.ids[f]);
     ASSERT_EQ(frame.rig.size(), 4u);

@@ -7,11 +7,11 @@
 #include <iterator>
 #include <map>
 
+#include "capture/capture_reader.h"
+#include "core/capsule_hand.h"
 #include "core/errors.h"
 #include "core/hand_model_io.h"
 #include "core/mesh_primitives.h"
-#include "core/capsule_hand.h"
-#include "capture/capture_reader.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -63,8 +63,8 @@ TEST(SynthCapture, StoredKeypointsAreTheGroundTruthJointsProjectedWithTheStoredR
       for (int k = 0; k < kNumHandKeypoints; ++k) {
         Eigen::Vector2d uv;
         ASSERT_TRUE(reader.rig()[c].ProjectWorld(gt.keypoints.row(k).transpose(), &uv));
-        EXPECT_NEAR(views[c].keypoints(k, 0), uv.x(), 1e-9);
-        EXPECT_NEAR(views[c].keypoints(k, 1), uv.y(), 1e-9);
+        EXPECT_NEAR(views[c].keypoints.uv_px(k, 0), uv.x(), 1e-9);
+        EXPECT_NEAR(views[c].keypoints.uv_px(k, 1), uv.y(), 1e-9);
         EXPECT_EQ(views[c].visibility[k] == kOutOfFrame,
                   !reader.rig()[c].camera.InImage(uv));
         visible += views[c].visibility[k] == kVisible;
@@ -273,11 +273,13 @@ TEST(SynthCapture, ReaderReturnsExactlyWhatTheGeneratorMade) {
       EXPECT_EQ(reader.ReadMask(f, c).data, frame.views[c].hand_mask.data);
       EXPECT_EQ(reader.ReadDetectionMask(f, c).data, frame.detections[c].mask.data);
       for (int k = 0; k < kNumHandKeypoints; ++k) {
-        EXPECT_EQ(det[c].confidence[k], frame.detections[c].confidence[k]);
-        if (det[c].confidence[k] > 0) {
-          EXPECT_EQ(det[c].keypoints(k, 0), frame.detections[c].keypoints(k, 0));
+        EXPECT_EQ(det[c].keypoints.confidence[k],
+                  frame.detections[c].keypoints.confidence[k]);
+        if (det[c].keypoints.confidence[k] > 0) {
+          EXPECT_EQ(det[c].keypoints.uv_px(k, 0),
+                    frame.detections[c].keypoints.uv_px(k, 0));
         } else {
-          EXPECT_TRUE(std::isnan(det[c].keypoints(k, 0)));
+          EXPECT_TRUE(std::isnan(det[c].keypoints.uv_px(k, 0)));
         }
       }
     }

@@ -183,8 +183,8 @@ TEST(SynthDetections, NoiseFreeDetectionsEqualTheGroundTruthAndNoiseHasItsSigma)
   EXPECT_EQ(clean.mask.data, view.hand_mask.data);
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     if (view.visibility[k] == kOutOfFrame) continue;
-    EXPECT_EQ(clean.keypoints(k, 0), view.keypoints(k, 0));
-    EXPECT_GT(clean.confidence[k], 0.19);
+    EXPECT_EQ(clean.keypoints.uv_px(k, 0), view.keypoints(k, 0));
+    EXPECT_GT(clean.keypoints.confidence[k], 0.19);
   }
   // Noise: the spread of visible-keypoint errors is sigma.
   DetectionNoiseOptions noisy = exact;
@@ -195,7 +195,7 @@ TEST(SynthDetections, NoiseFreeDetectionsEqualTheGroundTruthAndNoiseHasItsSigma)
     const ViewDetections d = SimulateDetections(view, noisy, TestRng());
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       if (view.visibility[k] != kVisible) continue;
-      sum2 += (d.keypoints.row(k) - view.keypoints.row(k)).squaredNorm() / 2;
+      sum2 += (d.keypoints.uv_px.row(k) - view.keypoints.row(k)).squaredNorm() / 2;
       ++n;
     }
   }
@@ -206,8 +206,8 @@ TEST(SynthDetections, NoiseFreeDetectionsEqualTheGroundTruthAndNoiseHasItsSigma)
   drop.dropout_rate = drop.occluded_dropout_rate = 1.0;
   const ViewDetections none = SimulateDetections(view, drop, TestRng());
   for (int k = 0; k < kNumHandKeypoints; ++k) {
-    EXPECT_EQ(none.confidence[k], 0.0);
-    EXPECT_TRUE(std::isnan(none.keypoints(k, 0)));
+    EXPECT_EQ(none.keypoints.confidence[k], 0.0);
+    EXPECT_TRUE(std::isnan(none.keypoints.uv_px(k, 0)));
   }
 }
 

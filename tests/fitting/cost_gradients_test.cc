@@ -143,8 +143,8 @@ TEST_F(CostGradientsTest, KeypointReprojectionAutodiff) {
 
 TEST_F(CostGradientsTest, KeypointReprojectionAnalyticMatchesAutodiff) {
   std::vector<KeypointView> views = frame_.views;
-  views[1].confidence[3] = 0.0;  // a missing detection
-  views[2].confidence[4] = 0.3;
+  views[1].keypoints.confidence[3] = 0.0;  // a missing detection
+  views[2].keypoints.confidence[4] = 0.3;
   for (RobustLossType type :
        {RobustLossType::kTrivial, RobustLossType::kHuber, RobustLossType::kCauchy}) {
     const RobustLoss loss{type, 1.5};

@@ -70,8 +70,8 @@ inline SceneFrame RandomSceneFrame(const HandModel& model, std::mt19937_64& rng,
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       Eigen::Vector2d uv;
       const bool ok = cam.ProjectWorld(f.mesh.keypoints.row(k).transpose(), &uv);
-      view.uv_px.row(k) = uv.transpose();
-      view.confidence[k] = ok ? 1.0 : 0.0;
+      view.keypoints.uv_px.row(k) = uv.transpose();
+      view.keypoints.confidence[k] = ok ? 1.0 : 0.0;
     }
     f.views.push_back(view);
   }
@@ -88,15 +88,15 @@ inline void CorruptViews(std::vector<KeypointView>* views, double sigma_px,
   for (KeypointView& view : *views) {
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       if (u(rng) < outlier_fraction) {
-        view.uv_px(k, 0) = view.camera.camera.width() * u(rng);
-        view.uv_px(k, 1) = view.camera.camera.height() * u(rng);
+        view.keypoints.uv_px(k, 0) = view.camera.camera.width() * u(rng);
+        view.keypoints.uv_px(k, 1) = view.camera.camera.height() * u(rng);
       } else {
-        view.uv_px(k, 0) += g(rng);
-        view.uv_px(k, 1) += g(rng);
+        view.keypoints.uv_px(k, 0) += g(rng);
+        view.keypoints.uv_px(k, 1) += g(rng);
       }
     }
   }
-  for (int v : occluded) (*views)[v].confidence.setZero();
+  for (int v : occluded) (*views)[v].keypoints.confidence.setZero();
 }
 
 }  // namespace handlabel::testing

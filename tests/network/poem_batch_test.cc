@@ -34,7 +34,7 @@ TEST(PoemBatch, TargetsFromEigenAndOneTrainStep) {
   g.joints.col(2).setConstant(0.6);
   g.vertices =
       Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>::Constant(778, 3, 0.6);
-  g.joints_2d = {Keypoints2::Constant(30), Keypoints2::Constant(20)};
+  g.joints_2d = {KeypointPixels::Constant(30), KeypointPixels::Constant(20)};
   g.view_weights = {1, 0};
   const PoemTargets t = MakePoemTargets({g}, 0, 1, c);
   EXPECT_FLOAT_EQ(t.joints_3d[0][4][2].item<float>(), 0.6f);

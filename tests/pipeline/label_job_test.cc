@@ -80,7 +80,7 @@ TEST(LabelJob, FallbackModeKeepsGoodNetworkAnswersAndFitsTheOthers) {
   EXPECT_TRUE(good.quality.Passed());
   EXPECT_EQ(good.provenance.network_model, "test-predictor");
   EXPECT_EQ(good.provenance.job_hash,
-            JobHash(MakeJob(out, RefineMode::kFallback), s.predictor.WeightsSha256()));
+            JobHash(MakeJob(out, RefineMode::kFallback), s.predictor.weights_sha256));
   EXPECT_TRUE(fs::exists(MeshFilePath(out, "000003", "ply")));
   // The network's answer is the ground truth on good frames: zero error, full AUC.
   EXPECT_NEAR(summary.metrics.at("network").at("mpjpe_mm").Mean(), 0.0, 1e-9);
@@ -246,7 +246,7 @@ TEST(LabelJob, ShardsPartitionTheFramesAndTheirMergeEqualsOneProcess) {
   }
   EXPECT_EQ(s.capture.loads.load(), 12);  // every frame exactly once
   const std::vector<std::string> frames = s.capture.FrameIds();
-  const std::string hash = JobHash(sharded, s.predictor.WeightsSha256());
+  const std::string hash = JobHash(sharded, s.predictor.weights_sha256);
   const LabelSummary merged = MergeLabelOutputs(root + "/sharded", "test", hash, frames);
   EXPECT_EQ(merged.ok, 12);
   EXPECT_EQ(testing::ReadFileBytes(ManifestPath(root + "/sharded")),

@@ -42,9 +42,8 @@ inline Rig MakeFourCameraRig() {
   return rig;
 }
 
-inline Keypoints2dView ProjectKeypoints(const RigCamera& camera,
-                                        const Points3d& keypoints) {
-  Keypoints2dView view;
+inline Keypoints2d ProjectKeypoints(const RigCamera& camera, const Points3d& keypoints) {
+  Keypoints2d view;
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     Eigen::Vector2d uv;
     camera.ProjectWorld(keypoints.row(k).transpose(), &uv);
@@ -114,12 +113,16 @@ class TestCapture : public FrameSource {
 
 // The ground truth, with a 3 cm error on frames in `shifted` (fails quality checks) and
 // an exception for frames in `throws`.
-class TestPredictor : public MeshPredictor {
+class TestPredictor : public NetworkStage {
  public:
-  std::string ModelName() const override { return "test-predictor"; }
-  std::string WeightsSha256() const override { return std::string(64, 'a'); }
-  std::vector<MeshPrediction> Predict(
-      const std::vector<const FrameInput*>& frames) override {
+  TestPredictor() {
+    model_name = "test-predictor";
+    weights_sha256 = std::string(64, 'a');
+    predict = [this](const std::vector<const FrameInput*>& frames) {
+      return Predict(frames);
+    };
+  }
+  std::vector<MeshPrediction> Predict(const std::vector<const FrameInput*>& frames) {
     ++batches;
     std::vector<MeshPrediction> out;
     for (const FrameInput* frame : frames) {

@@ -3,22 +3,22 @@
 // 2D answers are the network's crop pixels seen through the real cameras; and moving
 // the whole rig moves the 3D answers with it and leaves the 2D ones alone.
 
-#include "pipeline/poem_mesh_predictor.h"
+#include "pipeline/network_stage.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
+#include "capture/native_frame_source.h"
 #include "core/image_file.h"
 #include "network/poem_config.h"
-#include "capture/native_frame_source.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
 namespace {
 
-class PoemMeshPredictorTest : public ::testing::Test {
+class NetworkStageTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const std::string dir = testing::ScratchDir();
@@ -34,9 +34,9 @@ class PoemMeshPredictorTest : public ::testing::Test {
   FrameInput frame_;
 };
 
-TEST_F(PoemMeshPredictorTest, AnswersAreTheNetworksInTheRigsFrames) {
-  PoemMeshPredictor stage(weights_, 1, 1);
-  const MeshPrediction p = stage.Predict({&frame_}).at(0);
+TEST_F(NetworkStageTest, AnswersAreTheNetworksInTheRigsFrames) {
+  const NetworkStage stage = LoadNetworkStage(weights_, 1, 1);
+  const MeshPrediction p = stage.predict({&frame_}).at(0);
 
   // The wrapped network on the same crops.
   HandMeshPredictorOptions options;
@@ -52,10 +52,7 @@ TEST_F(PoemMeshPredictorTest, AnswersAreTheNetworksInTheRigsFrames) {
     const ImageU8 image = ReadImageFile(frame_.image_paths[v]);
     HandEvidence evidence;
     ASSERT_TRUE(frame_.keypoints_2d.at(v).has_value());
-    for (int k = 0; k < kNumHandKeypoints; ++k) {
-      evidence.keypoints.push_back(frame_.keypoints_2d[v]->uv_px.row(k).transpose());
-      evidence.confidences.push_back(frame_.keypoints_2d[v]->confidence(k));
-    }
+    evidence.keypoints = frame_.keypoints_2d[v];
     crops.push_back(CropForView({image.width, image.height, image.data.data()},
                                 rig[v].camera, evidence, crop_options));
     HandMeshViewInput view;
@@ -81,16 +78,17 @@ TEST_F(PoemMeshPredictorTest, AnswersAreTheNetworksInTheRigsFrames) {
       const Eigen::Vector3d ray =
           rig[v].camera.Unproject(p.keypoints_2d[v].uv_px.row(k).transpose());
       const Eigen::Vector3d crop = crops[v].intrinsics * ray;
-      EXPECT_NEAR(crop.x() / crop.z(), raw.joints_2d[v](k, 0), 1e-6) << v << "," << k;
-      EXPECT_NEAR(crop.y() / crop.z(), raw.joints_2d[v](k, 1), 1e-6) << v << "," << k;
-      EXPECT_DOUBLE_EQ(p.keypoints_2d[v].confidence(k), raw.joint_confidence[v](k));
+      const Keypoints2d& raw_2d = raw.joints_2d[v];
+      EXPECT_NEAR(crop.x() / crop.z(), raw_2d.uv_px(k, 0), 1e-6) << v << "," << k;
+      EXPECT_NEAR(crop.y() / crop.z(), raw_2d.uv_px(k, 1), 1e-6) << v << "," << k;
+      EXPECT_DOUBLE_EQ(p.keypoints_2d[v].confidence(k), raw_2d.confidence(k));
     }
   }
 }
 
-TEST_F(PoemMeshPredictorTest, MovingTheRigMovesTheAnswerWithIt) {
-  PoemMeshPredictor stage(weights_, 1, 1);
-  const MeshPrediction a = stage.Predict({&frame_}).at(0);
+TEST_F(NetworkStageTest, MovingTheRigMovesTheAnswerWithIt) {
+  const NetworkStage stage = LoadNetworkStage(weights_, 1, 1);
+  const MeshPrediction a = stage.predict({&frame_}).at(0);
   // new_world = T * world: every camera sees the same, the world frame moved.
   const Rigid3 T(
       Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())),
@@ -99,7 +97,7 @@ TEST_F(PoemMeshPredictorTest, MovingTheRigMovesTheAnswerWithIt) {
   for (size_t v = 0; v < moved.rig.size(); ++v) {
     moved.rig[v].cam_from_world = moved.rig[v].cam_from_world * T.Inverse();
   }
-  const MeshPrediction b = stage.Predict({&moved}).at(0);
+  const MeshPrediction b = stage.predict({&moved}).at(0);
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     const Eigen::Vector3d expected = T * Eigen::Vector3d(a.keypoints.row(k).transpose());
     EXPECT_LT((expected - b.keypoints.row(k).transpose()).norm(), 1e-6) << k;

@@ -1,0 +1,136 @@
+#include "pipeline/network_stage.h"
+
+#include <filesystem>
+#include <memory>
+
+#include "core/errors.h"
+#include "core/image.h"
+#include "core/image_file.h"
+#include "core/sha256.h"
+
+namespace handlabel {
+namespace {
+
+// Points from the master camera's frame to the world frame.
+Points3d ToWorld(const Rigid3& world_from_master, const Points3d& points) {
+  Points3d out(points.rows(), 3);
+  for (int i = 0; i < points.rows(); ++i) {
+    out.row(i) = (world_from_master * points.row(i).transpose()).transpose();
+  }
+  return out;
+}
+
+// A crop pixel is a ray of the view's camera (same rotation, pinhole K_crop);
+// projecting that ray with the real camera gives the full-image pixel.
+Keypoints2d CropKeypointsToImage(const Keypoints2d& in_crop, const ViewCrop& crop,
+                                 const Camera& camera) {
+  Keypoints2d out;
+  const Eigen::Matrix3d crop_from_ray = crop.intrinsics;
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const Eigen::Vector3d ray =
+        crop_from_ray.inverse() *
+        Eigen::Vector3d(in_crop.uv_px(k, 0), in_crop.uv_px(k, 1), 1.0);
+    Eigen::Vector2d uv;
+    const bool in_front = camera.Project(ray, &uv);
+    out.uv_px.row(k) = uv.transpose();
+    out.confidence(k) = in_front && crop.hand_visible ? in_crop.confidence(k) : 0.0;
+  }
+  return out;
+}
+
+}  // namespace
+
+HandMeshInput CropFrameForNetwork(const FrameInput& frame, int num_views,
+                                  const HandCropOptions& crop,
+                                  std::vector<ViewCrop>* crops) {
+  const Rig& rig = frame.rig;
+  if (static_cast<int>(rig.size()) != num_views) {
+    throw InputError(frame.id, "cameras",
+                     std::to_string(num_views) + " views for this network",
+                     std::to_string(rig.size()));
+  }
+  HandMeshInput input;
+  crops->clear();
+  for (size_t v = 0; v < rig.size(); ++v) {
+    const ImageU8 image = ReadImageFile(frame.image_paths.at(v));
+    if (image.channels != 3) {
+      throw InputError(frame.image_paths[v], "channels", "an RGB image",
+                       std::to_string(image.channels));
+    }
+    HandEvidence evidence;
+    if (!frame.keypoints_2d.empty()) evidence.keypoints = frame.keypoints_2d[v];
+    ViewCrop view_crop = CropForView({image.width, image.height, image.data.data()},
+                                     rig[v].camera, evidence, crop);
+    HandMeshViewInput view;
+    view.pixels = std::move(view_crop.pixels);
+    view.intrinsics = view_crop.intrinsics;
+    view.cam_from_master = rig[v].cam_from_world * rig[0].cam_from_world.Inverse();
+    view.weight = view_crop.hand_visible ? 1.0 : 0.0;
+    input.views.push_back(std::move(view));
+    crops->push_back(std::move(view_crop));
+  }
+  return input;
+}
+
+MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& frame,
+                               const std::vector<ViewCrop>& crops, int crop_size) {
+  const Rig& rig = frame.rig;
+  const Rigid3 world_from_master = rig[0].cam_from_world.Inverse();
+  MeshPrediction p;
+  p.keypoints = ToWorld(world_from_master, out.joints);
+  p.vertices = ToWorld(world_from_master, out.vertices);
+  for (size_t v = 0; v < rig.size(); ++v) {
+    p.keypoints_2d.push_back(
+        CropKeypointsToImage(out.joints_2d[v], crops[v], rig[v].camera));
+    if (out.masks.empty()) continue;
+    const int cell = crop_size / static_cast<int>(out.masks[v].rows());
+    MaskImage mask =
+        CropMaskToImage(out.masks[v], cell, crops[v].intrinsics, rig[v].camera);
+    // An empty prediction says "no hand here", which the silhouette term would
+    // enforce; treat it as no evidence instead (the keypoints decide).
+    if ((mask.array() == 0).all()) mask = MaskImage();
+    p.masks.push_back(std::move(mask));
+  }
+  return p;
+}
+
+std::vector<MeshPrediction> PredictFramesInRig(
+    HandMeshPredictor& network, const std::vector<const FrameInput*>& frames) {
+  HandCropOptions crop;
+  crop.crop_size = network.crop_size();
+  std::vector<HandMeshInput> inputs;
+  std::vector<std::vector<ViewCrop>> crops(frames.size());
+  for (size_t f = 0; f < frames.size(); ++f) {
+    inputs.push_back(
+        CropFrameForNetwork(*frames[f], network.num_views(), crop, &crops[f]));
+  }
+  const std::vector<HandMeshPrediction> outputs = network.Predict(inputs);
+  HL_CHECK(outputs.size() == frames.size(), "one prediction per frame");
+  std::vector<MeshPrediction> predictions;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    predictions.push_back(
+        PredictionInRig(outputs[f], *frames[f], crops[f], network.crop_size()));
+  }
+  return predictions;
+}
+
+NetworkStage LoadNetworkStage(const std::string& weights, int batch_size,
+                              int num_threads) {
+  HandMeshPredictorOptions options;
+  options.weights = weights;
+  options.batch_size = batch_size;
+  options.num_threads = num_threads;
+  // Shared: std::function needs a copyable callable.
+  std::shared_ptr<HandMeshPredictor> network = CreateHandMeshPredictor(options);
+  NetworkStage stage;
+  stage.model_name =
+      network->name() + " (" + std::filesystem::path(weights).filename().string() + ")";
+  stage.weights_sha256 = Sha256OfFile(weights);
+  stage.predicts_masks = network->predicts_masks();
+  stage.predict = [network](const std::vector<const FrameInput*>& frames) {
+    return PredictFramesInRig(*network, frames);
+  };
+  return stage;
+}
+
+}  // namespace handlabel
