@@ -11,7 +11,7 @@
 #include "core/errors.h"
 #include "core/hand_model_io.h"
 #include "pipeline/network_evaluation.h"
-#include "pipeline/progress.h"
+#include "core/progress.h"
 #include "pipeline/train_config.h"
 
 namespace handlabel {

@@ -7,7 +7,7 @@
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_stage_factory.h"
-#include "pipeline/progress.h"
+#include "core/progress.h"
 #include "pipeline/shard.h"
 
 namespace handlabel {

@@ -8,7 +8,7 @@
 #include "capture/capture_reader.h"
 #include "capture/contact_sheet.h"
 #include "pipeline/hand_model_source.h"
-#include "pipeline/progress.h"
+#include "core/progress.h"
 #include "capture/synth_capture.h"
 
 namespace handlabel {

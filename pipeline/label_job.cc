@@ -20,7 +20,7 @@
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
-#include "pipeline/progress.h"
+#include "core/progress.h"
 
 namespace handlabel {
 namespace {

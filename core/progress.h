@@ -1,5 +1,5 @@
 #pragma once
-// Progress of a labeling run on stderr: on a terminal a bar redrawn in place with
+// Progress of a long run (labeling, synthesis, evaluation) on stderr: on a terminal a bar redrawn in place with
 // frames/s and ETA; otherwise (cluster logs, pipes) one plain line per ~5 % of the
 // frames, so logs stay short and greppable. Thread-safe.
 
