@@ -15,6 +15,7 @@
 #include "core/errors.h"
 #include "core/image_file.h"
 #include "tests/capture/dexycb_fixture.h"
+#include "tests/image_difference.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -26,21 +27,7 @@ using testing::DexYcbFixtureOptions;
 using ::testing::HasSubstr;
 using testing::WriteDexYcbFixture;
 
-// Mean and largest absolute channel difference.
-std::pair<double, int> ImageDifference(const ImageU8& a, const ImageU8& b) {
-  EXPECT_EQ(a.width, b.width);
-  EXPECT_EQ(a.height, b.height);
-  EXPECT_EQ(a.channels, b.channels);
-  if (a.data.size() != b.data.size()) return {1e9, 255};
-  double sum = 0;
-  int worst = 0;
-  for (size_t i = 0; i < a.data.size(); ++i) {
-    const int d = std::abs(int(a.data[i]) - int(b.data[i]));
-    sum += d;
-    worst = std::max(worst, d);
-  }
-  return {sum / a.data.size(), worst};
-}
+using testing::ImageDifference;
 
 TEST(DexYcbFrameSource, LoadsTheRigImagesKeypointsAndTruthThatWereWritten) {
   const DexYcbFixture fx =

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "core/errors.h"
+#include "tests/image_difference.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -34,16 +35,7 @@ ImageU8 TestImage(int w, int h, int channels) {
   return image;
 }
 
-std::pair<double, int> Difference(const ImageU8& a, const ImageU8& b) {
-  double sum = 0;
-  int worst = 0;
-  for (size_t i = 0; i < a.data.size(); ++i) {
-    const int d = std::abs(int(a.data[i]) - int(b.data[i]));
-    sum += d;
-    worst = std::max(worst, d);
-  }
-  return {sum / a.data.size(), worst};
-}
+using testing::ImageDifference;
 
 std::string ErrorOf(const std::string& path) {
   try {
@@ -65,7 +57,7 @@ TEST(ImageFile, JpegRoundTripKeepsSizeLayoutAndPixelsWithinQuality) {
     ASSERT_EQ(back.width, 37);
     ASSERT_EQ(back.height, 23);
     ASSERT_EQ(back.channels, channels);
-    const auto [mean, worst] = Difference(back, image);
+    const auto [mean, worst] = ImageDifference(back, image);
     EXPECT_LT(mean, 1.0) << channels;
     EXPECT_LE(worst, 4) << channels;
     // Lower quality is lossier, but still the same picture.
@@ -73,7 +65,7 @@ TEST(ImageFile, JpegRoundTripKeepsSizeLayoutAndPixelsWithinQuality) {
     low.quality = 60;
     low.full_chroma = false;
     WriteJpeg(dir + "/b.jpg", image, low);
-    const auto [low_mean, low_worst] = Difference(ReadJpeg(dir + "/b.jpg"), image);
+    const auto [low_mean, low_worst] = ImageDifference(ReadJpeg(dir + "/b.jpg"), image);
     EXPECT_GT(low_mean, mean);
     EXPECT_LT(low_mean, 8.0);
     EXPECT_LT(std::filesystem::file_size(dir + "/b.jpg"),
