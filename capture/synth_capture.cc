@@ -12,10 +12,11 @@
 #include "calib/colmap_model.h"
 #include "calib/colmap_rig.h"
 #include "calib/rig_json.h"
-#include "core/errors.h"
-#include "core/atomic_file.h"
-#include "core/version.h"
 #include "capture/capture_format.h"
+#include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/random.h"
+#include "core/version.h"
 
 namespace handlabel {
 namespace {
@@ -23,13 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 
 enum Stream : uint64_t { kSceneStream = 1, kBackgroundStream = 2, kDetectionStream = 3 };
-
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
 
 // Frame files are plain writes (no fsync): the manifest, written atomically last,
 // is what marks a capture complete.
@@ -66,10 +60,6 @@ void SynthCaptureOptions::Check() const {
     throw InputError("synth options", "png.compression_level", "0..9",
                      std::to_string(png.compression_level));
   }
-}
-
-uint64_t MixSeed(uint64_t seed, uint64_t frame, uint64_t stream) {
-  return SplitMix64(SplitMix64(SplitMix64(seed) ^ frame) ^ stream);
 }
 
 SynthGenerator::SynthGenerator(const HandModel& model, Rig rig,
