@@ -14,6 +14,7 @@
 #include "core/errors.h"
 #include "core/image_file.h"
 #include "core/capsule_hand.h"
+#include "capture/ho3d_frame_source.h"
 #include "capture/synth_capture.h"
 #include "tests/core/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/test_util.h"

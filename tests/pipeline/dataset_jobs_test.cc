@@ -24,6 +24,13 @@ namespace {
 using ::testing::HasSubstr;
 using namespace testing;  // the fixtures
 
+// DexYCB frame ids name subject, sequence and frame; their label files are file-name
+// safe.
+TEST(DexYcbJob, LabelFileNamesOfSequenceFrameIds) {
+  EXPECT_EQ(LabelFilePath("out", "20200709-subject-01/20200709_142123/000000"),
+            "out/labels/20200709-subject-01__20200709_142123__000000.json");
+}
+
 // The whole job from a YAML file: fit-only from the labels' 2D keypoints, evaluated
 // against their joint_3d, overlays drawn on the JPEGs.
 TEST(DexYcbJob, LabelJobFitsTheLabelsKeypointsAndEvaluatesAgainstJoint3d) {
