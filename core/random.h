@@ -24,7 +24,9 @@ uint64_t SplitMix64(uint64_t x);
 uint64_t MixSeed(uint64_t seed, uint64_t frame, uint64_t stream);
 
 // 64-bit FNV-1a of the bytes of `text`: a string hash that is the same on every
-// compiler and platform (std::hash is not).
+// compiler and platform (std::hash is not). The offset basis is 1469598103934665603,
+// FNV's standard 14695981039346656037 without its last digit, as the frame seeds have
+// always used; kept, since every label's seed depends on it.
 uint64_t Fnv1a64(std::string_view text);
 
 }  // namespace handlabel
