@@ -98,7 +98,7 @@ TEST(LabelRecord, FrameIdsBecomeSafeFileNames) {
 
 TEST(LabelRecord, MeshFilesReadBackWithOpenMesh) {
   const LabelRecord label = MakeLabel();
-  // The stick hand has one face; a fan over all vertices makes a real test.
+  // A fan over all vertices: every face is known (face 3 is 0, 4, 5).
   Faces faces(label.mesh.vertices.rows() - 2, 3);
   for (int f = 0; f < faces.rows(); ++f) faces.row(f) << 0, f + 1, f + 2;
   const std::string out = testing::ScratchDir();
