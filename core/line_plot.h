@@ -1,7 +1,7 @@
 #pragma once
 // Line plots drawn in software on core/image (no plotting library, no Python): axes with
-// tick labels in the built-in 5x7 pixel font (core/draw.h), one polyline per series, a legend.
-// Used for training curves (loss.png) and PCK curves.
+// tick labels in the built-in 5x7 pixel font (core/draw.h), one polyline per series, a
+// legend. Used for training curves (loss.png) and PCK curves.
 
 #include <array>
 #include <cstdint>
