@@ -1,4 +1,5 @@
-// `handlabel calib board|colmap`: calibrate a rig from board images or by SfM.
+// `handlabel calib board|render-board|colmap`: calibrate a rig from board images or by
+// SfM, or render a synthetic board capture to try board calibration without a rig.
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -132,6 +133,103 @@ int RunCalibRenderBoard(int argc, char** argv) {
   });
 }
 
+// The command line of `handlabel calib colmap`.
+struct ColmapFlags {
+  std::string images, out = "sfm_out", model = "OPENCV", scale;
+  std::string board_spec, board_images, world = "camera";
+  ColmapSfmOptions options;
+};
+
+void AddColmapOptions(CLI::App* app, ColmapFlags* f) {
+  app->add_option("--images", f->images,
+                  "folder with one sub-folder of images per camera")
+      ->required();
+  app->add_option("--out", f->out, "output folder (created)")->capture_default_str();
+  app->add_option("--model", f->model, "COLMAP camera model for every camera")
+      ->capture_default_str();
+  app->add_option("--scale", f->scale,
+                  "CAM_A,CAM_B,METRES: known distance between two camera centres");
+  app->add_option("--board", f->board_spec,
+                  "board for the scale, e.g. charuco:11x8:0.03:0.022 (docs/cameras.md)");
+  app->add_option(
+      "--board-images", f->board_images,
+      "folder with <camera>/<frame> images of the board (cameras named as the "
+      "--images folders; only cameras that see it)");
+  app->add_option("--world", f->world, "camera (the master) or board (needs --board)")
+      ->check(CLI::IsMember({"camera", "board"}))
+      ->capture_default_str();
+  app->add_option("--master", f->options.master,
+                  "world = this camera (default: the first)");
+  app->add_option("--colmap", f->options.colmap, "the colmap binary")
+      ->capture_default_str();
+  app->add_option("--threads", f->options.num_threads, "threads for COLMAP")
+      ->capture_default_str();
+}
+
+// --scale CAM_A,CAM_B,METRES into the SfM options.
+void ParseScale(const std::string& scale, ColmapSfmOptions* options) {
+  const size_t c1 = scale.find(','), c2 = scale.rfind(',');
+  try {
+    if (c1 == std::string::npos || c1 == c2) throw std::invalid_argument(scale);
+    options->camera_a = scale.substr(0, c1);
+    options->camera_b = scale.substr(c1 + 1, c2 - c1 - 1);
+    options->distance_m = std::stod(scale.substr(c2 + 1));
+  } catch (const std::exception&) {
+    throw InputError("--scale", "CAM_A,CAM_B,METRES", "e.g. cam0,cam1,0.412",
+                     "'" + scale + "'");
+  }
+}
+
+// One source of scale at most, the board with its images, a board world with a board.
+void CheckScaleSources(const ColmapFlags& f) {
+  if (!f.board_spec.empty() && !f.scale.empty()) {
+    throw InputError("calib colmap", "--scale / --board", "one source of scale",
+                     "both given");
+  }
+  if (f.board_spec.empty() != f.board_images.empty()) {
+    throw InputError("calib colmap", "--board / --board-images", "both or neither",
+                     f.board_spec.empty() ? "only --board-images" : "only --board");
+  }
+  if (f.world == "board" && f.board_spec.empty()) {
+    throw InputError("calib colmap", "--world", "camera, or board with --board",
+                     "board without --board");
+  }
+}
+
+// Scales the SfM rig to metres from the board seen by several cameras at once and,
+// for --world board, moves the world onto the board.
+void ScaleByBoard(const ColmapFlags& f, const BoardSpec& board, ColmapSfmResult* result,
+                  RigFileInfo* info) {
+  std::cout << "detecting the board in " << f.board_images << "\n";
+  const std::vector<CameraBoardViews> views =
+      DetectBoardsInFolders(f.board_images, board, {}, &std::cout);
+  const BoardScaleResult fix = ScaleFromBoard(result->rig, views, board, f.board_images);
+  ScaleRig(&result->rig, fix.scale);
+  result->scale = fix.scale;
+  std::cout << "board scale from " << fix.corners << " corners in " << fix.frames
+            << " frames (" << fix.pairs << " pairs, spread " << 100 * fix.spread
+            << " %)\n";
+  if (f.world == "board") {
+    SetWorldToBoard(&result->rig, fix.world_from_board);
+    info->world = "board in frame " + fix.board_frame;
+  }
+}
+
+// OUT/rig.json, OUT/colmap/ and OUT/rig.png, and the summary on stdout.
+void WriteColmapRig(const ColmapSfmResult& result, const RigFileInfo& info,
+                    const std::string& out) {
+  namespace fs = std::filesystem;
+  WriteRig(result.rig, {"json", (fs::path(out) / "rig.json").string()}, info);
+  WriteRig(result.rig, {"colmap-text", (fs::path(out) / "colmap").string()}, info);
+  RigPlotOptions plot;
+  plot.title = "COLMAP rig, world " + info.world;
+  PlotRig(result.rig, (fs::path(out) / "rig.png").string(), plot);
+  std::cout << result.registered << " of " << result.images
+            << " images registered; scale " << result.scale << " m per COLMAP unit\n"
+            << RigTable(result.rig) << "wrote " << out
+            << "/{rig.json, colmap/, rig.png}\n";
+}
+
 int RunCalibColmap(int argc, char** argv) {
   CLI::App app(
       "Calibrate a static rig by structure from motion with the colmap binary (CPU):\n"
@@ -148,90 +246,30 @@ int RunCalibColmap(int argc, char** argv) {
       "Example: handlabel calib colmap --images scene/ --scale cam0,cam1,0.412 --out "
       "sfm_out",
       "calib colmap");
-  std::string images, out = "sfm_out", model = "OPENCV", scale;
-  std::string board_spec, board_images, world = "camera";
-  ColmapSfmOptions options;
-  app.add_option("--images", images, "folder with one sub-folder of images per camera")
-      ->required();
-  app.add_option("--out", out, "output folder (created)")->capture_default_str();
-  app.add_option("--model", model, "COLMAP camera model for every camera")
-      ->capture_default_str();
-  app.add_option("--scale", scale,
-                 "CAM_A,CAM_B,METRES: known distance between two camera centres");
-  app.add_option("--board", board_spec,
-                 "board for the scale, e.g. charuco:11x8:0.03:0.022 (docs/cameras.md)");
-  app.add_option("--board-images", board_images,
-                 "folder with <camera>/<frame> images of the board (cameras named as the "
-                 "--images folders; only cameras that see it)");
-  app.add_option("--world", world, "camera (the master) or board (needs --board)")
-      ->check(CLI::IsMember({"camera", "board"}))
-      ->capture_default_str();
-  app.add_option("--master", options.master, "world = this camera (default: the first)");
-  app.add_option("--colmap", options.colmap, "the colmap binary")->capture_default_str();
-  app.add_option("--threads", options.num_threads, "threads for COLMAP")
-      ->capture_default_str();
+  ColmapFlags f;
+  AddColmapOptions(&app, &f);
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("calib colmap", [&] {
     namespace fs = std::filesystem;
-    options.model = CameraModelFromName(model, "--model");
-    options.work_dir = (fs::path(out) / "colmap_work").string();
-    if (!scale.empty()) {
-      const size_t c1 = scale.find(','), c2 = scale.rfind(',');
-      try {
-        if (c1 == std::string::npos || c1 == c2) throw std::invalid_argument(scale);
-        options.camera_a = scale.substr(0, c1);
-        options.camera_b = scale.substr(c1 + 1, c2 - c1 - 1);
-        options.distance_m = std::stod(scale.substr(c2 + 1));
-      } catch (const std::exception&) {
-        throw InputError("--scale", "CAM_A,CAM_B,METRES", "e.g. cam0,cam1,0.412",
-                         "'" + scale + "'");
-      }
-    }
-    if (!board_spec.empty() && !scale.empty()) {
-      throw InputError("calib colmap", "--scale / --board", "one source of scale",
-                       "both given");
-    }
-    if (board_spec.empty() != board_images.empty()) {
-      throw InputError("calib colmap", "--board / --board-images", "both or neither",
-                       board_spec.empty() ? "only --board-images" : "only --board");
-    }
-    if (world == "board" && board_spec.empty()) {
-      throw InputError("calib colmap", "--world", "camera, or board with --board",
-                       "board without --board");
-    }
-    const BoardSpec board = board_spec.empty() ? BoardSpec() : ParseBoardSpec(board_spec);
-    std::cout << "running colmap on " << images << "\n";
-    ColmapSfmResult result = CalibrateWithColmap(images, options, &std::cout);
-    fs::create_directories(out);
+    ColmapSfmOptions& options = f.options;
+    options.model = CameraModelFromName(f.model, "--model");
+    options.work_dir = (fs::path(f.out) / "colmap_work").string();
+    if (!f.scale.empty()) ParseScale(f.scale, &options);
+    CheckScaleSources(f);
+    const BoardSpec board =
+        f.board_spec.empty() ? BoardSpec() : ParseBoardSpec(f.board_spec);
+    std::cout << "running colmap on " << f.images << "\n";
+    ColmapSfmResult result = CalibrateWithColmap(f.images, options, &std::cout);
+    fs::create_directories(f.out);
     RigFileInfo info;
     info.world = "camera:" + result.rig[0].name;
     if (!options.master.empty()) info.world = "camera:" + options.master;
-    if (!board_spec.empty()) {
-      std::cout << "detecting the board in " << board_images << "\n";
-      const std::vector<CameraBoardViews> views =
-          DetectBoardsInFolders(board_images, board, {}, &std::cout);
-      const BoardScaleResult fix = ScaleFromBoard(result.rig, views, board, board_images);
-      ScaleRig(&result.rig, fix.scale);
-      result.scale = fix.scale;
-      std::cout << "board scale from " << fix.corners << " corners in " << fix.frames
-                << " frames (" << fix.pairs << " pairs, spread " << 100 * fix.spread
-                << " %)\n";
-      if (world == "board") {
-        SetWorldToBoard(&result.rig, fix.world_from_board);
-        info.world = "board in frame " + fix.board_frame;
-      }
+    if (!f.board_spec.empty()) {
+      ScaleByBoard(f, board, &result, &info);
     } else if (options.camera_a.empty()) {
       info.world += " (COLMAP units, scale unknown)";
     }
-    WriteRig(result.rig, {"json", (fs::path(out) / "rig.json").string()}, info);
-    WriteRig(result.rig, {"colmap-text", (fs::path(out) / "colmap").string()}, info);
-    RigPlotOptions plot;
-    plot.title = "COLMAP rig, world " + info.world;
-    PlotRig(result.rig, (fs::path(out) / "rig.png").string(), plot);
-    std::cout << result.registered << " of " << result.images
-              << " images registered; scale " << result.scale << " m per COLMAP unit\n"
-              << RigTable(result.rig) << "wrote " << out
-              << "/{rig.json, colmap/, rig.png}\n";
+    WriteColmapRig(result, info, f.out);
     return 0;
   });
 }

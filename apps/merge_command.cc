@@ -2,11 +2,11 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "core/sha256.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_stage_factory.h"
-#include "core/sha256.h"
 
 namespace handlabel {
 
@@ -25,8 +25,7 @@ int RunMerge(int argc, char** argv) {
   return RunReportingErrors("merge", [&] {
     const JobConfig job = LoadJobConfig(job_file);
     const auto source = BuildFrameSource(job);
-    const std::vector<std::string> frames =
-        SelectFrames(source->FrameIds(), job.frames, job.source_file);
+    const std::vector<std::string> frames = JobFrames(job, *source);
     const std::string weights_sha =
         job.network_weights.empty() ? "" : Sha256OfFile(job.network_weights);
     const LabelSummary summary =

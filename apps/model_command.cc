@@ -12,41 +12,13 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "apps/model_file_flags.h"
 #include "core/errors.h"
 #include "core/hand_lbs.h"
 #include "core/hand_model_io.h"
 
 namespace handlabel {
 namespace {
-
-// Options shared by subcommands that load a model file.
-struct ModelFileFlags {
-  std::string side;  // "", "left" or "right"
-  std::vector<int> tips;
-
-  void Register(CLI::App& app) {
-    app.add_option("--side", side,
-                   "side for files that do not record it (MANO pickles, smplx npz); "
-                   "default: from the file name (MANO_LEFT / MANO_RIGHT)")
-        ->check(CLI::IsMember({"left", "right"}));
-    app.add_option("--tips", tips,
-                   "fingertip vertex ids thumb,index,middle,ring,pinky for files without "
-                   "them; default for 778-vertex MANO: 745,317,444,556,673 (manopth)")
-        ->delimiter(',')
-        ->expected(5);
-  }
-
-  HandModelLoadOptions Options() const {
-    HandModelLoadOptions options;
-    if (!side.empty()) options.side = side == "left" ? HandSide::kLeft : HandSide::kRight;
-    if (!tips.empty()) {
-      std::array<int, 5> t;
-      std::copy(tips.begin(), tips.end(), t.begin());
-      options.tip_vertex_ids = t;
-    }
-    return options;
-  }
-};
 
 constexpr const char* kSnapNames[kNumHandKeypoints] = {
     "wrist",      "thumb_cmc", "thumb_mcp", "thumb_ip",   "thumb_tip",  "index_mcp",

@@ -7,10 +7,11 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "apps/model_file_flags.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/hand_lbs.h"
 #include "core/hand_model_io.h"
-#include "core/atomic_file.h"
 #include "core/hand_preview.h"
 #include "pipeline/label_record.h"
 
@@ -23,6 +24,7 @@ int RunModelExport(int argc, char** argv) {
       "model export");
   std::string path, out, pose = "rest";
   std::vector<double> betas;
+  ModelFileFlags flags;
   app.add_option("model", path, "model file (MANO .pkl, smplx .npz or handlabel .npz)")
       ->required();
   app.add_option("--out", out, "mesh file to write: NAME.ply or NAME.obj")->required();
@@ -30,13 +32,14 @@ int RunModelExport(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--betas", betas, "shape coefficients b1,b2,... (missing ones are 0)")
       ->delimiter(',');
+  flags.Register(app);
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("model export", [&] {
     const std::string extension = std::filesystem::path(out).extension().string();
     if (extension != ".ply" && extension != ".obj") {
       throw InputError("--out", "extension", ".ply or .obj", out);
     }
-    const HandModel model = LoadHandModel(path);
+    const HandModel model = LoadHandModelFile(path, flags.Options()).model;
     if (static_cast<int>(betas.size()) > model.num_betas()) {
       throw InputError("--betas", "count",
                        "at most " + std::to_string(model.num_betas()) + " values",

@@ -57,7 +57,8 @@ int RunSynth(int argc, char** argv) {
   app.add_flag("--no-clutter", no_clutter, "plain grey backgrounds");
   app.add_option("--hand-model", hand_model,
                  "model file or 'capsule'; default: $HANDLABEL_HAND_MODEL, then "
-                 "models/open_hand_<side>.npz, then the built-in capsule hand");
+                 "<data dir>/models/open_hand_<side>.npz, then the open hand built "
+                 "in memory");
   app.add_option("--side", side, "right or left hand")->capture_default_str();
   app.add_option("--threads", o.num_threads, "worker threads, 0 = all cores")
       ->capture_default_str();

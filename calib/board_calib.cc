@@ -102,26 +102,26 @@ void BoardCalibOptions::Check() const {
   }
 }
 
-BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
-                                   const BoardSpec& board,
-                                   const BoardCalibOptions& options) {
-  options.Check();
-  board.Check();
-  if (views.empty())
-    throw InputError("board calibration", "cameras", "at least one camera");
-  size_t master = 0;
-  if (!options.master.empty()) {
-    const auto it =
-        std::find_if(views.begin(), views.end(),
-                     [&](const CameraBoardViews& v) { return v.name == options.master; });
-    if (it == views.end()) {
-      std::string known;
-      for (const auto& v : views) known += (known.empty() ? "" : ", ") + v.name;
-      throw InputError("--master", "camera", "one of [" + known + "]",
-                       "'" + options.master + "'");
-    }
-    master = static_cast<size_t>(it - views.begin());
+namespace {
+
+// The master camera's index: options.master by name, else the first camera.
+size_t MasterIndex(const std::vector<CameraBoardViews>& views,
+                   const BoardCalibOptions& options) {
+  if (options.master.empty()) return 0;
+  const auto it =
+      std::find_if(views.begin(), views.end(),
+                   [&](const CameraBoardViews& v) { return v.name == options.master; });
+  if (it == views.end()) {
+    std::string known;
+    for (const auto& v : views) known += (known.empty() ? "" : ", ") + v.name;
+    throw InputError("--master", "camera", "one of [" + known + "]",
+                     "'" + options.master + "'");
   }
+  return static_cast<size_t>(it - views.begin());
+}
+
+void CheckEnoughFrames(const std::vector<CameraBoardViews>& views,
+                       const BoardCalibOptions& options) {
   for (const CameraBoardViews& v : views) {
     if (static_cast<int>(v.frames.size()) < options.min_frames_per_camera) {
       throw InputError("camera " + v.name, "board detections",
@@ -130,23 +130,18 @@ BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
                        std::to_string(v.frames.size()));
     }
   }
+}
 
-  // 1-2. Initial values.
-  BoardCalibResult result;
-  std::vector<InitialCamera> initial;
-  for (const CameraBoardViews& v : views) {
-    initial.push_back(InitialIntrinsics(v, board, options.model));
-  }
-  const std::vector<Rigid3> cam_from_master =
-      ChainExtrinsics(views, initial, master, &result.tree);
+// Steps 1-2 as the solver's start: per-camera intrinsics, chained extrinsics, and each
+// frame's board pose from the camera that saw most of it.
+State InitialState(const std::vector<CameraBoardViews>& views,
+                   const std::vector<InitialCamera>& initial,
+                   const std::vector<Rigid3>& cam_from_master) {
   State state;
-  std::vector<CameraModelId> models;
   for (size_t c = 0; c < views.size(); ++c) {
     state.intrinsics.push_back(initial[c].camera.params());
     state.cam_from_world.emplace_back(cam_from_master[c]);
-    models.push_back(options.model);
   }
-  // Each frame's board pose from the camera that saw most of it.
   std::map<std::string, std::pair<size_t, size_t>> best_view;  // key -> (corners, camera)
   for (size_t c = 0; c < views.size(); ++c) {
     for (const auto& [key, pose] : initial[c].cam_from_board) {
@@ -160,6 +155,12 @@ BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
     state.world_from_board[key] =
         Pose(cam_from_master[c].Inverse() * initial[c].cam_from_board.at(key));
   }
+  return state;
+}
+
+// Every corner seen in a frame that has an initial board pose.
+std::vector<Observation> CollectObservations(const std::vector<CameraBoardViews>& views,
+                                             const State& state) {
   std::vector<Observation> observations;
   for (size_t c = 0; c < views.size(); ++c) {
     for (const auto& [key, obs] : views[c].frames) {
@@ -169,14 +170,21 @@ BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
       }
     }
   }
+  return observations;
+}
 
-  // 3. Bundle adjustment with outlier rounds.
-  Solve(&state, models, board, observations, master, options);
+// Step 3: bundle adjustment, then rounds of outlier rejection, each followed by a new
+// solve, until no observation changes its inlier state.
+void SolveWithOutlierRounds(State* state, const std::vector<CameraModelId>& models,
+                            const BoardSpec& board,
+                            std::vector<Observation>* observations, size_t master,
+                            const BoardCalibOptions& options) {
+  Solve(state, models, board, *observations, master, options);
   for (int round = 0; round < options.outlier_rounds; ++round) {
     std::vector<double> norms;
-    for (const Observation& o : observations) {
+    for (const Observation& o : *observations) {
       bool ok;
-      if (o.inlier) norms.push_back(Residual(state, models, board, o, &ok).norm());
+      if (o.inlier) norms.push_back(Residual(*state, models, board, o, &ok).norm());
     }
     std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
     // For 2D Gaussian residuals, median |r| = 1.1774 sigma.
@@ -184,61 +192,76 @@ BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
     const double threshold =
         std::max(options.min_outlier_px, options.outlier_sigmas * sigma);
     int changed = 0;
-    for (Observation& o : observations) {
+    for (Observation& o : *observations) {
       bool ok;
-      const double r = Residual(state, models, board, o, &ok).norm();
+      const double r = Residual(*state, models, board, o, &ok).norm();
       const bool inlier = ok && r <= threshold;
       if (inlier != o.inlier) ++changed;
       o.inlier = inlier;
     }
     if (changed == 0) break;
-    Solve(&state, models, board, observations, master, options);
+    Solve(state, models, board, *observations, master, options);
   }
+}
 
-  // 4. World frame.
-  Rigid3 master_from_world;  // identity for world = master camera
-  result.world = "camera:" + views[master].name;
-  if (options.world != "camera") {
-    std::string key;
-    if (options.world == "board") {
-      key = views[master].frames.begin()->first;
-    } else {
-      key = options.world.substr(6);
-      if (!state.world_from_board.count(key)) {
-        throw InputError("--world", "board:FRAME",
-                         "a frame in which some camera saw the board", "'" + key + "'");
-      }
+// Step 4: the world frame (master camera or the board in one frame) as master_from_world;
+// `world` receives its description.
+Rigid3 MasterFromWorld(const std::vector<CameraBoardViews>& views, size_t master,
+                       const State& state, const BoardCalibOptions& options,
+                       std::string* world) {
+  *world = "camera:" + views[master].name;
+  if (options.world == "camera") return Rigid3();  // identity: world = master camera
+  std::string key;
+  if (options.world == "board") {
+    key = views[master].frames.begin()->first;
+  } else {
+    key = options.world.substr(6);
+    if (!state.world_from_board.count(key)) {
+      throw InputError("--world", "board:FRAME",
+                       "a frame in which some camera saw the board", "'" + key + "'");
     }
-    master_from_world = state.world_from_board.at(key).ToRigid();
-    result.world = "board:" + key;
   }
+  *world = "board:" + key;
+  return state.world_from_board.at(key).ToRigid();
+}
+
+// The solved cameras and board poses, re-expressed in the world frame.
+void AddRigAndBoards(const std::vector<CameraBoardViews>& views,
+                     const std::vector<CameraModelId>& models, const State& state,
+                     const Rigid3& master_from_world, BoardCalibResult* result) {
   for (size_t c = 0; c < views.size(); ++c) {
     RigCamera rc;
     rc.name = views[c].name;
     rc.camera = Camera(models[c], views[c].width, views[c].height, state.intrinsics[c],
                        "calibrated camera " + views[c].name);
     rc.cam_from_world = state.cam_from_world[c].ToRigid() * master_from_world;
-    result.rig.Add(rc);
+    result->rig.Add(rc);
   }
   for (const auto& [key, pose] : state.world_from_board) {
-    result.world_from_board[key] = master_from_world.Inverse() * pose.ToRigid();
+    result->world_from_board[key] = master_from_world.Inverse() * pose.ToRigid();
   }
+}
 
-  // Statistics and residuals.
-  result.stats.resize(views.size());
+// Per-camera and overall statistics and every corner's final residual.
+void AddStatistics(const std::vector<CameraBoardViews>& views,
+                   const std::vector<InitialCamera>& initial,
+                   const std::vector<CameraModelId>& models, const BoardSpec& board,
+                   const State& state, const std::vector<Observation>& observations,
+                   BoardCalibResult* result) {
+  result->stats.resize(views.size());
   std::vector<double> sum_sq(views.size(), 0.0);
   double total_sq = 0;
   int total = 0;
   for (size_t c = 0; c < views.size(); ++c) {
-    result.stats[c].name = views[c].name;
-    result.stats[c].frames = static_cast<int>(views[c].frames.size());
-    result.stats[c].initial_rms_px = initial[c].rms_px;
+    result->stats[c].name = views[c].name;
+    result->stats[c].frames = static_cast<int>(views[c].frames.size());
+    result->stats[c].initial_rms_px = initial[c].rms_px;
   }
   for (const Observation& o : observations) {
     bool ok;
     const Eigen::Vector2d r = Residual(state, models, board, o, &ok);
-    result.residuals.push_back({o.camera, o.frame, o.corner_id, o.pixel, r, o.inlier});
-    CameraCalibStats& st = result.stats[o.camera];
+    result->residuals.push_back({o.camera, o.frame, o.corner_id, o.pixel, r, o.inlier});
+    CameraCalibStats& st = result->stats[o.camera];
     if (o.inlier) {
       ++st.observations;
       sum_sq[o.camera] += r.squaredNorm();
@@ -249,10 +272,41 @@ BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
     }
   }
   for (size_t c = 0; c < views.size(); ++c) {
-    const int n = result.stats[c].observations;
-    result.stats[c].rms_px = n > 0 ? std::sqrt(sum_sq[c] / n) : 0;
+    const int n = result->stats[c].observations;
+    result->stats[c].rms_px = n > 0 ? std::sqrt(sum_sq[c] / n) : 0;
   }
-  result.rms_px = total > 0 ? std::sqrt(total_sq / total) : 0;
+  result->rms_px = total > 0 ? std::sqrt(total_sq / total) : 0;
+}
+
+}  // namespace
+
+BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
+                                   const BoardSpec& board,
+                                   const BoardCalibOptions& options) {
+  options.Check();
+  board.Check();
+  if (views.empty())
+    throw InputError("board calibration", "cameras", "at least one camera");
+  const size_t master = MasterIndex(views, options);
+  CheckEnoughFrames(views, options);
+
+  BoardCalibResult result;
+  std::vector<InitialCamera> initial;
+  for (const CameraBoardViews& v : views) {
+    initial.push_back(InitialIntrinsics(v, board, options.model));
+  }
+  const std::vector<Rigid3> cam_from_master =
+      ChainExtrinsics(views, initial, master, &result.tree);
+  State state = InitialState(views, initial, cam_from_master);
+  const std::vector<CameraModelId> models(views.size(), options.model);
+  std::vector<Observation> observations = CollectObservations(views, state);
+
+  SolveWithOutlierRounds(&state, models, board, &observations, master, options);
+
+  const Rigid3 master_from_world =
+      MasterFromWorld(views, master, state, options, &result.world);
+  AddRigAndBoards(views, models, state, master_from_world, &result);
+  AddStatistics(views, initial, models, board, state, observations, &result);
   return result;
 }
 

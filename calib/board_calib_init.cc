@@ -39,12 +39,14 @@ std::vector<double> PinholeParams(CameraModelId model, double f, double cx, doub
   return p;
 }
 
-}  // namespace
-
-InitialCamera InitialIntrinsics(const CameraBoardViews& views, const BoardSpec& board,
-                                CameraModelId model) {
+// One camera's board corners as OpenCV point lists, one list per frame (frame order).
+struct CornerLists {
   std::vector<std::vector<cv::Point3f>> object_points;
   std::vector<std::vector<cv::Point2f>> image_points;
+};
+
+CornerLists ToCornerLists(const CameraBoardViews& views, const BoardSpec& board) {
+  CornerLists lists;
   for (const auto& [key, obs] : views.frames) {
     std::vector<cv::Point3f> object;
     std::vector<cv::Point2f> image;
@@ -53,64 +55,75 @@ InitialCamera InitialIntrinsics(const CameraBoardViews& views, const BoardSpec& 
       object.emplace_back(c.x(), c.y(), c.z());
       image.emplace_back(obs.pixels[i].x(), obs.pixels[i].y());
     }
-    object_points.push_back(object);
-    image_points.push_back(image);
+    lists.object_points.push_back(object);
+    lists.image_points.push_back(image);
   }
-  const std::string source = "camera " + views.name;
-  const char* expected = "board views that constrain the focal length (several tilts)";
-  // Focal length: OpenCV's homography estimate (principal point at the image centre)
-  // when it is usable, else the best of a range of guesses, judged by the median
-  // reprojection error after planar PnP of every view; then board poses by planar PnP
-  // and a per-camera bundle adjustment.
-  const double cx = (views.width - 1) / 2.0, cy = (views.height - 1) / 2.0;
-  std::vector<double> focal_guesses;
+  return lists;
+}
+
+// OpenCV's homography estimate first (principal point at the image centre, skipped
+// when OpenCV fails), then a range of guesses relative to the image size.
+std::vector<double> FocalGuesses(const CameraBoardViews& views,
+                                 const CornerLists& lists) {
+  std::vector<double> guesses;
   try {
-    const cv::Mat k = cv::initCameraMatrix2D(object_points, image_points,
+    const cv::Mat k = cv::initCameraMatrix2D(lists.object_points, lists.image_points,
                                              cv::Size(views.width, views.height), 1.0);
-    focal_guesses.push_back(0.5 * (k.at<double>(0, 0) + k.at<double>(1, 1)));
+    guesses.push_back(0.5 * (k.at<double>(0, 0) + k.at<double>(1, 1)));
   } catch (const cv::Exception&) {
   }
   for (double scale : {0.4, 0.6, 0.8, 1.0, 1.3, 1.7, 2.2, 3.0}) {
-    focal_guesses.push_back(scale * std::max(views.width, views.height));
+    guesses.push_back(scale * std::max(views.width, views.height));
   }
-  const auto pnp_poses = [&](double f, double* median_error) {
-    const cv::Mat kk = (cv::Mat_<double>(3, 3) << f, 0, cx, 0, f, cy, 0, 0, 1);
-    std::map<std::string, Rigid3> poses;
-    std::vector<double> errors;
-    size_t i = 0;
-    for (const auto& [key, obs] : views.frames) {
-      cv::Mat rvec, tvec;
-      const bool solved =
-          object_points[i].size() >= 4 &&
-          cv::solvePnP(object_points[i], image_points[i], kk, cv::noArray(), rvec, tvec,
-                       false, cv::SOLVEPNP_IPPE);
-      if (!solved || !cv::checkRange(rvec) || !cv::checkRange(tvec) ||
-          tvec.at<double>(2) <= 0) {
-        ++i;
-        continue;  // a degenerate view (e.g. corners on one line): not used to initialise
-      }
-      std::vector<cv::Point2f> projected;
-      cv::projectPoints(object_points[i], rvec, tvec, kk, cv::noArray(), projected);
-      for (size_t j = 0; j < projected.size(); ++j) {
-        errors.push_back(cv::norm(projected[j] - image_points[i][j]));
-      }
-      const Rigid3 pose = RigidFromRodrigues(rvec, tvec);
-      bool in_front = true;
-      for (const cv::Point3f& p : object_points[i]) {
-        in_front = in_front && (pose * Eigen::Vector3d(p.x, p.y, p.z)).z() > 1e-6;
-      }
-      if (in_front) poses[key] = pose;
-      ++i;
+  return guesses;
+}
+
+// Board poses by planar PnP of every view for a pinhole camera of focal length f and
+// principal point (cx, cy), with the median reprojection error over all corners.
+std::map<std::string, Rigid3> PlanarPoses(const CameraBoardViews& views,
+                                          const CornerLists& lists, double f, double cx,
+                                          double cy, double* median_error) {
+  const cv::Mat kk = (cv::Mat_<double>(3, 3) << f, 0, cx, 0, f, cy, 0, 0, 1);
+  std::map<std::string, Rigid3> poses;
+  std::vector<double> errors;
+  size_t i = 0;
+  for (const auto& [key, obs] : views.frames) {
+    const std::vector<cv::Point3f>& object = lists.object_points[i];
+    const std::vector<cv::Point2f>& image = lists.image_points[i];
+    ++i;
+    cv::Mat rvec, tvec;
+    const bool solved =
+        object.size() >= 4 && cv::solvePnP(object, image, kk, cv::noArray(), rvec, tvec,
+                                           false, cv::SOLVEPNP_IPPE);
+    if (!solved || !cv::checkRange(rvec) || !cv::checkRange(tvec) ||
+        tvec.at<double>(2) <= 0) {
+      continue;  // a degenerate view (e.g. corners on one line): not used to initialise
     }
-    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-    *median_error = errors.empty() ? 1e30 : errors[errors.size() / 2];
-    return poses;
-  };
+    std::vector<cv::Point2f> projected;
+    cv::projectPoints(object, rvec, tvec, kk, cv::noArray(), projected);
+    for (size_t j = 0; j < projected.size(); ++j) {
+      errors.push_back(cv::norm(projected[j] - image[j]));
+    }
+    const Rigid3 pose = RigidFromRodrigues(rvec, tvec);
+    bool in_front = true;
+    for (const cv::Point3f& p : object) {
+      in_front = in_front && (pose * Eigen::Vector3d(p.x, p.y, p.z)).z() > 1e-6;
+    }
+    if (in_front) poses[key] = pose;
+  }
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  *median_error = errors.empty() ? 1e30 : errors[errors.size() / 2];
+  return poses;
+}
+
+// The guess with the smallest median PnP error; 0 if none is usable.
+double ChooseFocal(const CameraBoardViews& views, const CornerLists& lists, double cx,
+                   double cy) {
   double f = 0, best_error = std::numeric_limits<double>::infinity();
-  for (double guess : focal_guesses) {
+  for (double guess : FocalGuesses(views, lists)) {
     if (!std::isfinite(guess) || guess <= 0) continue;
     double error;
-    pnp_poses(guess, &error);
+    PlanarPoses(views, lists, guess, cx, cy, &error);
     if (error < best_error) {
       best_error = error;
       f = guess;
@@ -119,25 +132,26 @@ InitialCamera InitialIntrinsics(const CameraBoardViews& views, const BoardSpec& 
     // pinhole: skip the search.
     if (best_error < 5.0) break;
   }
-  if (f <= 0)
-    throw InputError(source, "board detections", expected, "no focal length estimate");
-  InitialCamera out;
-  std::vector<double> params = PinholeParams(model, f, cx, cy);
-  std::map<std::string, std::pair<Eigen::Quaterniond, Eigen::Vector3d>> poses;
-  double unused;
-  for (const auto& [key, pose] : pnp_poses(f, &unused)) {
-    poses[key] = {pose.rotation, pose.translation};
-  }
+  return f;
+}
+
+using BoardPoses = std::map<std::string, std::pair<Eigen::Quaterniond, Eigen::Vector3d>>;
+
+// Per-camera bundle adjustment of the intrinsics and the board poses (the camera is
+// the world). Throws InputError naming the camera if Ceres finds no usable solution.
+void AdjustCamera(const CameraBoardViews& views, const BoardSpec& board,
+                  CameraModelId model, const std::string& source, const char* expected,
+                  std::vector<double>* params, BoardPoses* poses) {
   ceres::Problem problem;
   Eigen::Quaterniond identity_q = Eigen::Quaterniond::Identity();
   Eigen::Vector3d zero_t = Eigen::Vector3d::Zero();
   for (const auto& [key, obs] : views.frames) {
-    if (!poses.count(key)) continue;
-    auto& pose = poses[key];
+    if (!poses->count(key)) continue;
+    auto& pose = (*poses)[key];
     for (size_t j = 0; j < obs.size(); ++j) {
       problem.AddResidualBlock(
           BoardCornerCost::Create(model, board.Corner(obs.ids[j]), obs.pixels[j]),
-          new ceres::HuberLoss(1.0), params.data(), identity_q.coeffs().data(),
+          new ceres::HuberLoss(1.0), params->data(), identity_q.coeffs().data(),
           zero_t.data(), pose.first.coeffs().data(), pose.second.data());
     }
     problem.SetManifold(pose.first.coeffs().data(), new ceres::EigenQuaternionManifold);
@@ -153,22 +167,53 @@ InitialCamera InitialIntrinsics(const CameraBoardViews& views, const BoardSpec& 
   if (!summary.IsSolutionUsable()) {
     throw InputError(source, "board detections", expected, summary.message);
   }
-  out.camera = Camera(model, views.width, views.height, params, source);
+}
+
+// Stores the adjusted board poses in `out` and sets its reprojection RMS.
+void StorePosesAndRms(const CameraBoardViews& views, const BoardSpec& board,
+                      const BoardPoses& poses, InitialCamera* out) {
   double sum_sq = 0;
   int count = 0;
   for (const auto& [key, obs] : views.frames) {
     if (!poses.count(key)) continue;
-    const Rigid3 pose(poses[key].first, poses[key].second);
-    out.cam_from_board[key] = pose;
+    const Rigid3 pose(poses.at(key).first, poses.at(key).second);
+    out->cam_from_board[key] = pose;
     for (size_t j = 0; j < obs.size(); ++j) {
       Eigen::Vector2d uv;
-      if (out.camera.Project(pose * board.Corner(obs.ids[j]), &uv)) {
+      if (out->camera.Project(pose * board.Corner(obs.ids[j]), &uv)) {
         sum_sq += (uv - obs.pixels[j]).squaredNorm();
         ++count;
       }
     }
   }
-  out.rms_px = count > 0 ? std::sqrt(sum_sq / count) : 0;
+  out->rms_px = count > 0 ? std::sqrt(sum_sq / count) : 0;
+}
+
+}  // namespace
+
+InitialCamera InitialIntrinsics(const CameraBoardViews& views, const BoardSpec& board,
+                                CameraModelId model) {
+  const CornerLists lists = ToCornerLists(views, board);
+  const std::string source = "camera " + views.name;
+  const char* expected = "board views that constrain the focal length (several tilts)";
+  // Focal length: OpenCV's homography estimate (principal point at the image centre)
+  // when it is usable, else the best of a range of guesses, judged by the median
+  // reprojection error after planar PnP of every view; then board poses by planar PnP
+  // and a per-camera bundle adjustment.
+  const double cx = (views.width - 1) / 2.0, cy = (views.height - 1) / 2.0;
+  const double f = ChooseFocal(views, lists, cx, cy);
+  if (f <= 0)
+    throw InputError(source, "board detections", expected, "no focal length estimate");
+  std::vector<double> params = PinholeParams(model, f, cx, cy);
+  BoardPoses poses;
+  double unused;
+  for (const auto& [key, pose] : PlanarPoses(views, lists, f, cx, cy, &unused)) {
+    poses[key] = {pose.rotation, pose.translation};
+  }
+  AdjustCamera(views, board, model, source, expected, &params, &poses);
+  InitialCamera out;
+  out.camera = Camera(model, views.width, views.height, params, source);
+  StorePosesAndRms(views, board, poses, &out);
   return out;
 }
 

@@ -30,18 +30,21 @@ void SyntheticBoardCaptureOptions::Check() const {
   if (min_corners < 4) throw InputError(src, "min_corners", ">= 4");
 }
 
-SyntheticBoardCapture SynthesizeBoardCapture(const BoardSpec& board,
-                                             const SyntheticBoardCaptureOptions& o) {
-  o.Check();
-  board.Check();
-  std::mt19937_64 rng(o.seed);
-  const auto uniform = [&](double lo, double hi) {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A uniform draw from `rng` (one fresh distribution per draw, as the seeds expect).
+auto UniformFrom(std::mt19937_64& rng) {
+  return [&rng](double lo, double hi) {
     return std::uniform_real_distribution<double>(lo, hi)(rng);
   };
-  std::normal_distribution<double> noise(0.0, o.corner_noise_px);
-  constexpr double kPi = 3.14159265358979323846;
+}
 
-  SyntheticBoardCapture capture;
+// Cameras on a ring around the table looking at its centre, with OpenCV distortion.
+void AddRingCameras(const SyntheticBoardCaptureOptions& o, std::mt19937_64& rng,
+                    SyntheticBoardCapture* capture) {
+  const auto uniform = UniformFrom(rng);
   for (int c = 0; c < o.num_cameras; ++c) {
     const double azimuth = 2 * kPi * c / o.num_cameras + uniform(-0.15, 0.15);
     const double radius = uniform(o.ring_radius_min, o.ring_radius_max);
@@ -59,16 +62,20 @@ SyntheticBoardCapture SynthesizeBoardCapture(const BoardSpec& board,
                 o.height / 2.0 + uniform(-8, 8), uniform(0.03, 0.1),
                 uniform(-0.15, -0.05), uniform(-0.001, 0.001), uniform(-0.001, 0.001)});
     rc.cam_from_world = LookAt(eye, target, Eigen::Vector3d::UnitZ());
-    capture.rig.Add(rc);
-    capture.views.push_back({rc.name, o.width, o.height, {}});
+    capture->rig.Add(rc);
+    capture->views.push_back({rc.name, o.width, o.height, {}});
   }
+}
 
+// Board poses lying on the table, tilted, seen by several cameras.
+void AddTableFrames(const BoardSpec& board, const SyntheticBoardCaptureOptions& o,
+                    std::mt19937_64& rng, SyntheticBoardCapture* capture) {
+  const auto uniform = UniformFrom(rng);
   // A board lying printed side up has z (into the board) pointing down.
   Eigen::Matrix3d flat;
   flat << 1, 0, 0, 0, -1, 0, 0, 0, -1;
   const Eigen::Vector3d board_centre(board.Width() / 2, board.Height() / 2, 0);
   const double max_tilt = o.max_board_tilt_deg * kPi / 180;
-  const double cos_max_view = std::cos(o.max_view_angle_deg * kPi / 180);
   for (int f = 0; f < o.num_frames; ++f) {
     const double tilt_axis = uniform(0, 2 * kPi);
     const Eigen::Quaterniond rotation(
@@ -78,11 +85,18 @@ SyntheticBoardCapture SynthesizeBoardCapture(const BoardSpec& board,
         Eigen::Quaterniond(flat));
     const Eigen::Vector3d centre(uniform(-0.12, 0.12), uniform(-0.12, 0.12),
                                  uniform(0.02, 0.2));
-    capture.world_from_board[FrameKey(f)] =
+    capture->world_from_board[FrameKey(f)] =
         Rigid3(rotation, centre - rotation * board_centre);
   }
-  for (size_t c = 0; c < capture.rig.size(); ++c) {
-    const Rigid3 world_from_cam = capture.rig[c].cam_from_world.Inverse();
+}
+
+// Close-ups held in front of each camera (they pin its principal point down).
+void AddNearFrames(const BoardSpec& board, const SyntheticBoardCaptureOptions& o,
+                   std::mt19937_64& rng, SyntheticBoardCapture* capture) {
+  const auto uniform = UniformFrom(rng);
+  const Eigen::Vector3d board_centre(board.Width() / 2, board.Height() / 2, 0);
+  for (size_t c = 0; c < capture->rig.size(); ++c) {
+    const Rigid3 world_from_cam = capture->rig[c].cam_from_world.Inverse();
     for (int f = 0; f < o.near_frames_per_camera; ++f) {
       // Board facing the camera (its z, into the board, along the optical axis), at
       // an offset that moves it around the image.
@@ -100,15 +114,24 @@ SyntheticBoardCapture SynthesizeBoardCapture(const BoardSpec& board,
               Eigen::AngleAxisd(uniform(-kPi, kPi), Eigen::Vector3d::UnitZ()));
       char key[32];
       std::snprintf(key, sizeof(key), "near%zu_%02d", c, f);
-      capture.world_from_board[key] = Rigid3(rotation, centre - rotation * board_centre);
+      capture->world_from_board[key] = Rigid3(rotation, centre - rotation * board_centre);
     }
   }
-  for (const auto& [key, world_from_board] : capture.world_from_board) {
+}
+
+// Every camera's noisy view of the corners of every board pose it faces; views with
+// too few corners (or an incomplete checkerboard) are not detections.
+void ObserveCorners(const BoardSpec& board, const SyntheticBoardCaptureOptions& o,
+                    std::mt19937_64& rng, SyntheticBoardCapture* capture) {
+  std::normal_distribution<double> noise(0.0, o.corner_noise_px);
+  const Eigen::Vector3d board_centre(board.Width() / 2, board.Height() / 2, 0);
+  const double cos_max_view = std::cos(o.max_view_angle_deg * kPi / 180);
+  for (const auto& [key, world_from_board] : capture->world_from_board) {
     const Eigen::Vector3d centre = world_from_board * board_centre;
     const Eigen::Vector3d printed_normal =
         -(world_from_board.rotation * Eigen::Vector3d::UnitZ());
-    for (size_t c = 0; c < capture.rig.size(); ++c) {
-      const RigCamera& rc = capture.rig[c];
+    for (size_t c = 0; c < capture->rig.size(); ++c) {
+      const RigCamera& rc = capture->rig[c];
       const Eigen::Vector3d to_camera = (rc.CenterInWorld() - centre).normalized();
       if (printed_normal.dot(to_camera) < cos_max_view) continue;
       BoardObservation obs;
@@ -124,9 +147,23 @@ SyntheticBoardCapture SynthesizeBoardCapture(const BoardSpec& board,
           (board.type == BoardType::kCheckerboard && !complete)) {
         continue;
       }
-      capture.views[c].frames[key] = obs;
+      capture->views[c].frames[key] = obs;
     }
   }
+}
+
+}  // namespace
+
+SyntheticBoardCapture SynthesizeBoardCapture(const BoardSpec& board,
+                                             const SyntheticBoardCaptureOptions& o) {
+  o.Check();
+  board.Check();
+  std::mt19937_64 rng(o.seed);
+  SyntheticBoardCapture capture;
+  AddRingCameras(o, rng, &capture);
+  AddTableFrames(board, o, rng, &capture);
+  AddNearFrames(board, o, rng, &capture);
+  ObserveCorners(board, o, rng, &capture);
   return capture;
 }
 

@@ -18,7 +18,9 @@ Rig ReadCamerasFile(const std::string& path, const std::string& job_file) {
 }
 
 NativeFrameSource::NativeFrameSource(const std::string& capture_dir,
-                                     const std::optional<Rig>& cameras)
+                                     const std::optional<Rig>& cameras,
+                                     const std::string& keypoint_files,
+                                     const std::string& mask_files)
     : reader_(capture_dir), rig_(reader_.rig()) {
   if (cameras) {
     Rig reordered;
@@ -36,6 +38,14 @@ NativeFrameSource::NativeFrameSource(const std::string& capture_dir,
     mask_kind_ = kFileDetectionMask;
   } else if (reader_.Has(kFileMask)) {
     mask_kind_ = kFileMask;
+  }
+  if (keypoint_files != "auto")
+    keypoint_kind_ = keypoint_files == "detections" ? kFileDetections : kFileKeypoints;
+  if (mask_files != "auto")
+    mask_kind_ = mask_files == "detections" ? kFileDetectionMask : kFileMask;
+  for (const std::string& kind : {keypoint_kind_, mask_kind_}) {
+    if (!kind.empty() && !reader_.Has(kind))
+      throw InputError(capture_dir, kind, "a capture with these files");
   }
 }
 

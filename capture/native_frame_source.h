@@ -21,9 +21,12 @@ namespace handlabel {
 class NativeFrameSource : public FrameSource {
  public:
   // Throws InputError naming the capture's files, or `cameras_file` when its cameras
-  // do not cover the capture's.
+  // do not cover the capture's. keypoint_files ("detections" | "keypoints") and
+  // mask_files ("detections" | "truth") override the choice above ("auto" keeps it).
   explicit NativeFrameSource(const std::string& capture_dir,
-                             const std::optional<Rig>& cameras = std::nullopt);
+                             const std::optional<Rig>& cameras = std::nullopt,
+                             const std::string& keypoint_files = "auto",
+                             const std::string& mask_files = "auto");
   std::vector<std::string> FrameIds() const override;
   FrameInput Load(const std::string& id) const override;
   std::string Describe() const override;

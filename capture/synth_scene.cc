@@ -190,29 +190,34 @@ std::vector<std::string> SynthPoseKindNames() {
   return {"open", "fist", "pinch", "point", "random", "grasp", "pca"};
 }
 
-SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
-                            const HandLimits& limits, const Rig& rig,
-                            const SynthSceneOptions& o, std::mt19937_64& rng) {
-  SynthScene scene;
-  scene.side = model.side;
-  // Pose kind; objects make grasps more likely, as in hand-object datasets.
+namespace {
+
+// Pose kind, pose and shape; objects make grasps more likely, as in hand-object
+// datasets.
+void SamplePoseAndShape(const HandModel& model, const HandAnatomy& anatomy,
+                        const HandLimits& limits, const SynthSceneOptions& o,
+                        std::mt19937_64& rng, SynthScene* scene) {
   const double grasp_boost = o.objects ? 2.0 : 1.0;
   std::discrete_distribution<int> pick({o.weight_open, o.weight_fist, o.weight_pinch,
                                         o.weight_point, o.weight_random,
                                         o.weight_grasp * grasp_boost, o.weight_pca});
   const int kind = pick(rng);
-  scene.pose_kind = SynthPoseKindNames()[kind];
-  HandParams& params = scene.params;
+  scene->pose_kind = SynthPoseKindNames()[kind];
+  HandParams& params = scene->params;
   params.hand_pose = SamplePose(model, anatomy, limits, o, kind, rng);
   params.betas = Eigen::VectorXd::Zero(std::min(model.num_betas(), 10));
   for (Eigen::Index i = 0; i < params.betas.size(); ++i) {
     params.betas[i] = std::clamp(Gaussian(rng, o.betas_sigma), -2.5 * o.betas_sigma,
                                  2.5 * o.betas_sigma);
   }
+}
 
-  // Placement: the hand at rest orientation, then rotated about the wrist (as the root
-  // rotation does) and moved; keep the try that the most cameras see entirely.
-  const HandMesh rest = PoseHand(model, params);
+// Placement: the hand at rest orientation, then rotated about the wrist (as the root
+// rotation does) and moved; keeps the try that the most cameras see entirely (sets
+// global_orient and transl) and returns that number of cameras.
+int PlaceHand(const HandModel& model, const Rig& rig, const SynthSceneOptions& o,
+              std::mt19937_64& rng, HandParams* params) {
+  const HandMesh rest = PoseHand(model, *params);
   const Eigen::RowVector3d wrist = rest.joints.row(0);
   const Eigen::RowVector3d centre = rest.keypoints.colwise().mean();
   int best = -1;
@@ -234,33 +239,34 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
     if (seen > best) {
       best = seen;
       const Eigen::AngleAxisd aa(q);
-      params.global_orient = aa.angle() * aa.axis();
-      params.transl = transl;
+      params->global_orient = aa.angle() * aa.axis();
+      params->transl = transl;
     }
     if (best == static_cast<int>(rig.size())) break;
   }
-  scene.cameras_seeing_hand = best;
-  scene.hand = PoseHand(model, params);
+  return best;
+}
 
-  // Appearance.
+// Skin tone with per-vertex shade variation, and the lighting.
+void SampleAppearance(const HandModel& model, std::mt19937_64& rng, SynthScene* scene) {
   const float* tone = kSkinTones[static_cast<int>(Uniform(rng, 0, 7))];
   for (int c = 0; c < 3; ++c) {
-    scene.skin[c] =
+    scene->skin[c] =
         std::clamp(tone[c] * static_cast<float>(Uniform(rng, 0.93, 1.07)), 0.0f, 1.0f);
   }
-  RenderMesh& hand = scene.hand_render;
-  hand.vertices = scene.hand.vertices;
+  RenderMesh& hand = scene->hand_render;
+  hand.vertices = scene->hand.vertices;
   hand.faces = model.faces;
   hand.normals = ComputeVertexNormals(hand.vertices, hand.faces);
   hand.colors.resize(hand.vertices.rows(), 3);
   for (Eigen::Index v = 0; v < hand.colors.rows(); ++v) {
     const float shade = static_cast<float>(Uniform(rng, 0.95, 1.05));
-    hand.colors.row(v) = (shade * scene.skin).cwiseMin(1.0f).transpose();
+    hand.colors.row(v) = (shade * scene->skin).cwiseMin(1.0f).transpose();
   }
-  scene.lighting.ambient =
+  scene->lighting.ambient =
       Eigen::Vector3f::Constant(static_cast<float>(Uniform(rng, 0.25, 0.5)));
   const int num_lights = 1 + static_cast<int>(Uniform(rng, 0, 2));
-  scene.lighting.lights.clear();
+  scene->lighting.lights.clear();
   for (int l = 0; l < num_lights; ++l) {
     // Light from above: the direction of travel points downwards.
     Eigen::Vector3d from(Gaussian(rng, 1), Gaussian(rng, 1),
@@ -271,39 +277,54 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
     light.color =
         intensity * Eigen::Vector3f(static_cast<float>(Uniform(rng, 0.9, 1.1)), 1.0f,
                                     static_cast<float>(Uniform(rng, 0.9, 1.1)));
-    scene.lighting.lights.push_back(light);
+    scene->lighting.lights.push_back(light);
   }
+}
 
-  // Objects: the first one in the hand (in front of the palm, or at the thumb and
-  // index tips for pinches), the others nearby.
-  if (o.objects) {
-    const int count = 1 + static_cast<int>(Uniform(rng, 0, o.max_objects));
-    const Eigen::Matrix3d r = Eigen::AngleAxisd(params.global_orient.norm(),
-                                                params.global_orient.norm() > 0
-                                                    ? params.global_orient.normalized()
-                                                    : Eigen::Vector3d::UnitX())
-                                  .toRotationMatrix();
-    const Eigen::Vector3d palm_normal = r * Eigen::Vector3d(0, -1, 0);
-    const Points3d& k = scene.hand.keypoints;
-    const Eigen::Vector3d palm_centre =
-        (k.row(0) + k.row(5) + k.row(9) + k.row(13) + k.row(17)).transpose() / 5.0;
-    for (int i = 0; i < count; ++i) {
-      Eigen::Vector3d anchor, away;
-      if (i == 0 && scene.pose_kind == "pinch") {
-        // Held at the pinching tips, on the side away from the palm (not swallowing
-        // the fingertips).
-        anchor = 0.5 * (k.row(4) + k.row(8)).transpose();
-        away = (anchor - palm_centre).normalized();
-      } else if (i == 0) {
-        anchor = palm_centre + 0.01 * palm_normal;
-        away = palm_normal;
-      } else {
-        away = RandomInBall(rng, 1.0).normalized();
-        anchor = palm_centre + Uniform(rng, 0.05, 0.12) * away;
-      }
-      scene.objects.push_back(SampleObject(anchor, away, rng));
+// Objects: the first one in the hand (in front of the palm, or at the thumb and index
+// tips for pinches), the others nearby.
+void AddObjects(const SynthSceneOptions& o, std::mt19937_64& rng, SynthScene* scene) {
+  const HandParams& params = scene->params;
+  const int count = 1 + static_cast<int>(Uniform(rng, 0, o.max_objects));
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(params.global_orient.norm(),
+                                              params.global_orient.norm() > 0
+                                                  ? params.global_orient.normalized()
+                                                  : Eigen::Vector3d::UnitX())
+                                .toRotationMatrix();
+  const Eigen::Vector3d palm_normal = r * Eigen::Vector3d(0, -1, 0);
+  const Points3d& k = scene->hand.keypoints;
+  const Eigen::Vector3d palm_centre =
+      (k.row(0) + k.row(5) + k.row(9) + k.row(13) + k.row(17)).transpose() / 5.0;
+  for (int i = 0; i < count; ++i) {
+    Eigen::Vector3d anchor, away;
+    if (i == 0 && scene->pose_kind == "pinch") {
+      // Held at the pinching tips, on the side away from the palm (not swallowing
+      // the fingertips).
+      anchor = 0.5 * (k.row(4) + k.row(8)).transpose();
+      away = (anchor - palm_centre).normalized();
+    } else if (i == 0) {
+      anchor = palm_centre + 0.01 * palm_normal;
+      away = palm_normal;
+    } else {
+      away = RandomInBall(rng, 1.0).normalized();
+      anchor = palm_centre + Uniform(rng, 0.05, 0.12) * away;
     }
+    scene->objects.push_back(SampleObject(anchor, away, rng));
   }
+}
+
+}  // namespace
+
+SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
+                            const HandLimits& limits, const Rig& rig,
+                            const SynthSceneOptions& o, std::mt19937_64& rng) {
+  SynthScene scene;
+  scene.side = model.side;
+  SamplePoseAndShape(model, anatomy, limits, o, rng, &scene);
+  scene.cameras_seeing_hand = PlaceHand(model, rig, o, rng, &scene.params);
+  scene.hand = PoseHand(model, scene.params);
+  SampleAppearance(model, rng, &scene);
+  if (o.objects) AddObjects(o, rng, &scene);
   return scene;
 }
 

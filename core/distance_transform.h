@@ -5,11 +5,11 @@
 // pixel centres at integer coordinates.
 
 #include <Eigen/Core>
-#include <cstdint>
+
+#include "core/mask_image.h"
 
 namespace handlabel {
 
-using MaskImage = Eigen::Matrix<uint8_t, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using DistanceImage =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 

@@ -95,35 +95,32 @@ HandEvaluator::HandEvaluator(const HandModel& model, const HandEvaluatorOptions&
 }  // namespace handlabel
 
 namespace handlabel {
+namespace {
 
-void HandEvaluator::KeypointsAndJacobian(const double* global_orient,
-                                         const double* hand_pose, const double* betas,
-                                         const double* transl, double* keypoints63,
-                                         double* jacobian) const {
-  using Vec3 = Eigen::Vector3d;
-  using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-  constexpr int kFeatures = 9 * (kNumHandJoints - 1);
-  const int nb = num_betas_;
-  const int np = num_params();
-  const int col_betas = 3 + pose_dim();
-  const int col_transl = col_betas + nb;
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using BetaColumns = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+using PoseColumns = Eigen::Matrix<double, 3, kNumPoseParams>;
+constexpr int kFeatures = 9 * (kNumHandJoints - 1);
 
-  HandPoseState<double> state;
-  Pose(global_orient, hand_pose, betas, transl, &state);
-  double pose45[kNumPoseParams];
-  AxisAnglePose(hand_pose, pose45);
-
-  // World rotation and position of every joint, and the world angular velocity
-  // omega[j][i] of joint j's frame per unit change of its axis-angle component i:
-  // a point q in j's subtree then moves by omega x (q - p_j).
+// World rotation and position of every joint, and the world angular velocity
+// omega[j][i] of joint j's frame per unit change of its axis-angle component i: a point
+// q in j's subtree then moves by omega x (q - p_j). feature_jac holds the derivatives
+// of the pose features (rotation entries of joints 1..15) by their axis-angle.
+struct JointMotion {
   std::array<Mat3, kNumHandJoints> world_r;
   std::array<Vec3, kNumHandJoints> world_p;
   std::array<std::array<Vec3, 3>, kNumHandJoints> omega;
   double feature_jac[kFeatures][3];
+};
+
+void ComputeJointMotion(const HandPoseState<double>& state, const double* global_orient,
+                        const double* pose45, JointMotion* m) {
   for (int j = 0; j < kNumHandJoints; ++j) {
     const double* g = state.world + 12 * j;
-    world_r[j] << g[0], g[1], g[2], g[4], g[5], g[6], g[8], g[9], g[10];
-    world_p[j] << g[3], g[7], g[11];
+    m->world_r[j] << g[0], g[1], g[2], g[4], g[5], g[6], g[8], g[9], g[10];
+    m->world_p[j] << g[3], g[7], g[11];
     const double* w = j == 0 ? global_orient : pose45 + 3 * (j - 1);
     Dual<3> wd[3] = {Dual<3>(w[0], 0), Dual<3>(w[1], 1), Dual<3>(w[2], 2)};
     Dual<3> rd[9];
@@ -134,30 +131,151 @@ void HandEvaluator::KeypointsAndJacobian(const double* global_orient,
       Mat3 dr;
       for (int e = 0; e < 9; ++e) {
         dr(e / 3, e % 3) = rd[e].v[i];
-        if (j > 0) feature_jac[9 * (j - 1) + e][i] = rd[e].v[i];
+        if (j > 0) m->feature_jac[9 * (j - 1) + e][i] = rd[e].v[i];
       }
       const Mat3 skew = r.transpose() * dr;  // body-frame [omega]x
-      omega[j][i] = world_r[j] * Vec3(skew(2, 1), skew(0, 2), skew(1, 0));
+      m->omega[j][i] = m->world_r[j] * Vec3(skew(2, 1), skew(0, 2), skew(1, 0));
     }
   }
-  // d p_j / d betas (3 x nb each): p_j = R_parent (J_j - J_parent) + p_parent.
-  std::array<Eigen::Matrix<double, 3, Eigen::Dynamic>, kNumHandJoints> dp_dbetas;
+}
+
+// d p_j / d betas (3 x nb each): p_j = R_parent (J_j - J_parent) + p_parent.
+std::array<BetaColumns, kNumHandJoints> JointBetaJacobians(
+    const RowMatrix& joint_shapedirs, const std::array<int, kNumHandJoints>& parents,
+    const JointMotion& m) {
+  std::array<BetaColumns, kNumHandJoints> dp_dbetas;
   for (int j = 0; j < kNumHandJoints; ++j) {
-    const Eigen::Matrix<double, 3, Eigen::Dynamic> dj =
-        joint_shapedirs_.middleRows(3 * j, 3);
-    const int parent = parents_[j];
+    const BetaColumns dj = joint_shapedirs.middleRows(3 * j, 3);
+    const int parent = parents[j];
     if (parent < 0) {
       dp_dbetas[j] = dj;
     } else {
-      dp_dbetas[j] = world_r[parent] * (dj - joint_shapedirs_.middleRows(3 * parent, 3)) +
-                     dp_dbetas[parent];
+      dp_dbetas[j] =
+          m.world_r[parent] * (dj - joint_shapedirs.middleRows(3 * parent, 3)) +
+          dp_dbetas[parent];
     }
   }
+  return dp_dbetas;
+}
+
+// Stores d / d(axis-angle component i of joint a): joint 0 is the global orientation.
+void SetRotationColumn(int a, int i, const Vec3& d, Eigen::Matrix3d* d_orient,
+                       PoseColumns* d_pose) {
+  if (a == 0) {
+    d_orient->col(i) = d;
+  } else {
+    d_pose->col(3 * (a - 1) + i) = d;
+  }
+}
+
+// The posed position of a joint keypoint and its rotation derivatives: every
+// ancestor-or-self a rotates p about p_a.
+Vec3 JointKeypoint(const JointMotion& m, const std::array<int, kNumHandJoints>& parents,
+                   int joint, Eigen::Matrix3d* d_orient, PoseColumns* d_pose) {
+  const Vec3 point = m.world_p[joint];
+  for (int a = joint; a >= 0; a = parents[a]) {
+    for (int i = 0; i < 3; ++i) {
+      SetRotationColumn(a, i, m.omega[a][i].cross(point - m.world_p[a]), d_orient,
+                        d_pose);
+    }
+  }
+  return point;
+}
+
+// The evaluator's arrays that skinning one vertex reads.
+struct SkinningArrays {
+  const Eigen::VectorXd& v_template;  // 3V
+  const RowMatrix& shapedirs;         // 3V x nb
+  const RowMatrix& posedirs;          // 3V x 135
+  const RowMatrix& joint_shapedirs;   // 48 x nb
+  const std::vector<int>& weight_start;
+  const std::vector<int>& weight_joint;
+  const std::vector<double>& weight_value;
+  const std::array<int, kNumHandJoints>& parents;
+  int nb;
+};
+
+// Vertex v after shape and pose blend shapes (rest frame), and its pose derivatives.
+Vec3 BlendedVertex(const SkinningArrays& s, const HandPoseState<double>& state,
+                   const JointMotion& m, int v, PoseColumns* dvp_dpose) {
+  Vec3 vp;
+  dvp_dpose->setZero();
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::Index row = 3 * v + c;
+    double value = s.v_template[row];
+    for (int b = 0; b < s.nb; ++b) value += s.shapedirs(row, b) * state.betas[b];
+    const double* pd = s.posedirs.data() + row * kFeatures;
+    for (int f = 0; f < kFeatures; ++f) {
+      value += pd[f] * state.pose_feature[f];
+      for (int i = 0; i < 3; ++i)
+        (*dvp_dpose)(c, 3 * (f / 9) + i) += pd[f] * m.feature_jac[f][i];
+    }
+    vp[c] = value;
+  }
+  return vp;
+}
+
+// The posed position of fingertip vertex v and its derivatives (rotation columns into
+// d_orient / d_pose, shape columns into d_shape).
+Vec3 TipVertex(const SkinningArrays& s, const HandPoseState<double>& state,
+               const JointMotion& m,
+               const std::array<BetaColumns, kNumHandJoints>& dp_dbetas, int v,
+               Eigen::Matrix3d* d_orient, PoseColumns* d_pose, BetaColumns* d_shape) {
+  PoseColumns dvp_dpose;
+  const Vec3 vp = BlendedVertex(s, state, m, v, &dvp_dpose);
+  // Blend: point = sum_j w_j q_j, q_j = R_j (vp - J_j) + p_j; s_a collects
+  // w_j (q_j - p_a) over the joints j in the subtree of a.
+  Mat3 blended_r = Mat3::Zero();
+  Vec3 point = Vec3::Zero();
+  std::array<Vec3, kNumHandJoints> moment;
+  for (Vec3& mo : moment) mo.setZero();
+  BetaColumns d_betas = BetaColumns::Zero(3, s.nb);
+  for (int e = s.weight_start[v]; e < s.weight_start[v + 1]; ++e) {
+    const int j = s.weight_joint[e];
+    const double w = s.weight_value[e];
+    const Vec3 rest(state.rest_joints[3 * j], state.rest_joints[3 * j + 1],
+                    state.rest_joints[3 * j + 2]);
+    const Vec3 q = m.world_r[j] * (vp - rest) + m.world_p[j];
+    point += w * q;
+    blended_r += w * m.world_r[j];
+    for (int a = j; a >= 0; a = s.parents[a]) moment[a] += w * (q - m.world_p[a]);
+    d_betas += w * (dp_dbetas[j] - m.world_r[j] * s.joint_shapedirs.middleRows(3 * j, 3));
+  }
+  for (int a = 0; a < kNumHandJoints; ++a) {
+    for (int i = 0; i < 3; ++i) {
+      SetRotationColumn(a, i, m.omega[a][i].cross(moment[a]), d_orient, d_pose);
+    }
+  }
+  *d_pose += blended_r * dvp_dpose;
+  *d_shape = d_betas + blended_r * s.shapedirs.middleRows(3 * v, 3);
+  return point;
+}
+
+}  // namespace
+
+void HandEvaluator::KeypointsAndJacobian(const double* global_orient,
+                                         const double* hand_pose, const double* betas,
+                                         const double* transl, double* keypoints63,
+                                         double* jacobian) const {
+  const int nb = num_betas_;
+  const int col_betas = 3 + pose_dim();
+  const int col_transl = col_betas + nb;
+
+  HandPoseState<double> state;
+  Pose(global_orient, hand_pose, betas, transl, &state);
+  double pose45[kNumPoseParams];
+  AxisAnglePose(hand_pose, pose45);
+  JointMotion motion;
+  ComputeJointMotion(state, global_orient, pose45, &motion);
+  const std::array<BetaColumns, kNumHandJoints> dp_dbetas =
+      JointBetaJacobians(joint_shapedirs_, parents_, motion);
+  const SkinningArrays arrays{v_template_,      shapedirs_,    posedirs_,
+                              joint_shapedirs_, weight_start_, weight_joint_,
+                              weight_value_,    parents_,      nb};
 
   // Jacobian w.r.t. axis-angle pose (45 columns) first; mapped to PCA at the end.
-  Eigen::Matrix<double, 3, kNumPoseParams> d_pose;
-  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> jac(
-      jacobian, 3 * kNumHandKeypoints, np);
+  PoseColumns d_pose;
+  Eigen::Map<RowMatrix> jac(jacobian, 3 * kNumHandKeypoints, num_params());
   jac.setZero();
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     const int native = kSnapFromNative[k];
@@ -166,70 +284,14 @@ void HandEvaluator::KeypointsAndJacobian(const double* global_orient,
     d_pose.setZero();
     Vec3 point;
     if (native < kNumHandJoints) {
-      point = world_p[native];
-      // Every ancestor-or-self a rotates p about p_a.
-      for (int a = native; a >= 0; a = parents_[a]) {
-        for (int i = 0; i < 3; ++i) {
-          const Vec3 d = omega[a][i].cross(point - world_p[a]);
-          if (a == 0) {
-            d_orient.col(i) = d;
-          } else {
-            d_pose.col(3 * (a - 1) + i) = d;
-          }
-        }
-      }
+      point = JointKeypoint(motion, parents_, native, &d_orient, &d_pose);
       rows.middleCols(col_betas, nb) = dp_dbetas[native];
     } else {
-      const int v = tip_vertex_ids_[native - kNumHandJoints];
-      // v_posed and its derivatives.
-      Vec3 vp;
-      Eigen::Matrix<double, 3, kNumPoseParams> dvp_dpose =
-          Eigen::Matrix<double, 3, kNumPoseParams>::Zero();
-      for (int c = 0; c < 3; ++c) {
-        const Eigen::Index row = 3 * v + c;
-        double value = v_template_[row];
-        for (int s = 0; s < nb; ++s) value += shapedirs_(row, s) * state.betas[s];
-        const double* pd = posedirs_.data() + row * kFeatures;
-        for (int f = 0; f < kFeatures; ++f) {
-          value += pd[f] * state.pose_feature[f];
-          for (int i = 0; i < 3; ++i)
-            dvp_dpose(c, 3 * (f / 9) + i) += pd[f] * feature_jac[f][i];
-        }
-        vp[c] = value;
-      }
-      // Blend: point = sum_j w_j q_j, q_j = R_j (vp - J_j) + p_j; s_a collects
-      // w_j (q_j - p_a) over the joints j in the subtree of a.
-      Mat3 blended_r = Mat3::Zero();
-      point.setZero();
-      std::array<Vec3, kNumHandJoints> moment;
-      for (Vec3& m : moment) m.setZero();
-      Eigen::Matrix<double, 3, Eigen::Dynamic> d_betas =
-          Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, nb);
-      for (int e = weight_start_[v]; e < weight_start_[v + 1]; ++e) {
-        const int j = weight_joint_[e];
-        const double w = weight_value_[e];
-        const Vec3 rest(state.rest_joints[3 * j], state.rest_joints[3 * j + 1],
-                        state.rest_joints[3 * j + 2]);
-        const Vec3 q = world_r[j] * (vp - rest) + world_p[j];
-        point += w * q;
-        blended_r += w * world_r[j];
-        for (int a = j; a >= 0; a = parents_[a]) moment[a] += w * (q - world_p[a]);
-        d_betas +=
-            w * (dp_dbetas[j] - world_r[j] * joint_shapedirs_.middleRows(3 * j, 3));
-      }
-      for (int a = 0; a < kNumHandJoints; ++a) {
-        for (int i = 0; i < 3; ++i) {
-          const Vec3 d = omega[a][i].cross(moment[a]);
-          if (a == 0) {
-            d_orient.col(i) = d;
-          } else {
-            d_pose.col(3 * (a - 1) + i) = d;
-          }
-        }
-      }
-      d_pose += blended_r * dvp_dpose;
-      rows.middleCols(col_betas, nb) =
-          d_betas + blended_r * shapedirs_.middleRows(3 * v, 3);
+      BetaColumns d_shape;
+      point = TipVertex(arrays, state, motion, dp_dbetas,
+                        tip_vertex_ids_[native - kNumHandJoints], &d_orient, &d_pose,
+                        &d_shape);
+      rows.middleCols(col_betas, nb) = d_shape;
     }
     rows.leftCols<3>() = d_orient;
     if (options_.num_pca_comps > 0) {

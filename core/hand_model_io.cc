@@ -251,30 +251,23 @@ std::string Stem(const std::string& path) {
   return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
 }
 
-HandModel ModelFromEntries(const Entries& entries, HandModelFormat format,
-                           const HandModelLoadOptions& options) {
-  const std::string& path = entries.path();
-  HandModel m;
-  const std::vector<double> v_template = entries.Doubles("v_template", {-1, 3});
-  const int64_t nv = static_cast<int64_t>(v_template.size() / 3);
-  m.v_template = RowMajorMatrix(v_template, nv, 3);
-
+// Triangle vertex indices, each checked against the vertex count.
+void ReadFaces(const Entries& entries, int64_t nv, HandModel* m) {
   const std::vector<int64_t> faces = entries.Ints("f", {-1, 3});
-  m.faces.resize(static_cast<Eigen::Index>(faces.size() / 3), 3);
+  m->faces.resize(static_cast<Eigen::Index>(faces.size() / 3), 3);
   for (size_t i = 0; i < faces.size(); ++i) {
     if (faces[i] < 0 || faces[i] >= nv) {
-      throw InputError(path, "f", "vertex indices below " + std::to_string(nv),
+      throw InputError(entries.path(), "f", "vertex indices below " + std::to_string(nv),
                        std::to_string(faces[i]));
     }
-    m.faces(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3)) =
+    m->faces(static_cast<Eigen::Index>(i / 3), static_cast<Eigen::Index>(i % 3)) =
         static_cast<int>(faces[i]);
   }
-  m.shapedirs = Blendshapes(entries, "shapedirs", nv, -1);
-  m.posedirs = Blendshapes(entries, "posedirs", nv, 9 * (kNumHandJoints - 1));
-  m.joint_regressor = JointRegressor(entries, nv);
-  m.skinning_weights = RowMajorMatrix(entries.Doubles("weights", {nv, kNumHandJoints}),
-                                      nv, kNumHandJoints);
+}
 
+// Joint parents from MANO's kintree_table (row 0 parents, row 1 the joint ids).
+void ReadParents(const Entries& entries, HandModel* m) {
+  const std::string& path = entries.path();
   const std::vector<int64_t> kintree = entries.Ints("kintree_table", {2, kNumHandJoints});
   for (int j = 0; j < kNumHandJoints; ++j) {
     if (kintree[kNumHandJoints + j] != j) {
@@ -284,23 +277,28 @@ HandModel ModelFromEntries(const Entries& entries, HandModelFormat format,
     }
     const int64_t parent = kintree[j];
     if (parent == kUint32MinusOne || parent == -1) {
-      m.parents[j] = -1;
+      m->parents[j] = -1;
     } else if (parent >= 0 && parent < kNumHandJoints) {
-      m.parents[j] = static_cast<int>(parent);  // order is checked by HandModel::Check
+      m->parents[j] = static_cast<int>(parent);  // order is checked by HandModel::Check
     } else {
       throw InputError(path, "kintree_table", "parent ids in [0, 16) or -1",
                        std::to_string(parent) + " for joint " + std::to_string(j));
     }
   }
+}
+
+// The optional pose PCA, and the skinning style, which must be MANO's own.
+void ReadPosePcaAndStyle(const Entries& entries, HandModel* m) {
+  const std::string& path = entries.path();
   if (entries.Has("hands_components")) {
     const std::vector<double> pca =
         entries.Doubles("hands_components", {-1, kNumPoseParams});
-    m.pose_pca_basis = RowMajorMatrix(
+    m->pose_pca_basis = RowMajorMatrix(
         pca, static_cast<Eigen::Index>(pca.size() / kNumPoseParams), kNumPoseParams);
   }
   if (entries.Has("hands_mean")) {
     const std::vector<double> mean = entries.Doubles("hands_mean", {kNumPoseParams});
-    m.pose_mean = Eigen::Map<const Eigen::VectorXd>(mean.data(), kNumPoseParams);
+    m->pose_mean = Eigen::Map<const Eigen::VectorXd>(mean.data(), kNumPoseParams);
   }
   // MANO's own loader supports linear blend skinning with rotation-matrix pose features
   // only; refuse anything else rather than compute a different model.
@@ -310,52 +308,80 @@ HandModel ModelFromEntries(const Entries& entries, HandModelFormat format,
   if (entries.Has("bs_type") && entries.Text("bs_type") != "lrotmin") {
     throw InputError(path, "bs_type", "'lrotmin'", "'" + entries.Text("bs_type") + "'");
   }
+}
 
-  if (format == HandModelFormat::kHandlabelNpz) {
-    const std::vector<int64_t> version = entries.Ints("handlabel_version", {});
-    if (version[0] < 1 || version[0] > kHandModelFileVersion) {
-      throw InputError(path, "handlabel_version",
-                       "a version up to " + std::to_string(kHandModelFileVersion),
-                       std::to_string(version[0]));
+// Version, side, name, tips and keypoint map stored by SaveHandModel.
+void ReadHandlabelMetadata(const Entries& entries, HandModel* m) {
+  const std::string& path = entries.path();
+  const std::vector<int64_t> version = entries.Ints("handlabel_version", {});
+  if (version[0] < 1 || version[0] > kHandModelFileVersion) {
+    throw InputError(path, "handlabel_version",
+                     "a version up to " + std::to_string(kHandModelFileVersion),
+                     std::to_string(version[0]));
+  }
+  const std::string side = entries.Text("handlabel_side");
+  if (side != "right" && side != "left") {
+    throw InputError(path, "handlabel_side", "'right' or 'left'", "'" + side + "'");
+  }
+  m->side = side == "left" ? HandSide::kLeft : HandSide::kRight;
+  m->name = entries.Text("handlabel_name");
+  const std::vector<int64_t> tips = entries.Ints("handlabel_tip_vertex_ids", {5});
+  for (int t = 0; t < 5; ++t) m->tip_vertex_ids[t] = static_cast<int>(tips[t]);
+  const std::vector<int64_t> map =
+      entries.Ints("handlabel_keypoint_map", {kNumHandKeypoints});
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (map[k] != kSnapFromNative[k]) {
+      throw InputError(path, "handlabel_keypoint_map",
+                       "the SNAP order from native joints + tips "
+                       "[0, 13, 14, 15, 16, 1, ...]",
+                       "a different map at keypoint " + std::to_string(k));
     }
-    const std::string side = entries.Text("handlabel_side");
-    if (side != "right" && side != "left") {
-      throw InputError(path, "handlabel_side", "'right' or 'left'", "'" + side + "'");
-    }
-    m.side = side == "left" ? HandSide::kLeft : HandSide::kRight;
-    m.name = entries.Text("handlabel_name");
-    const std::vector<int64_t> tips = entries.Ints("handlabel_tip_vertex_ids", {5});
-    for (int t = 0; t < 5; ++t) m.tip_vertex_ids[t] = static_cast<int>(tips[t]);
-    const std::vector<int64_t> map =
-        entries.Ints("handlabel_keypoint_map", {kNumHandKeypoints});
-    for (int k = 0; k < kNumHandKeypoints; ++k) {
-      if (map[k] != kSnapFromNative[k]) {
-        throw InputError(path, "handlabel_keypoint_map",
-                         "the SNAP order from native joints + tips "
-                         "[0, 13, 14, 15, 16, 1, ...]",
-                         "a different map at keypoint " + std::to_string(k));
-      }
-    }
+  }
+}
+
+// What a MANO file does not store: name from the file, side from the options or the
+// file name, fingertip vertices from the options or manopth's (778-vertex MANO only).
+void InferManoMetadata(const std::string& path, int64_t nv,
+                       const HandModelLoadOptions& options, HandModel* m) {
+  m->name = Stem(path);
+  const std::optional<HandSide> side = options.side ? options.side : SideFromName(path);
+  if (!side) {
+    throw InputError(path, "side",
+                     "a file name containing 'left' or 'right' (as MANO_LEFT.pkl) or an "
+                     "explicit side option");
+  }
+  m->side = *side;
+  if (options.tip_vertex_ids) {
+    m->tip_vertex_ids = *options.tip_vertex_ids;
+  } else if (nv == kManoVertexCount) {
+    m->tip_vertex_ids = kManopthTipIds;
   } else {
-    m.name = Stem(path);
-    const std::optional<HandSide> side = options.side ? options.side : SideFromName(path);
-    if (!side) {
-      throw InputError(
-          path, "side",
-          "a file name containing 'left' or 'right' (as MANO_LEFT.pkl) or an "
-          "explicit side option");
-    }
-    m.side = *side;
-    if (options.tip_vertex_ids) {
-      m.tip_vertex_ids = *options.tip_vertex_ids;
-    } else if (nv == kManoVertexCount) {
-      m.tip_vertex_ids = kManopthTipIds;
-    } else {
-      throw InputError(path, "tip_vertex_ids",
-                       "fingertip vertex ids as an option for a model of " +
-                           std::to_string(nv) +
-                           " vertices (only 778-vertex MANO has defaults)");
-    }
+    throw InputError(path, "tip_vertex_ids",
+                     "fingertip vertex ids as an option for a model of " +
+                         std::to_string(nv) +
+                         " vertices (only 778-vertex MANO has defaults)");
+  }
+}
+
+HandModel ModelFromEntries(const Entries& entries, HandModelFormat format,
+                           const HandModelLoadOptions& options) {
+  const std::string& path = entries.path();
+  HandModel m;
+  const std::vector<double> v_template = entries.Doubles("v_template", {-1, 3});
+  const int64_t nv = static_cast<int64_t>(v_template.size() / 3);
+  m.v_template = RowMajorMatrix(v_template, nv, 3);
+  ReadFaces(entries, nv, &m);
+  m.shapedirs = Blendshapes(entries, "shapedirs", nv, -1);
+  m.posedirs = Blendshapes(entries, "posedirs", nv, 9 * (kNumHandJoints - 1));
+  m.joint_regressor = JointRegressor(entries, nv);
+  m.skinning_weights = RowMajorMatrix(entries.Doubles("weights", {nv, kNumHandJoints}),
+                                      nv, kNumHandJoints);
+  ReadParents(entries, &m);
+  ReadPosePcaAndStyle(entries, &m);
+  if (format == HandModelFormat::kHandlabelNpz) {
+    ReadHandlabelMetadata(entries, &m);
+  } else {
+    InferManoMetadata(path, nv, options, &m);
   }
   m.Check(path);
   return m;

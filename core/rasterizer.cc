@@ -69,6 +69,123 @@ inline double CanonicalEdge(const Eigen::Vector2d& a, const Eigen::Vector2d& b, 
   return -Edge(b.x(), b.y(), a.x(), a.y(), px, py);
 }
 
+// Per vertex: camera point, normalised coordinates and pixel (distorted) position;
+// q and uv are left unset for vertices before the near plane.
+struct ProjectedVertices {
+  std::vector<Eigen::Vector3d> pc;
+  std::vector<Eigen::Vector2d> q, uv;
+};
+
+ProjectedVertices ProjectVertices(const RenderMesh& mesh, const Rigid3& cam_from_world,
+                                  const Camera& camera, double near) {
+  const Eigen::Index nv = mesh.vertices.rows();
+  const Eigen::Matrix3d r = cam_from_world.rotation.toRotationMatrix();
+  const Eigen::Vector3d& t = cam_from_world.translation;
+  ProjectedVertices p;
+  p.pc.resize(nv);
+  p.q.resize(nv);
+  p.uv.resize(nv);
+  for (Eigen::Index v = 0; v < nv; ++v) {
+    p.pc[v] = r * mesh.vertices.row(v).transpose() + t;
+    if (p.pc[v].z() < near) continue;
+    p.q[v] = p.pc[v].head<2>() / p.pc[v].z();
+    p.uv[v] = camera.ImageFromNormalized(p.q[v]);
+  }
+  return p;
+}
+
+// Inclusive pixel range that a face may cover.
+struct PixelBox {
+  int x0, y0, x1, y1;
+};
+
+// The face's pixel search box, clipped to the image (empty: x0 > x1 or y0 > y1).
+// With distortion, edges are curved in the image and a face far outside the image's
+// rays cannot be trusted to project sensibly: search the whole image then.
+PixelBox FacePixelBox(const PixelRays& rays, const ProjectedVertices& p, int i0, int i1,
+                      int i2, const Eigen::Vector2d& qmin, const Eigen::Vector2d& qmax) {
+  const Camera& camera = rays.camera();
+  const bool distorted = camera.HasDistortion();
+  const int w = rays.width(), h = rays.height();
+  // The normalised-plane box where the distorted projection is still trustworthy:
+  // the image's ray box with a generous margin (distortion polynomials can fold back
+  // far outside the image).
+  const Eigen::Vector2d span = rays.max_xy() - rays.min_xy();
+  const Eigen::Vector2d valid_min = rays.min_xy() - 0.25 * span;
+  const Eigen::Vector2d valid_max = rays.max_xy() + 0.25 * span;
+  double umin, umax, vmin, vmax;
+  const bool trust = !distorted || ((qmin.array() >= valid_min.array()).all() &&
+                                    (qmax.array() <= valid_max.array()).all());
+  if (!trust) {
+    umin = vmin = -1;
+    umax = w;
+    vmax = h;
+  } else {
+    Eigen::Vector2d lo = p.uv[i0].cwiseMin(p.uv[i1]).cwiseMin(p.uv[i2]);
+    Eigen::Vector2d hi = p.uv[i0].cwiseMax(p.uv[i1]).cwiseMax(p.uv[i2]);
+    if (distorted) {  // edges are curved in the image: add points along them
+      const Eigen::Vector2d* corners[3] = {&p.q[i0], &p.q[i1], &p.q[i2]};
+      for (int e = 0; e < 3; ++e) {
+        const Eigen::Vector2d& a = *corners[e];
+        const Eigen::Vector2d& b = *corners[(e + 1) % 3];
+        for (double s : {0.25, 0.5, 0.75}) {
+          const Eigen::Vector2d pt = camera.ImageFromNormalized(a + s * (b - a));
+          lo = lo.cwiseMin(pt);
+          hi = hi.cwiseMax(pt);
+        }
+      }
+    }
+    const double pad = distorted ? 2.0 : 1.0;
+    umin = lo.x() - pad;
+    vmin = lo.y() - pad;
+    umax = hi.x() + pad;
+    vmax = hi.y() + pad;
+  }
+  return {std::max(0, static_cast<int>(std::ceil(umin))),
+          std::max(0, static_cast<int>(std::ceil(vmin))),
+          std::min(w - 1, static_cast<int>(std::floor(umax))),
+          std::min(h - 1, static_cast<int>(std::floor(vmax)))};
+}
+
+// Depth-tests and writes the pixels of `box` inside face f (vertices i0, i1, i2 with
+// normalised-plane signed area `area`).
+void DrawFace(const PixelRays& rays, const ProjectedVertices& p, int i0, int i1, int i2,
+              double area, const PixelBox& box, int mesh_id, Eigen::Index f,
+              VisibilityBuffer* buffer) {
+  const Eigen::Vector2d& q0 = p.q[i0];
+  const Eigen::Vector2d& q1 = p.q[i1];
+  const Eigen::Vector2d& q2 = p.q[i2];
+  float* depth = buffer->depth.data();
+  const double inv_area = 1.0 / area;
+  const double iz0 = 1.0 / p.pc[i0].z(), iz1 = 1.0 / p.pc[i1].z(),
+               iz2 = 1.0 / p.pc[i2].z();
+  for (int y = box.y0; y <= box.y1; ++y) {
+    for (int x = box.x0; x <= box.x1; ++x) {
+      const double* ray = rays.xy(x, y);
+      // Screen-space barycentrics in the normalised plane (same sign as area
+      // inside the triangle, whatever its orientation).
+      double l0 = CanonicalEdge(q1, q2, ray[0], ray[1]) * inv_area;
+      double l1 = CanonicalEdge(q2, q0, ray[0], ray[1]) * inv_area;
+      double l2 = CanonicalEdge(q0, q1, ray[0], ray[1]) * inv_area;
+      if (l0 < 0 || l1 < 0 || l2 < 0) continue;
+      const double sum = l0 + l1 + l2;  // 1 up to rounding
+      l0 /= sum;
+      l1 /= sum;
+      l2 /= sum;
+      // 1/z is affine along the plane's image: exact ray-plane depth.
+      const double inv_z = l0 * iz0 + l1 * iz1 + l2 * iz2;
+      const double z = 1.0 / inv_z;
+      const size_t idx = buffer->index(x, y);
+      if (!(z < depth[idx])) continue;
+      depth[idx] = static_cast<float>(z);
+      buffer->mesh_id[idx] = static_cast<int16_t>(mesh_id);
+      buffer->face_id[idx] = static_cast<int32_t>(f);
+      buffer->bary[2 * idx] = static_cast<float>(l1 * iz1 * z);
+      buffer->bary[2 * idx + 1] = static_cast<float>(l2 * iz2 * z);
+    }
+  }
+}
+
 }  // namespace
 
 int RasterizeMesh(const RenderMesh& mesh, int mesh_id, const Rigid3& cam_from_world,
@@ -77,40 +194,18 @@ int RasterizeMesh(const RenderMesh& mesh, int mesh_id, const Rigid3& cam_from_wo
   HL_CHECK(mesh_id >= 0 && mesh_id < 32768, "mesh id out of range");
   HL_CHECK(buffer->width == rays.width() && buffer->height == rays.height(),
            "visibility buffer not reset to the camera size");
-  const Camera& camera = rays.camera();
-  const bool distorted = camera.HasDistortion();
-  const int w = rays.width(), h = rays.height();
-  const Eigen::Index nv = mesh.vertices.rows();
-
-  // Per vertex: camera point, normalised coordinates, pixel (distorted) position.
-  const Eigen::Matrix3d r = cam_from_world.rotation.toRotationMatrix();
-  const Eigen::Vector3d& t = cam_from_world.translation;
-  std::vector<Eigen::Vector3d> pc(nv);
-  std::vector<Eigen::Vector2d> q(nv), uv(nv);
-  // The normalised-plane box where the distorted projection is still trustworthy:
-  // the image's ray box with a generous margin (distortion polynomials can fold back
-  // far outside the image).
-  const Eigen::Vector2d span = rays.max_xy() - rays.min_xy();
-  const Eigen::Vector2d valid_min = rays.min_xy() - 0.25 * span;
-  const Eigen::Vector2d valid_max = rays.max_xy() + 0.25 * span;
-  for (Eigen::Index v = 0; v < nv; ++v) {
-    pc[v] = r * mesh.vertices.row(v).transpose() + t;
-    if (pc[v].z() < options.near) continue;
-    q[v] = pc[v].head<2>() / pc[v].z();
-    uv[v] = camera.ImageFromNormalized(q[v]);
-  }
-
+  const ProjectedVertices p =
+      ProjectVertices(mesh, cam_from_world, rays.camera(), options.near);
   int tested = 0;
-  float* depth = buffer->depth.data();
   for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f) {
     const int i0 = mesh.faces(f, 0), i1 = mesh.faces(f, 1), i2 = mesh.faces(f, 2);
-    if (pc[i0].z() < options.near || pc[i1].z() < options.near ||
-        pc[i2].z() < options.near) {
+    if (p.pc[i0].z() < options.near || p.pc[i1].z() < options.near ||
+        p.pc[i2].z() < options.near) {
       continue;
     }
-    const Eigen::Vector2d& q0 = q[i0];
-    const Eigen::Vector2d& q1 = q[i1];
-    const Eigen::Vector2d& q2 = q[i2];
+    const Eigen::Vector2d& q0 = p.q[i0];
+    const Eigen::Vector2d& q1 = p.q[i1];
+    const Eigen::Vector2d& q2 = p.q[i2];
     const Eigen::Vector2d qmin = q0.cwiseMin(q1).cwiseMin(q2);
     const Eigen::Vector2d qmax = q0.cwiseMax(q1).cwiseMax(q2);
     // Entirely outside the image's rays: nothing to draw.
@@ -121,69 +216,9 @@ int RasterizeMesh(const RenderMesh& mesh, int mesh_id, const Rigid3& cam_from_wo
     const double area = Edge(q0.x(), q0.y(), q1.x(), q1.y(), q2.x(), q2.y());
     if (std::abs(area) < 1e-18) continue;  // degenerate or seen edge-on
     ++tested;
-
-    // Pixel search box.
-    double umin, umax, vmin, vmax;
-    const bool trust = !distorted || ((qmin.array() >= valid_min.array()).all() &&
-                                      (qmax.array() <= valid_max.array()).all());
-    if (!trust) {
-      umin = vmin = -1;
-      umax = w;
-      vmax = h;
-    } else {
-      Eigen::Vector2d lo = uv[i0].cwiseMin(uv[i1]).cwiseMin(uv[i2]);
-      Eigen::Vector2d hi = uv[i0].cwiseMax(uv[i1]).cwiseMax(uv[i2]);
-      if (distorted) {  // edges are curved in the image: add points along them
-        const Eigen::Vector2d* corners[3] = {&q0, &q1, &q2};
-        for (int e = 0; e < 3; ++e) {
-          const Eigen::Vector2d& a = *corners[e];
-          const Eigen::Vector2d& b = *corners[(e + 1) % 3];
-          for (double s : {0.25, 0.5, 0.75}) {
-            const Eigen::Vector2d p = camera.ImageFromNormalized(a + s * (b - a));
-            lo = lo.cwiseMin(p);
-            hi = hi.cwiseMax(p);
-          }
-        }
-      }
-      const double pad = distorted ? 2.0 : 1.0;
-      umin = lo.x() - pad;
-      vmin = lo.y() - pad;
-      umax = hi.x() + pad;
-      vmax = hi.y() + pad;
-    }
-    const int x0 = std::max(0, static_cast<int>(std::ceil(umin)));
-    const int y0 = std::max(0, static_cast<int>(std::ceil(vmin)));
-    const int x1 = std::min(w - 1, static_cast<int>(std::floor(umax)));
-    const int y1 = std::min(h - 1, static_cast<int>(std::floor(vmax)));
-    if (x0 > x1 || y0 > y1) continue;
-
-    const double inv_area = 1.0 / area;
-    const double iz0 = 1.0 / pc[i0].z(), iz1 = 1.0 / pc[i1].z(), iz2 = 1.0 / pc[i2].z();
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
-        const double* p = rays.xy(x, y);
-        // Screen-space barycentrics in the normalised plane (same sign as area
-        // inside the triangle, whatever its orientation).
-        double l0 = CanonicalEdge(q1, q2, p[0], p[1]) * inv_area;
-        double l1 = CanonicalEdge(q2, q0, p[0], p[1]) * inv_area;
-        double l2 = CanonicalEdge(q0, q1, p[0], p[1]) * inv_area;
-        if (l0 < 0 || l1 < 0 || l2 < 0) continue;
-        const double sum = l0 + l1 + l2;  // 1 up to rounding
-        l0 /= sum;
-        l1 /= sum;
-        l2 /= sum;
-        // 1/z is affine along the plane's image: exact ray-plane depth.
-        const double inv_z = l0 * iz0 + l1 * iz1 + l2 * iz2;
-        const double z = 1.0 / inv_z;
-        const size_t idx = buffer->index(x, y);
-        if (!(z < depth[idx])) continue;
-        depth[idx] = static_cast<float>(z);
-        buffer->mesh_id[idx] = static_cast<int16_t>(mesh_id);
-        buffer->face_id[idx] = static_cast<int32_t>(f);
-        buffer->bary[2 * idx] = static_cast<float>(l1 * iz1 * z);
-        buffer->bary[2 * idx + 1] = static_cast<float>(l2 * iz2 * z);
-      }
-    }
+    const PixelBox box = FacePixelBox(rays, p, i0, i1, i2, qmin, qmax);
+    if (box.x0 > box.x1 || box.y0 > box.y1) continue;
+    DrawFace(rays, p, i0, i1, i2, area, box, mesh_id, f, buffer);
   }
   return tested;
 }

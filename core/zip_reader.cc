@@ -151,23 +151,39 @@ const ZipEntry* ZipReader::Find(const std::string& name) const {
   return nullptr;
 }
 
-void ZipReader::ParseCentralDirectory() {
-  const uint64_t file_size = bytes_->size();
-  auto read_block = [&](uint64_t offset, uint64_t n, const char* what) {
-    if (offset > file_size || n > file_size - offset) {
-      throw InputError(source_, what, "a record inside the file", "offset out of range");
-    }
-    std::string block(static_cast<size_t>(n), '\0');
-    bytes_->ReadAt(offset, static_cast<size_t>(n), block.data());
-    return block;
-  };
+namespace {
+
+// n bytes at `offset`, refusing ranges beyond the end of the file.
+std::string ReadBlock(const ZipReader::ByteSource& bytes, const std::string& source,
+                      uint64_t offset, uint64_t n, const char* what) {
+  const uint64_t file_size = bytes.size();
+  if (offset > file_size || n > file_size - offset) {
+    throw InputError(source, what, "a record inside the file", "offset out of range");
+  }
+  std::string block(static_cast<size_t>(n), '\0');
+  bytes.ReadAt(offset, static_cast<size_t>(n), block.data());
+  return block;
+}
+
+// Where the central directory lies and how many entries it holds.
+struct CentralDirectoryPlace {
+  uint64_t disk = 0, cd_disk = 0;  // both 0 for a single-disk archive
+  uint64_t count = 0, size = 0, offset = 0;
+};
+
+// Reads the end of central directory record (searched backwards over the comment) and,
+// when a zip64 locator sits directly before it, the zip64 end record.
+CentralDirectoryPlace FindCentralDirectory(const ZipReader::ByteSource& bytes,
+                                           const std::string& source) {
+  const uint64_t file_size = bytes.size();
   if (file_size < kEndSize) {
-    throw InputError(source_, "", "a zip archive",
+    throw InputError(source, "", "a zip archive",
                      "a file of " + std::to_string(file_size) + " bytes");
   }
   // The end record sits in the last 22 + (up to 65535 comment) bytes.
   const uint64_t tail_size = std::min<uint64_t>(file_size, kEndSize + 0xFFFF);
-  const std::string tail = read_block(file_size - tail_size, tail_size, "end record");
+  const std::string tail =
+      ReadBlock(bytes, source, file_size - tail_size, tail_size, "end record");
   size_t end_pos = std::string::npos;
   for (size_t p = tail.size() - kEndSize + 1; p-- > 0;) {
     if (LoadLE(tail.data() + p, 4) == kEndSig) {
@@ -176,79 +192,96 @@ void ZipReader::ParseCentralDirectory() {
     }
   }
   if (end_pos == std::string::npos) {
-    throw InputError(source_, "", "a zip archive (end of central directory record)",
+    throw InputError(source, "", "a zip archive (end of central directory record)",
                      "none found: not a zip file or truncated");
   }
   const uint64_t end_offset = file_size - tail_size + end_pos;
-  Cursor end(tail, source_, "end record");
+  Cursor end(tail, source, "end record");
   end.Skip(end_pos + 4);
-  const uint64_t disk = end.Get(2), cd_disk = end.Get(2);
+  CentralDirectoryPlace place;
+  place.disk = end.Get(2);
+  place.cd_disk = end.Get(2);
   end.Get(2);
-  uint64_t count = end.Get(2);
-  uint64_t cd_size = end.Get(4);
-  uint64_t cd_offset = end.Get(4);
+  place.count = end.Get(2);
+  place.size = end.Get(4);
+  place.offset = end.Get(4);
   // A zip64 locator directly before the end record points at the zip64 end record.
   if (end_offset >= 20) {
-    const std::string loc = read_block(end_offset - 20, 20, "zip64 locator");
+    const std::string loc =
+        ReadBlock(bytes, source, end_offset - 20, 20, "zip64 locator");
     if (LoadLE(loc.data(), 4) == kZip64LocatorSig) {
       const uint64_t z64_offset = LoadLE(loc.data() + 8, 8);
-      const std::string z64 = read_block(z64_offset, 56, "zip64 end record");
+      const std::string z64 =
+          ReadBlock(bytes, source, z64_offset, 56, "zip64 end record");
       if (LoadLE(z64.data(), 4) != kZip64EndSig) {
-        throw InputError(source_, "zip64 end record", "signature PK\\6\\6");
+        throw InputError(source, "zip64 end record", "signature PK\\6\\6");
       }
-      count = LoadLE(z64.data() + 32, 8);
-      cd_size = LoadLE(z64.data() + 40, 8);
-      cd_offset = LoadLE(z64.data() + 48, 8);
+      place.count = LoadLE(z64.data() + 32, 8);
+      place.size = LoadLE(z64.data() + 40, 8);
+      place.offset = LoadLE(z64.data() + 48, 8);
     }
   }
-  if (disk != 0 || cd_disk != 0) {
+  return place;
+}
+
+// One central directory header (entry number i) at the cursor.
+ZipEntry ParseCentralEntry(Cursor* c, const std::string& source, uint64_t i) {
+  if (c->Get(4) != kCentralHeaderSig) {
+    throw InputError(source, "central directory",
+                     "entry signature PK\\1\\2 at entry " + std::to_string(i));
+  }
+  ZipEntry e;
+  c->Skip(4);  // versions
+  e.flags = static_cast<uint16_t>(c->Get(2));
+  e.method = static_cast<uint16_t>(c->Get(2));
+  c->Skip(4);  // time, date
+  e.crc32 = static_cast<uint32_t>(c->Get(4));
+  e.compressed_size = c->Get(4);
+  e.uncompressed_size = c->Get(4);
+  const size_t name_len = c->Get(2), extra_len = c->Get(2), comment_len = c->Get(2);
+  c->Skip(8);  // disk, internal and external attributes
+  e.local_header_offset = c->Get(4);
+  e.name = c->Take(name_len);
+  const std::string extra = c->Take(extra_len);
+  c->Skip(comment_len);
+  // Zip64 extra field: 64-bit values for the fields that hold 0xFFFFFFFF, in order.
+  Cursor x(extra, source, "zip64 extra field");
+  while (x.remaining() >= 4) {
+    const uint64_t id = x.Get(2), size = x.Get(2);
+    const std::string body = x.Take(size);
+    if (id != 0x0001) continue;
+    Cursor z(body, source, "zip64 extra field");
+    if (e.uncompressed_size == 0xFFFFFFFF) e.uncompressed_size = z.Get(8);
+    if (e.compressed_size == 0xFFFFFFFF) e.compressed_size = z.Get(8);
+    if (e.local_header_offset == 0xFFFFFFFF) e.local_header_offset = z.Get(8);
+  }
+  return e;
+}
+
+}  // namespace
+
+void ZipReader::ParseCentralDirectory() {
+  const CentralDirectoryPlace place = FindCentralDirectory(*bytes_, source_);
+  if (place.disk != 0 || place.cd_disk != 0) {
     throw InputError(source_, "", "a single-disk archive", "a multi-disk archive");
   }
-  if (count > static_cast<uint64_t>(limits_.max_entries)) {
+  if (place.count > static_cast<uint64_t>(limits_.max_entries)) {
     throw InputError(source_, "entries",
                      "at most " + std::to_string(limits_.max_entries) + " entries",
-                     std::to_string(count));
+                     std::to_string(place.count));
   }
-  if (count * kCentralHeaderSize > cd_size) {
-    throw InputError(
-        source_, "central directory",
-        std::to_string(count) + " entries in " + std::to_string(cd_size) + " bytes",
-        "inconsistent sizes");
+  if (place.count * kCentralHeaderSize > place.size) {
+    throw InputError(source_, "central directory",
+                     std::to_string(place.count) + " entries in " +
+                         std::to_string(place.size) + " bytes",
+                     "inconsistent sizes");
   }
-  const std::string cd = read_block(cd_offset, cd_size, "central directory");
+  const std::string cd =
+      ReadBlock(*bytes_, source_, place.offset, place.size, "central directory");
   Cursor c(cd, source_, "central directory");
-  entries_.reserve(static_cast<size_t>(count));
-  for (uint64_t i = 0; i < count; ++i) {
-    if (c.Get(4) != kCentralHeaderSig) {
-      throw InputError(source_, "central directory",
-                       "entry signature PK\\1\\2 at entry " + std::to_string(i));
-    }
-    ZipEntry e;
-    c.Skip(4);  // versions
-    e.flags = static_cast<uint16_t>(c.Get(2));
-    e.method = static_cast<uint16_t>(c.Get(2));
-    c.Skip(4);  // time, date
-    e.crc32 = static_cast<uint32_t>(c.Get(4));
-    e.compressed_size = c.Get(4);
-    e.uncompressed_size = c.Get(4);
-    const size_t name_len = c.Get(2), extra_len = c.Get(2), comment_len = c.Get(2);
-    c.Skip(8);  // disk, internal and external attributes
-    e.local_header_offset = c.Get(4);
-    e.name = c.Take(name_len);
-    const std::string extra = c.Take(extra_len);
-    c.Skip(comment_len);
-    // Zip64 extra field: 64-bit values for the fields that hold 0xFFFFFFFF, in order.
-    Cursor x(extra, source_, "zip64 extra field");
-    while (x.remaining() >= 4) {
-      const uint64_t id = x.Get(2), size = x.Get(2);
-      const std::string body = x.Take(size);
-      if (id != 0x0001) continue;
-      Cursor z(body, source_, "zip64 extra field");
-      if (e.uncompressed_size == 0xFFFFFFFF) e.uncompressed_size = z.Get(8);
-      if (e.compressed_size == 0xFFFFFFFF) e.compressed_size = z.Get(8);
-      if (e.local_header_offset == 0xFFFFFFFF) e.local_header_offset = z.Get(8);
-    }
-    entries_.push_back(std::move(e));
+  entries_.reserve(static_cast<size_t>(place.count));
+  for (uint64_t i = 0; i < place.count; ++i) {
+    entries_.push_back(ParseCentralEntry(&c, source_, i));
   }
 }
 

@@ -15,6 +15,7 @@
 #include "fitting/axis_angle_manifold.h"
 #include "fitting/joint_limit_cost.h"
 #include "fitting/keypoint_reprojection_cost.h"
+#include "fitting/points3d_cost.h"
 #include "fitting/prior_costs.h"
 #include "fitting/silhouette_cost.h"
 #include "fitting/silhouette_outline.h"

@@ -27,7 +27,7 @@
 #include "core/hand_model.h"
 #include "core/rasterizer.h"
 #include "fitting/keypoint_view.h"
-#include "fitting/points3d_cost.h"
+#include "fitting/points3d_targets.h"
 #include "fitting/robust_loss.h"
 
 namespace handlabel {

@@ -13,15 +13,9 @@
 
 #include "core/hand_evaluator.h"
 #include "core/hand_lbs.h"
+#include "fitting/points3d_targets.h"
 
 namespace handlabel {
-
-struct Points3dTargets {
-  Points3d keypoints;                // 21 x 3 or empty
-  Eigen::VectorXd keypoint_weights;  // 21 or empty (= all 1)
-  std::vector<int> vertex_ids;       // vertices to pull (may be empty)
-  Points3d vertices;                 // vertex_ids.size() x 3
-};
 
 template <int kPoseDim = kNumPoseParams, int kNumBetas = 10>
 class Points3dCost {

@@ -32,12 +32,4 @@ double MaskIoU(const MaskImage& a, const MaskImage& b) {
   return either == 0 ? 1.0 : double(both) / double(either);
 }
 
-MaskImage MaskFromImage(const ImageU8& image) {
-  MaskImage mask(image.height, image.width);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) mask(y, x) = image.at(x, y, 0) != 0 ? 1 : 0;
-  }
-  return mask;
-}
-
 }  // namespace handlabel

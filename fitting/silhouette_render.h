@@ -2,8 +2,8 @@
 // Masks of a posed hand mesh seen by a camera (core/rasterizer.h) and their IoU with a
 // silhouette mask: the per-view quality figure of a fit.
 
-#include "core/distance_transform.h"
 #include "core/hand_lbs.h"
+#include "core/mask_image.h"
 #include "core/rasterizer.h"
 #include "core/rig.h"
 
@@ -16,8 +16,5 @@ MaskImage RenderHandMask(const Points3d& vertices, const MeshFaces& faces,
 
 // |A and B| / |A or B| over nonzero pixels; 1 when both are empty.
 double MaskIoU(const MaskImage& a, const MaskImage& b);
-
-// ImageU8 (1 channel, or the first channel) -> MaskImage (nonzero = 1).
-MaskImage MaskFromImage(const ImageU8& image);
 
 }  // namespace handlabel

@@ -162,15 +162,12 @@ void OpenHandBuildOptions::Check() const {
   skinning.Check();
 }
 
-HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions& options,
-                        OpenHandBuildReport* report) {
-  options.Check();
-  OpenHandBuildReport local_report;
-  if (!report) report = &local_report;
-  const OpenHandShape shape = ShapeFromDesign(design);
-  const OpenHandSkeleton skeleton = SkeletonFromDesign(design);
+namespace {
 
-  // 1. Surface.
+// Step 1: the design's implicit surface meshed finely, decimated to the target size
+// and relaxed without self-intersections.
+TriangleMesh BuildSurface(const OpenHandShape& shape, const OpenHandBuildOptions& options,
+                          OpenHandBuildReport* report) {
   Eigen::Vector3d lo, hi;
   shape.Bounds(&lo, &hi);
   ImplicitMesherOptions mesher;
@@ -184,8 +181,88 @@ HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions
   decimation.improve_by_flips = true;
   TriangleMesh mesh = DecimateMesh(fine, decimation);
   RelaxWithoutIntersections(&mesh, options.relax_iterations, shape);
-  const int nv = static_cast<int>(mesh.vertices.size());
+  return mesh;
+}
 
+// Step 4: each joint's regressor row, fitted over the vertices near it.
+Eigen::SparseMatrix<double, Eigen::RowMajor> BuildJointRegressor(
+    const TriangleMesh& mesh, const OpenHandShapeSpace& space,
+    const OpenHandSkeleton& skeleton, const OpenHandBuildOptions& options,
+    OpenHandBuildReport* report) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int j = 0; j < kNumHandJoints; ++j) {
+    const double radius = options.regressor_radius * skeleton.radii[j];
+    const Eigen::SparseVector<double> row =
+        FitRegressorRow(mesh.vertices, space.vertex_dirs, space.joint_dirs, j,
+                        skeleton.joints[j], BoneAxis(skeleton, j), radius,
+                        &report->max_regressor_error, &report->max_regressor_error_mean);
+    for (Eigen::SparseVector<double>::InnerIterator it(row); it; ++it)
+      triplets.emplace_back(j, static_cast<int>(it.index()), it.value());
+  }
+  Eigen::SparseMatrix<double, Eigen::RowMajor> regressor;
+  regressor.resize(kNumHandJoints, static_cast<int>(mesh.vertices.size()));
+  regressor.setFromTriplets(triplets.begin(), triplets.end());
+  return regressor;
+}
+
+// Step 5: the vertex nearest to each designed fingertip.
+std::array<int, 5> NearestTipVertices(const TriangleMesh& mesh,
+                                      const OpenHandSkeleton& skeleton) {
+  std::array<int, 5> tips{};
+  const int nv = static_cast<int>(mesh.vertices.size());
+  for (int t = 0; t < 5; ++t) {
+    int best = 0;
+    for (int v = 1; v < nv; ++v) {
+      if ((mesh.vertices[v] - skeleton.tips[t]).squaredNorm() <
+          (mesh.vertices[best] - skeleton.tips[t]).squaredNorm())
+        best = v;
+    }
+    tips[t] = best;
+  }
+  return tips;
+}
+
+// Step 6: pose PCA from natural poses (open, fist, pinch, point, random within
+// limits) sampled on the model's anatomy; sets pose_mean and pose_pca_basis.
+void BuildPosePca(const OpenHandBuildOptions& options, std::mt19937_64& rng,
+                  HandModel* model, OpenHandBuildReport* report) {
+  const HandAnatomy anatomy = ComputeHandAnatomy(*model);
+  const HandLimits limits = DefaultHandLimits();
+  HandPoseSamplerOptions sampler;
+  Eigen::MatrixXd poses(options.num_pose_samples, kNumPoseParams);
+  for (int s = 0; s < options.num_pose_samples; ++s) {
+    poses.row(s) = SampleHandPose(anatomy, limits, sampler, rng).hand_pose.transpose();
+  }
+  model->pose_mean = poses.colwise().mean().transpose();
+  const Eigen::MatrixXd centred = poses.rowwise() - model->pose_mean.transpose();
+  const Eigen::MatrixXd cov = centred.transpose() * centred / options.num_pose_samples;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
+  HL_CHECK(eig.info() == Eigen::Success, "pose PCA failed");
+  model->pose_pca_basis.resize(kNumPoseParams, kNumPoseParams);
+  double first6 = 0.0;
+  for (int k = 0; k < kNumPoseParams; ++k) {
+    Eigen::VectorXd dir = eig.eigenvectors().col(kNumPoseParams - 1 - k);
+    Eigen::Index big;
+    dir.cwiseAbs().maxCoeff(&big);
+    if (dir[big] < 0) dir = -dir;  // deterministic sign: largest entry positive
+    model->pose_pca_basis.row(k) = dir.transpose();
+    if (k < 6) first6 += eig.eigenvalues()[kNumPoseParams - 1 - k];
+  }
+  report->pose_variance_explained_6 = first6 / cov.trace();
+}
+
+}  // namespace
+
+HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions& options,
+                        OpenHandBuildReport* report) {
+  options.Check();
+  OpenHandBuildReport local_report;
+  if (!report) report = &local_report;
+  const OpenHandShape shape = ShapeFromDesign(design);
+  const OpenHandSkeleton skeleton = SkeletonFromDesign(design);
+
+  const TriangleMesh mesh = BuildSurface(shape, options, report);
+  const int nv = static_cast<int>(mesh.vertices.size());
   HandModel model;
   model.name = "open_hand_right";
   model.side = HandSide::kRight;
@@ -197,8 +274,7 @@ HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions
 
   // 2. Skinning.
   model.skinning_weights = OpenHandSkinningWeights(mesh, skeleton, options.skinning);
-
-  // 3. Shapes.
+  // 3. Shapes (plain LBS: no pose blend shapes).
   std::mt19937_64 rng(options.seed);
   const OpenHandShapeSpace space = BuildOpenHandShapeSpace(
       mesh.vertices, model.skinning_weights, design, options.variation, options.num_betas,
@@ -206,56 +282,10 @@ HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions
   model.shapedirs = space.vertex_dirs;
   report->shape_variance_explained = space.explained;
   model.posedirs = Eigen::MatrixXd::Zero(3 * nv, 9 * (kNumHandJoints - 1));
-
-  // 4. Joint regressor.
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (int j = 0; j < kNumHandJoints; ++j) {
-    const double radius = options.regressor_radius * skeleton.radii[j];
-    const Eigen::SparseVector<double> row =
-        FitRegressorRow(mesh.vertices, space.vertex_dirs, space.joint_dirs, j,
-                        skeleton.joints[j], BoneAxis(skeleton, j), radius,
-                        &report->max_regressor_error, &report->max_regressor_error_mean);
-    for (Eigen::SparseVector<double>::InnerIterator it(row); it; ++it)
-      triplets.emplace_back(j, static_cast<int>(it.index()), it.value());
-  }
-  model.joint_regressor.resize(kNumHandJoints, nv);
-  model.joint_regressor.setFromTriplets(triplets.begin(), triplets.end());
-
-  // 5. Fingertips.
-  for (int t = 0; t < 5; ++t) {
-    int best = 0;
-    for (int v = 1; v < nv; ++v) {
-      if ((mesh.vertices[v] - skeleton.tips[t]).squaredNorm() <
-          (mesh.vertices[best] - skeleton.tips[t]).squaredNorm())
-        best = v;
-    }
-    model.tip_vertex_ids[t] = best;
-  }
-
-  // 6. Pose PCA from natural poses (open, fist, pinch, point, random within limits).
-  const HandAnatomy anatomy = ComputeHandAnatomy(model);
-  const HandLimits limits = DefaultHandLimits();
-  HandPoseSamplerOptions sampler;
-  Eigen::MatrixXd poses(options.num_pose_samples, kNumPoseParams);
-  for (int s = 0; s < options.num_pose_samples; ++s) {
-    poses.row(s) = SampleHandPose(anatomy, limits, sampler, rng).hand_pose.transpose();
-  }
-  model.pose_mean = poses.colwise().mean().transpose();
-  const Eigen::MatrixXd centred = poses.rowwise() - model.pose_mean.transpose();
-  const Eigen::MatrixXd cov = centred.transpose() * centred / options.num_pose_samples;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
-  HL_CHECK(eig.info() == Eigen::Success, "pose PCA failed");
-  model.pose_pca_basis.resize(kNumPoseParams, kNumPoseParams);
-  double first6 = 0.0;
-  for (int k = 0; k < kNumPoseParams; ++k) {
-    Eigen::VectorXd dir = eig.eigenvectors().col(kNumPoseParams - 1 - k);
-    Eigen::Index big;
-    dir.cwiseAbs().maxCoeff(&big);
-    if (dir[big] < 0) dir = -dir;  // deterministic sign: largest entry positive
-    model.pose_pca_basis.row(k) = dir.transpose();
-    if (k < 6) first6 += eig.eigenvalues()[kNumPoseParams - 1 - k];
-  }
-  report->pose_variance_explained_6 = first6 / cov.trace();
+  // 4-6.
+  model.joint_regressor = BuildJointRegressor(mesh, space, skeleton, options, report);
+  model.tip_vertex_ids = NearestTipVertices(mesh, skeleton);
+  BuildPosePca(options, rng, &model, report);
 
   model.Check("open hand builder");
   return options.side == HandSide::kLeft ? MirrorHandModel(model) : model;

@@ -1,46 +1,116 @@
 #include "pipeline/ceres_label_fitter.h"
 
+#include <filesystem>
+#include <fstream>
+
 #include "core/errors.h"
-#include "core/image.h"
+#include "core/mask_image.h"
 #include "pipeline/label_policy.h"
+#include "pipeline/label_record.h"
 
 namespace handlabel {
 namespace {
 
+namespace fs = std::filesystem;
+using nlohmann::json;
+
 // Network vertices pulled in refinement: every n-th (the keypoints carry most of it).
 constexpr int kVertexTargetStride = 8;
 
-MaskImage ReadMaskImage(const std::string& path) {
-  const ImageU8 image = ReadPng(path);
-  MaskImage mask(image.height, image.width);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) mask(y, x) = image.at(x, y, 0) > 127 ? 255 : 0;
+Eigen::VectorXd VectorFromJson(const json& j, const std::string& source,
+                               const std::string& field, int size) {
+  if (!j.is_array() || (size >= 0 && static_cast<int>(j.size()) != size)) {
+    throw InputError(source, field,
+                     size >= 0 ? "an array of " + std::to_string(size) + " numbers"
+                               : "an array of numbers");
   }
-  return mask;
+  Eigen::VectorXd v(j.size());
+  for (size_t i = 0; i < j.size(); ++i) {
+    if (!j[i].is_number()) throw InputError(source, field, "numbers");
+    v[i] = j[i].get<double>();
+  }
+  return v;
+}
+
+// A label of a job (label_record.h), or MANO parameters at the top or under "params".
+HandParams ParamsFromJson(const json& file, const std::string& source) {
+  if (file.value("format", "") == "handlabel-label") {
+    const LabelRecord label = LabelFromJson(file, source);
+    if (!label.params) throw InputError(source, "mano", "a label with MANO parameters");
+    return *label.params;
+  }
+  const json& j =
+      file.contains("params") && file["params"].is_object() ? file["params"] : file;
+  for (const char* key : {"global_orient", "hand_pose", "betas", "transl"}) {
+    if (!j.contains(key)) {
+      throw InputError(source, key,
+                       "MANO parameters (global_orient, hand_pose, betas, transl)");
+    }
+  }
+  HandParams p;
+  p.global_orient = VectorFromJson(j["global_orient"], source, "global_orient", 3);
+  p.hand_pose = VectorFromJson(j["hand_pose"], source, "hand_pose", kNumPoseParams);
+  p.betas = VectorFromJson(j["betas"], source, "betas", -1);
+  p.transl = VectorFromJson(j["transl"], source, "transl", 3);
+  return p;
+}
+
+HandParams ReadInitFile(const std::string& dir, const std::string& frame) {
+  const std::string stem = FrameFileStem(frame, dir);
+  for (const std::string& rel :
+       {frame + ".json", "frames/" + frame + ".json", "labels/" + stem + ".json"}) {
+    const fs::path path = fs::path(dir) / rel;
+    if (!fs::exists(path)) continue;
+    std::ifstream in(path);
+    json j;
+    try {
+      j = json::parse(in);
+    } catch (const json::exception& e) {
+      throw InputError(path.string(), "(file)", "JSON", e.what());
+    }
+    return ParamsFromJson(j, path.string());
+  }
+  throw InputError("fit.init " + dir, frame + ".json",
+                   "a per-frame parameter file (<frame>.json, frames/ or labels/)");
+}
+
+Points3dTargets NetworkTargets(const MeshPrediction& net, int num_vertices) {
+  Points3dTargets targets;
+  targets.keypoints = net.keypoints;
+  targets.keypoint_weights = Eigen::VectorXd::Ones(kNumHandKeypoints);
+  if (net.vertices.rows() == num_vertices) {
+    for (int v = 0; v < num_vertices; v += kVertexTargetStride) {
+      targets.vertex_ids.push_back(v);
+    }
+    targets.vertices.resize(targets.vertex_ids.size(), 3);
+    for (size_t i = 0; i < targets.vertex_ids.size(); ++i) {
+      targets.vertices.row(i) = net.vertices.row(targets.vertex_ids[i]);
+    }
+  }
+  return targets;
 }
 
 }  // namespace
 
-CeresLabelFitter::CeresLabelFitter(const HandModel& model, bool use_masks,
-                                   const HandFitConfig& config,
-                                   const HandFitOptions& options,
-                                   double network_mask_sigma_px)
-    : fitter_(model, config, options),
+CeresLabelFitter::CeresLabelFitter(const HandModel& model,
+                                   const CeresLabelFitterOptions& options)
+    : fitter_(model, options.config, options.fit),
       num_vertices_(model.num_vertices()),
-      use_masks_(use_masks) {
-  if (network_mask_sigma_px > 0) {
-    HandFitOptions coarse = options;
-    coarse.silhouette_sigma_px = network_mask_sigma_px;
-    network_mask_fitter_.emplace(model, config, coarse);
+      options_(options) {
+  if (options.network_mask_sigma_px > 0) {
+    HandFitOptions coarse = options.fit;
+    coarse.silhouette_sigma_px = options.network_mask_sigma_px;
+    network_mask_fitter_.emplace(model, options.config, coarse);
   }
 }
 
 std::string CeresLabelFitter::Describe() const {
   return std::string("Ceres hand fitter (keypoints") +
-         (use_masks_ ? " + silhouettes" : "") + ")";
+         (options_.use_masks ? " + silhouettes" : "") + ")";
 }
 
-LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
+HandFitInput CeresLabelFitter::Evidence(const LabelFitRequest& request,
+                                        std::string* silhouettes) const {
   const FrameInput& frame = *request.frame;
   HandFitInput input;
   for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
@@ -52,43 +122,85 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
     input.views.push_back(view);
   }
   // Masks follow the order of input.views.
-  std::string silhouettes = "none";
+  *silhouettes = "none";
   if (!request.masks.empty()) {
-    silhouettes = "network";
+    *silhouettes = "network";
     HL_CHECK(request.masks.size() == request.keypoints_2d.size(), "one mask per view");
     for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
       if (request.keypoints_2d[v]) input.masks.push_back(request.masks[v]);
     }
-  } else if (use_masks_ && !frame.mask_paths.empty()) {
-    silhouettes = "files";
+  } else if (options_.use_masks && !frame.mask_paths.empty()) {
+    *silhouettes = "files";
     for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
       if (!request.keypoints_2d[v]) continue;
       input.masks.push_back(
-          frame.mask_paths[v].empty() ? MaskImage() : ReadMaskImage(frame.mask_paths[v]));
+          frame.mask_paths[v].empty() ? MaskImage() : ReadMaskPng(frame.mask_paths[v]));
     }
+  }
+  return input;
+}
+
+HandParams CeresLabelFitter::Start(const LabelFitRequest& request,
+                                   const CeresHandFitter& fitter, HandFitInput* input,
+                                   std::string* start) const {
+  const FrameInput& frame = *request.frame;
+  if (request.init) {
+    *start = "network";
+    input->targets3d = NetworkTargets(*request.init, num_vertices_);
+    return fitter.InitFromKeypoints3d(request.init->keypoints,
+                                      input->targets3d->keypoint_weights);
+  }
+  const std::string& init = options_.init;
+  if (init == "gt") {
+    if (!frame.ground_truth || !frame.ground_truth->params) {
+      throw Error("fit.init is gt, and frame " + frame.id +
+                  " has no ground-truth parameters");
+    }
+    *start = "ground_truth";
+    return *frame.ground_truth->params;
+  }
+  if (init == "previous" && request.previous) {
+    *start = "previous_label";
+    input->previous = *request.previous;
+    return *request.previous;
+  }
+  if (init != "triangulate" && init != "previous") {
+    *start = "file";
+    return ReadInitFile(init, frame.id);
+  }
+  *start = "triangulated_views";
+  return fitter.InitFromViews(input->views);
+}
+
+std::shared_ptr<const std::vector<PixelRays>> CeresLabelFitter::Rays(
+    const std::vector<KeypointView>& views) const {
+  std::vector<double> key;
+  for (const KeypointView& view : views) {
+    const Camera& camera = view.camera.camera;
+    key.insert(key.end(), {static_cast<double>(static_cast<int>(camera.model())),
+                           static_cast<double>(camera.width()),
+                           static_cast<double>(camera.height())});
+    key.insert(key.end(), camera.params().begin(), camera.params().end());
+  }
+  std::lock_guard<std::mutex> lock(rays_mutex_);
+  if (const auto it = rays_.find(key); it != rays_.end()) return it->second;
+  auto rays = std::make_shared<std::vector<PixelRays>>();
+  for (const KeypointView& view : views) rays->emplace_back(view.camera.camera);
+  if (rays_.size() < kMaxRigs) rays_.emplace(key, rays);
+  return rays;
+}
+
+LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
+  std::string silhouettes, start;
+  HandFitInput input = Evidence(request, &silhouettes);
+  std::shared_ptr<const std::vector<PixelRays>> rays;
+  if (!input.masks.empty()) {
+    rays = Rays(input.views);
+    input.pixel_rays = rays.get();
   }
   const CeresHandFitter& fitter =
       !request.masks.empty() && network_mask_fitter_ ? *network_mask_fitter_ : fitter_;
-  HandParams init;
-  if (request.init) {
-    const MeshPrediction& net = *request.init;
-    Points3dTargets targets;
-    targets.keypoints = net.keypoints;
-    targets.keypoint_weights = Eigen::VectorXd::Ones(kNumHandKeypoints);
-    if (net.vertices.rows() == num_vertices_) {
-      for (int v = 0; v < num_vertices_; v += kVertexTargetStride) {
-        targets.vertex_ids.push_back(v);
-      }
-      targets.vertices.resize(targets.vertex_ids.size(), 3);
-      for (size_t i = 0; i < targets.vertex_ids.size(); ++i) {
-        targets.vertices.row(i) = net.vertices.row(targets.vertex_ids[i]);
-      }
-    }
-    input.targets3d = targets;
-    init = fitter.InitFromKeypoints3d(net.keypoints, targets.keypoint_weights);
-  } else {
-    init = fitter.InitFromViews(input.views);
-  }
+  const HandParams init = Start(request, fitter, &input, &start);
   const HandFitResult fit = fitter.Fit(input, init);
 
   LabelFit out;
@@ -97,7 +209,7 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
   out.mesh.keypoints = fit.keypoints;
   out.mesh.joints = NativeJointsFromKeypoints(fit.keypoints);
   // Only deterministic fields: labels must not change between identical runs.
-  out.report = {{"init", request.init ? "network" : "triangulated_views"},
+  out.report = {{"init", start},
                 {"iterations", fit.iterations},
                 {"converged", fit.converged},
                 {"message", fit.message},

@@ -1,17 +1,26 @@
 #pragma once
-// The labeling job's fitter (label_stages.h LabelFitter) on the Ceres hand fitter of
-// fitting/hand_fitter.h:
+// The labeling job's fitting stage: the LabelFitter interface (label_stages.h)
+// implemented on the Ceres hand fitter of fitting/ceres_hand_fitter.h. Names follow the
+// other stages (NativeFrameSource, PoemMeshPredictor): CeresHandFitter solves the
+// problem; CeresLabelFitter turns a frame and its evidence into that problem.
 //   refine (request.init set)  start from the network's 3D keypoints (IK alignment),
 //                              keep a 3D pull towards the network's keypoints (and a
 //                              subset of its vertices when the meshes match), and fit
 //                              to the 2D keypoints (+ silhouettes)
-//   fit from 2D only           the paper's multi-view fitting baseline: robust
-//                              triangulation of the 2D keypoints, IK alignment, fit
+//   fit from 2D only           the paper's multi-view fitting baseline (`handlabel fit`
+//                              and a job without network): start per `init` (job
+//                              field fit.init; by default robust triangulation of the
+//                              2D keypoints + IK alignment), then fit
 // Silhouettes are used when the request carries them (the network's, evidence.masks:
-// network), or when use_masks is set and the capture has mask files.
+// network), or when use_masks is set and the frame has mask files (read with the one
+// mask rule of core/mask_image.h).
 
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/hand_model.h"
 #include "fitting/ceres_hand_fitter.h"
@@ -19,22 +28,49 @@
 
 namespace handlabel {
 
+struct CeresLabelFitterOptions {
+  // Fit to the frame's mask files (evidence.masks: files).
+  bool use_masks = false;
+  HandFitConfig config;
+  HandFitOptions fit;
+  // > 0: silhouettes that come with the request (the network's) are fitted with this
+  // residual scale instead of fit.silhouette_sigma_px.
+  double network_mask_sigma_px = 0;
+  // Start of a fit from 2D evidence alone: triangulate | gt | previous | a folder of
+  // per-frame parameter files (job field fit.init, pipeline/job_config.h).
+  std::string init = "triangulate";
+};
+
 class CeresLabelFitter : public LabelFitter {
  public:
   // Throws InputError when the config or options do not fit the model.
-  // network_mask_sigma_px > 0: silhouettes that come with the request (the network's)
-  // are fitted with this residual scale instead of options.silhouette_sigma_px.
-  CeresLabelFitter(const HandModel& model, bool use_masks,
-                   const HandFitConfig& config = {}, const HandFitOptions& options = {},
-                   double network_mask_sigma_px = 0);
+  CeresLabelFitter(const HandModel& model, const CeresLabelFitterOptions& options = {});
   LabelFit Fit(const LabelFitRequest& request) const override;
   std::string Describe() const override;
 
  private:
+  // The views with 2D evidence and their silhouettes; `silhouettes` says where the
+  // masks came from (none | network | files).
+  HandFitInput Evidence(const LabelFitRequest& request, std::string* silhouettes) const;
+  // The start of the solve (and the 3D targets or temporal pull it implies); `start`
+  // names it for the report.
+  HandParams Start(const LabelFitRequest& request, const CeresHandFitter& fitter,
+                   HandFitInput* input, std::string* start) const;
+
+  // Pixel rays of the views' cameras, for the IoU of fits with silhouettes; computed
+  // once per set of cameras (a capture's rig) for up to kMaxRigs sets, then per fit.
+  std::shared_ptr<const std::vector<PixelRays>> Rays(
+      const std::vector<KeypointView>& views) const;
+  static constexpr size_t kMaxRigs = 4;
+
   CeresHandFitter fitter_;
   std::optional<CeresHandFitter> network_mask_fitter_;
   int num_vertices_;
-  bool use_masks_;
+  CeresLabelFitterOptions options_;
+  mutable std::mutex rays_mutex_;
+  // Cameras' model, size and parameters -> their rays.
+  mutable std::map<std::vector<double>, std::shared_ptr<const std::vector<PixelRays>>>
+      rays_;
 };
 
 }  // namespace handlabel

@@ -3,59 +3,81 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "core/capsule_hand.h"
+#include "core/data_dir.h"
 #include "core/errors.h"
 #include "core/hand_model_io.h"
-#include "pipeline/build_config.h"
-#include "core/capsule_hand.h"
+#include "openhand/builder.h"
 
 namespace handlabel {
 namespace {
 
-ResolvedHandModel FromValue(const std::string& value, const std::string& origin,
-                            HandSide side) {
-  ResolvedHandModel out;
-  if (value == "capsule") {
-    out.model = MakeCapsuleHand(side);
-    out.source = "builtin:capsule";
-    return out;
-  }
-  if (!std::filesystem::exists(value)) {
-    throw InputError(origin, "hand model", "an existing model file or \"capsule\"",
-                     value);
+const char* SideName(HandSide side) { return side == HandSide::kLeft ? "left" : "right"; }
+
+// A file given by flag, field or variable, checked against the side asked for.
+ResolvedHandModel FromFile(const std::string& path, std::optional<HandSide> side,
+                           const HandModelOrigin& origin) {
+  if (!std::filesystem::exists(path)) {
+    throw InputError(origin.source, origin.field, "an existing model file or \"capsule\"",
+                     path);
   }
   // The file's own side (own format, or MANO_LEFT / MANO_RIGHT in the name) wins; a
   // file that records no side is taken as the side asked for.
+  ResolvedHandModel out;
   HandModelLoadOptions options;
   try {
-    out.model = LoadHandModel(value, options);
+    out.model = LoadHandModel(path, options);
   } catch (const InputError& e) {
-    if (e.field() != "side") throw;
+    if (e.field() != "side" || !side) throw;
     options.side = side;
-    out.model = LoadHandModel(value, options);
+    out.model = LoadHandModel(path, options);
   }
-  if (out.model.side != side) {
-    const auto name = [](HandSide s) { return s == HandSide::kLeft ? "left" : "right"; };
-    throw InputError(origin, "hand model", std::string("a ") + name(side) + " hand model",
-                     value + " (a " + name(out.model.side) + " hand)");
+  if (side && out.model.side != *side) {
+    throw InputError(origin.source, origin.field,
+                     std::string("a ") + SideName(*side) + " hand model",
+                     path + " (a " + SideName(out.model.side) + " hand)");
   }
-  out.source = value;
+  out.source = path;
+  return out;
+}
+
+ResolvedHandModel FromValue(const std::string& value, std::optional<HandSide> side,
+                            const HandModelOrigin& origin) {
+  if (value != "capsule") return FromFile(value, side, origin);
+  ResolvedHandModel out;
+  out.model = MakeCapsuleHand(side.value_or(HandSide::kRight));
+  out.source = "builtin:capsule";
+  return out;
+}
+
+// The documented fallback when no data folder holds the shipped file.
+ResolvedHandModel BuildDefaultOpenHand(HandSide side, const std::string& shipped) {
+  OpenHandBuildOptions options;
+  options.side = side;
+  ResolvedHandModel out;
+  out.model = BuildOpenHand(DefaultOpenHandDesign(), options);
+  out.source = std::string("builtin:open_hand_") + SideName(side) + " (built in memory)";
+  out.note = "no hand model file given and " +
+             (shipped.empty() ? "no data folder" : shipped) +
+             " not found (set HANDLABEL_DATA_DIR): built the open hand in memory";
   return out;
 }
 
 }  // namespace
 
-ResolvedHandModel ResolveHandModel(const std::string& flag, HandSide side) {
-  if (!flag.empty()) return FromValue(flag, "--hand-model", side);
+ResolvedHandModel ResolveHandModel(const std::string& value, std::optional<HandSide> side,
+                                   const HandModelOrigin& origin) {
+  if (!value.empty()) return FromValue(value, side, origin);
   if (const char* env = std::getenv("HANDLABEL_HAND_MODEL"); env && *env) {
-    return FromValue(env, "HANDLABEL_HAND_MODEL", side);
+    return FromValue(env, side, {"HANDLABEL_HAND_MODEL", "hand model"});
   }
-  const std::string shipped = std::string(HANDLABEL_SOURCE_DIR) + "/models/open_hand_" +
-                              (side == HandSide::kLeft ? "left" : "right") + ".npz";
-  if (std::filesystem::exists(shipped)) return FromValue(shipped, shipped, side);
-  ResolvedHandModel out = FromValue("capsule", "", side);
-  out.note = "no hand model file given and " + shipped +
-             " not found: using the built-in capsule hand";
-  return out;
+  const HandSide shipped_side = side.value_or(HandSide::kRight);
+  const std::string shipped =
+      ShippedModelPath(std::string("open_hand_") + SideName(shipped_side) + ".npz");
+  if (!shipped.empty() && std::filesystem::exists(shipped)) {
+    return FromFile(shipped, shipped_side, {shipped, "hand model"});
+  }
+  return BuildDefaultOpenHand(shipped_side, shipped);
 }
 
 }  // namespace handlabel

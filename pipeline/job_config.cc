@@ -30,7 +30,148 @@ std::string Resolve(const std::string& path, const fs::path& base) {
   return (base / path).lexically_normal().string();
 }
 
+// Fields that are absent stay unset (the fitter's default).
+template <typename T>
+void ReadOptional(Section& section, const char* key, std::optional<T>* value) {
+  const YAML::Node node = section.Raw(key);
+  if (!node || node.IsNull()) return;
+  T read{};
+  section.Read(key, &read);
+  *value = read;
+}
+
+bool IsFitInitKeyword(const std::string& init) {
+  return init == "triangulate" || init == "gt" || init == "previous";
+}
+
+void CheckFitSettings(const FitSettings& fit, const std::string& f) {
+  if (!IsFitInitKeyword(fit.init) && !fs::is_directory(fit.init)) {
+    throw InputError(
+        f, "fit.init",
+        "triangulate | gt | previous | a folder of per-frame parameter files",
+        "'" + fit.init + "'");
+  }
+  if (fit.keypoint_loss && *fit.keypoint_loss != "cauchy" &&
+      *fit.keypoint_loss != "huber" && *fit.keypoint_loss != "trivial") {
+    throw InputError(f, "fit.keypoint_loss", "cauchy | huber | trivial",
+                     "'" + *fit.keypoint_loss + "'");
+  }
+  const std::pair<const char*, const std::optional<double>*> positive[] = {
+      {"fit.keypoint_loss_scale", &fit.keypoint_loss_scale},
+      {"fit.keypoint_sigma_px", &fit.keypoint_sigma_px},
+      {"fit.silhouette_sigma_px", &fit.silhouette_sigma_px}};
+  for (const auto& [field, value] : positive) {
+    if (*value && !(**value > 0)) {
+      throw InputError(f, field, "> 0", std::to_string(**value));
+    }
+  }
+  if (fit.silhouette_rounds && *fit.silhouette_rounds < 0) {
+    throw InputError(f, "fit.silhouette_rounds", ">= 0",
+                     std::to_string(*fit.silhouette_rounds));
+  }
+  if (fit.pose_pca_comps && *fit.pose_pca_comps != 0 && *fit.pose_pca_comps != 12 &&
+      *fit.pose_pca_comps != 45) {
+    throw InputError(f, "fit.pose_pca_comps", "0, 12 or 45",
+                     std::to_string(*fit.pose_pca_comps));
+  }
+}
+
+void CheckFileEvidence(const JobConfig& job) {
+  const std::string& f = job.source_file;
+  if (job.keypoint_files != "auto" && job.keypoint_files != "detections" &&
+      job.keypoint_files != "keypoints") {
+    throw InputError(f, "evidence.keypoint_files", "auto | detections | keypoints",
+                     "'" + job.keypoint_files + "'");
+  }
+  if (job.mask_files != "auto" && job.mask_files != "detections" &&
+      job.mask_files != "truth") {
+    throw InputError(f, "evidence.mask_files", "auto | detections | truth",
+                     "'" + job.mask_files + "'");
+  }
+  if (job.input_format != "native") {
+    if (job.keypoint_files != "auto") {
+      throw InputError(f, "evidence.keypoint_files",
+                       "auto (the choice exists for input.format native only)",
+                       "'" + job.keypoint_files + "'");
+    }
+    if (job.mask_files != "auto") {
+      throw InputError(f, "evidence.mask_files",
+                       "auto (the choice exists for input.format native only)",
+                       "'" + job.mask_files + "'");
+    }
+  }
+}
+
+void ReadFitSection(Section& top, JobConfig* job) {
+  Section fit = top.Child("fit");
+  FitSettings& s = job->fit;
+  fit.Read("init", &s.init);
+  ReadOptional(fit, "keypoint_loss", &s.keypoint_loss);
+  ReadOptional(fit, "keypoint_loss_scale", &s.keypoint_loss_scale);
+  ReadOptional(fit, "keypoint_sigma_px", &s.keypoint_sigma_px);
+  ReadOptional(fit, "silhouette_sigma_px", &s.silhouette_sigma_px);
+  ReadOptional(fit, "silhouette_rounds", &s.silhouette_rounds);
+  ReadOptional(fit, "pose_pca_comps", &s.pose_pca_comps);
+  ReadOptional(fit, "joint_limits", &s.joint_limits);
+  ReadOptional(fit, "optimise_shape", &s.optimise_shape);
+  fit.RejectUnknownKeys();
+}
+
+void ReadRefineSection(Section& top, const std::string& path, JobConfig* job) {
+  Section refine = top.Child("refine");
+  std::string mode = "fallback";
+  refine.Read("mode", &mode);
+  job->refine_mode = ParseEnum<RefineMode>(mode,
+                                           {{"off", RefineMode::kOff},
+                                            {"always", RefineMode::kAlways},
+                                            {"fallback", RefineMode::kFallback}},
+                                           path, refine.Name("mode"));
+  refine.Read("max_reprojection_px", &job->quality.max_reprojection_px);
+  refine.Read("max_view_disagreement_mm", &job->quality.max_view_disagreement_mm);
+  refine.Read("min_confidence", &job->quality.min_confidence);
+  refine.Read("min_views", &job->quality.min_views);
+  refine.Read("min_hand_span_m", &job->quality.min_hand_span_m);
+  refine.Read("max_hand_span_m", &job->quality.max_hand_span_m);
+  refine.RejectUnknownKeys();
+}
+
+void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) {
+  Section evidence = top.Child("evidence");
+  std::string keypoints = "network", masks = "files";
+  evidence.Read("keypoints_2d", &keypoints);
+  evidence.Read("masks", &masks);
+  evidence.Read("network_mask_sigma_px", &job->network_mask_sigma_px);
+  evidence.Read("keypoint_files", &job->keypoint_files);
+  evidence.Read("mask_files", &job->mask_files);
+  evidence.Read("ignore_views", &job->ignore_views);
+  if (!(job->network_mask_sigma_px >= 0)) {
+    throw InputError(path, evidence.Name("network_mask_sigma_px"),
+                     "> 0 pixels, or 0 for the default",
+                     std::to_string(job->network_mask_sigma_px));
+  }
+  job->keypoints = ParseEnum<KeypointSource>(keypoints,
+                                             {{"network", KeypointSource::kNetwork},
+                                              {"files", KeypointSource::kFiles},
+                                              {"both", KeypointSource::kBoth}},
+                                             path, evidence.Name("keypoints_2d"));
+  job->masks = ParseEnum<MaskSource>(masks,
+                                     {{"none", MaskSource::kNone},
+                                      {"files", MaskSource::kFiles},
+                                      {"network", MaskSource::kNetwork}},
+                                     path, evidence.Name("masks"));
+  if (job->network_mask_sigma_px == 0) {
+    job->network_mask_sigma_px = job->keypoints == KeypointSource::kNetwork ? 2.0 : 16.0;
+  }
+  evidence.RejectUnknownKeys();
+}
+
 }  // namespace
+
+bool FitSettings::IsDefault() const {
+  return init == "triangulate" && !keypoint_loss && !keypoint_loss_scale &&
+         !keypoint_sigma_px && !silhouette_sigma_px && !silhouette_rounds &&
+         !pose_pca_comps && !joint_limits && !optimise_shape;
+}
 
 std::string ToString(RefineMode mode) {
   switch (mode) {
@@ -91,6 +232,10 @@ void JobConfig::Check() const {
     if (m != "ply" && m != "obj")
       throw InputError(f, "output.meshes", "ply and/or obj", "'" + m + "'");
   }
+  if (max_frames < 0)
+    throw InputError(f, "input.max_frames", ">= 0", std::to_string(max_frames));
+  CheckFileEvidence(*this);
+  CheckFitSettings(fit, f);
 }
 
 JobConfig LoadJobConfig(const std::string& path) {
@@ -115,6 +260,7 @@ JobConfig LoadJobConfig(const std::string& path) {
   input.Read("format", &job.input_format);
   input.Read("path", &job.input_path);
   input.Read("frames", &job.frames);
+  input.Read("max_frames", &job.max_frames);
   input.RejectUnknownKeys();
 
   Section cameras = top.Child("cameras");
@@ -128,46 +274,8 @@ JobConfig LoadJobConfig(const std::string& path) {
   network.Read("threads", &job.threads);
   network.RejectUnknownKeys();
 
-  Section refine = top.Child("refine");
-  std::string mode = "fallback";
-  refine.Read("mode", &mode);
-  job.refine_mode = ParseEnum<RefineMode>(mode,
-                                          {{"off", RefineMode::kOff},
-                                           {"always", RefineMode::kAlways},
-                                           {"fallback", RefineMode::kFallback}},
-                                          path, refine.Name("mode"));
-  refine.Read("max_reprojection_px", &job.quality.max_reprojection_px);
-  refine.Read("max_view_disagreement_mm", &job.quality.max_view_disagreement_mm);
-  refine.Read("min_confidence", &job.quality.min_confidence);
-  refine.Read("min_views", &job.quality.min_views);
-  refine.Read("min_hand_span_m", &job.quality.min_hand_span_m);
-  refine.Read("max_hand_span_m", &job.quality.max_hand_span_m);
-  refine.RejectUnknownKeys();
-
-  Section evidence = top.Child("evidence");
-  std::string keypoints = "network", masks = "files";
-  evidence.Read("keypoints_2d", &keypoints);
-  evidence.Read("masks", &masks);
-  evidence.Read("network_mask_sigma_px", &job.network_mask_sigma_px);
-  if (!(job.network_mask_sigma_px >= 0)) {
-    throw InputError(path, evidence.Name("network_mask_sigma_px"),
-                     "> 0 pixels, or 0 for the default",
-                     std::to_string(job.network_mask_sigma_px));
-  }
-  job.keypoints = ParseEnum<KeypointSource>(keypoints,
-                                            {{"network", KeypointSource::kNetwork},
-                                             {"files", KeypointSource::kFiles},
-                                             {"both", KeypointSource::kBoth}},
-                                            path, evidence.Name("keypoints_2d"));
-  job.masks = ParseEnum<MaskSource>(masks,
-                                    {{"none", MaskSource::kNone},
-                                     {"files", MaskSource::kFiles},
-                                     {"network", MaskSource::kNetwork}},
-                                    path, evidence.Name("masks"));
-  if (job.network_mask_sigma_px == 0) {
-    job.network_mask_sigma_px = job.keypoints == KeypointSource::kNetwork ? 2.0 : 16.0;
-  }
-  evidence.RejectUnknownKeys();
+  ReadRefineSection(top, path, &job);
+  ReadEvidenceSection(top, path, &job);
 
   Section output = top.Child("output");
   output.Read("dir", &job.output_dir);
@@ -176,6 +284,7 @@ JobConfig LoadJobConfig(const std::string& path) {
   output.Read("evaluate", &job.evaluate);
   output.Read("baseline", &job.baseline);
   output.RejectUnknownKeys();
+  ReadFitSection(top, &job);
   top.RejectUnknownKeys();
 
   job.input_path = Resolve(job.input_path, base);
@@ -184,6 +293,7 @@ JobConfig LoadJobConfig(const std::string& path) {
     job.hand_model = Resolve(job.hand_model, base);  // built-in
   job.network_weights = Resolve(job.network_weights, base);
   job.output_dir = Resolve(job.output_dir, base);
+  if (!IsFitInitKeyword(job.fit.init)) job.fit.init = Resolve(job.fit.init, base);
   job.Check();
   return job;
 }

@@ -3,6 +3,7 @@
 // docs/labeling-jobs.md). Relative paths are resolved against the job file's folder.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,32 @@ struct QualityThresholds {
   double max_hand_span_m = 0.35;
 };
 
+// Section `fit`: how the fitter fits (refine and fallback fits alike). Every optional
+// field left unset keeps the fitter's default (fitting/ceres_hand_fitter.h, where each
+// default is explained); `handlabel fit` sets these from its flags.
+struct FitSettings {
+  // Start of a fit from 2D evidence alone (fallback fit, fit-only job, baseline):
+  // "triangulate" (robust triangulation of the 2D keypoints + IK alignment, the paper's
+  // baseline), "gt" (the capture's ground-truth parameters, for refinement checks),
+  // "previous" (the label of the previous frame in the job's frame order, with a
+  // temporal pull; frames then run in order on one thread), or a folder of per-frame
+  // parameter files (<frame>.json, frames/<frame>.json or labels/<frame>.json: labels
+  // of a job, or global_orient, hand_pose, betas, transl at the top or under "params").
+  std::string init = "triangulate";
+  std::optional<std::string> keypoint_loss;   // robust loss: cauchy | huber | trivial
+  std::optional<double> keypoint_loss_scale;  // in units of keypoint_sigma_px, > 0
+  std::optional<double> keypoint_sigma_px;    // keypoint error per residual unit, > 0
+  std::optional<double> silhouette_sigma_px;  // silhouette error per residual unit, > 0
+  std::optional<int> silhouette_rounds;       // outline re-matching rounds, >= 0
+  std::optional<int> pose_pca_comps;          // 0 (45 axis-angle values), 12 or 45
+  std::optional<bool> joint_limits;           // anatomical joint limits
+  std::optional<bool> optimise_shape;         // false: betas stay at the start's
+
+  // True when nothing differs from the defaults (the job hash then leaves `fit` out,
+  // so jobs written before the section existed keep their hash).
+  bool IsDefault() const;
+};
+
 struct JobConfig {
   std::string source_file;  // the YAML file (for error messages)
   std::string name = "job";
@@ -37,6 +64,7 @@ struct JobConfig {
   std::string input_format = "native";  // native | dexycb | ho3d | oakink
   std::string input_path;
   std::string frames = "all";  // "all", "a:b" (half-open index range) or "id,id,..."
+  int max_frames = 0;          // label at most the first N selected frames; 0 = all
 
   // cameras
   std::string cameras_source = "capture";  // capture | file
@@ -56,6 +84,14 @@ struct JobConfig {
   QualityThresholds quality;
   KeypointSource keypoints = KeypointSource::kNetwork;
   MaskSource masks = MaskSource::kFiles;
+  // Which files of a native capture are the file evidence: keypoint_files "auto"
+  // (detections if the capture has them, else keypoints), "detections" or "keypoints"
+  // (exact projections); mask_files "auto" (detection masks, else true masks),
+  // "detections" or "truth". Other input formats take "auto" only.
+  std::string keypoint_files = "auto";
+  std::string mask_files = "auto";
+  // Camera names whose 2D keypoints and masks are not fitted to (a broken camera).
+  std::vector<std::string> ignore_views;
   // Silhouette residual scale (pixels per unit) for the network's masks. In the file
   // 0 (the default) means: 2 px when the network's own 2D keypoints are the only
   // evidence (they are weak, the masks help), else 16 px (good detections: the coarse
@@ -69,6 +105,8 @@ struct JobConfig {
   bool overlays = true;
   bool evaluate = true;   // against ground truth, when the capture has it
   bool baseline = false;  // also run the fit-only baseline for comparison
+
+  FitSettings fit;
 
   // Throws InputError naming the file and field.
   void Check() const;

@@ -5,6 +5,7 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -12,14 +13,14 @@
 #include <set>
 #include <sstream>
 
-#include "core/errors.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/sha256.h"
 #include "pipeline/build_info.h"
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/progress.h"
-#include "core/sha256.h"
 
 namespace handlabel {
 namespace {
@@ -77,11 +78,28 @@ void ClaimOutputFolder(const JobConfig& job, const std::string& job_hash, bool f
   WriteFileAtomically(stamp, j.dump(1) + "\n");
 }
 
+template <typename T>
+nlohmann::json Optional(const std::optional<T>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json FitSettingsJson(const FitSettings& f) {
+  return {f.init,
+          Optional(f.keypoint_loss),
+          Optional(f.keypoint_loss_scale),
+          Optional(f.keypoint_sigma_px),
+          Optional(f.silhouette_sigma_px),
+          Optional(f.silhouette_rounds),
+          Optional(f.pose_pca_comps),
+          Optional(f.joint_limits),
+          Optional(f.optimise_shape)};
+}
+
 }  // namespace
 
 std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   const QualityThresholds& q = job.quality;
-  const nlohmann::json j = {
+  nlohmann::json j = {
       {"label_format", kLabelFormatVersion},
       {"input", {job.input_format, job.input_path, job.frames}},
       {"cameras", {job.cameras_source, job.cameras_file}},
@@ -92,6 +110,16 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
         q.min_confidence, q.min_views, q.min_hand_span_m, q.max_hand_span_m}},
       {"evidence", {static_cast<int>(job.keypoints), static_cast<int>(job.masks)}},
       {"seed", job.seed}};
+  // Fields added later enter only when set, so older jobs keep their hash (and their
+  // output folders resume).
+  nlohmann::json extra = nlohmann::json::object();
+  if (job.max_frames > 0) extra["max_frames"] = job.max_frames;
+  if (job.keypoint_files != "auto" || job.mask_files != "auto" ||
+      !job.ignore_views.empty()) {
+    extra["evidence_files"] = {job.keypoint_files, job.mask_files, job.ignore_views};
+  }
+  if (!job.fit.IsDefault()) extra["fit"] = FitSettingsJson(job.fit);
+  if (!extra.empty()) j["added"] = extra;
   return Sha256Hex(j.dump());
 }
 
@@ -142,105 +170,203 @@ std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames
   return frames;
 }
 
-LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
-                         const LabelRunOptions& options) {
-  HL_CHECK(stages.source != nullptr, "a frame source");
-  HL_CHECK(stages.predictor || job.refine_mode != RefineMode::kOff,
-           "a network for refine off");
-  const Clock::time_point start = Clock::now();
-  const std::string& out = job.output_dir;
+std::vector<std::string> JobFrames(const JobConfig& job, const FrameSource& source) {
+  std::vector<std::string> frames =
+      SelectFrames(source.FrameIds(), job.frames, job.source_file);
+  if (job.max_frames > 0 && static_cast<int>(frames.size()) > job.max_frames) {
+    frames.resize(job.max_frames);
+  }
+  return frames;
+}
 
-  const std::string weights_sha =
-      stages.predictor ? stages.predictor->WeightsSha256() : "";
-  const std::string job_hash = JobHash(job, weights_sha);
-  const std::vector<std::string> all_frames =
-      SelectFrames(stages.source->FrameIds(), job.frames, job.source_file);
-  const std::vector<std::string> mine = FramesOfShard(all_frames, options.shard);
-  for (const std::string& f : mine) FrameFileStem(f, stages.source->Describe());
+namespace {
 
-  ClaimOutputFolder(job, job_hash, options.force);
-  const std::string log_path = ShardLogPath(out, options.shard);
-  if (options.force) fs::remove(log_path);
-  RemoveStaleFrameTemporaries(out, mine);
+// One run of one shard of a job: plan (frames, resume, folder), label every frame to
+// do through the stages, then summarise and, for a whole-job run, merge.
+class LabelJobRun {
+ public:
+  LabelJobRun(const JobConfig& job, const LabelStageSet& stages,
+              const LabelRunOptions& options)
+      : job_(job), stages_(stages), options_(options), out_(job.output_dir) {
+    HL_CHECK(stages.source != nullptr, "a frame source");
+    HL_CHECK(stages.predictor || job.refine_mode != RefineMode::kOff,
+             "a network for refine off");
+  }
 
-  std::vector<std::string> todo;
-  int done_before = 0;
-  {
+  LabelSummary Run() {
+    const Clock::time_point start = Clock::now();
+    Plan();
+    FindFramesToDo();
+    FrameLog log(log_path_);
+    log_ = &log;
+    threads_ = job_.threads > 0 ? job_.threads : tbb::info::default_concurrency();
+    // fit.init previous: each fit starts from the previous frame's label.
+    in_order_ = job_.fit.init == "previous";
+    LogStart();
+    std::ostringstream discard;
+    Progress progress(static_cast<int>(todo_.size()),
+                      options_.log ? *options_.log : discard, options_.interactive);
+    progress_ = &progress;
+    if (in_order_) {
+      LabelInOrder();
+    } else {
+      LabelPipelined();
+    }
+    progress.Finish();
+    return Finish(SecondsSince(start));
+  }
+
+ private:
+  // The job's frames, this shard's part of them, the job hash and the claim on the
+  // output folder.
+  void Plan() {
+    weights_sha_ = stages_.predictor ? stages_.predictor->WeightsSha256() : "";
+    job_hash_ = JobHash(job_, weights_sha_);
+    all_frames_ = JobFrames(job_, *stages_.source);
+    mine_ = FramesOfShard(all_frames_, options_.shard);
+    for (const std::string& f : mine_) FrameFileStem(f, stages_.source->Describe());
+    ClaimOutputFolder(job_, job_hash_, options_.force);
+    log_path_ = ShardLogPath(out_, options_.shard);
+    if (options_.force) fs::remove(log_path_);
+    RemoveStaleFrameTemporaries(out_, mine_);
+    const BuildInfo build = GetBuildInfo();
+    context_.job = &job_;
+    context_.fitter = stages_.fitter;
+    context_.side = stages_.side;
+    context_.provenance = {stages_.predictor ? stages_.predictor->ModelName() : "",
+                           weights_sha_,
+                           stages_.hand_model_name,
+                           job_hash_,
+                           build.version,
+                           build.git_hash,
+                           job_.seed};
+  }
+
+  // Resume: frames with an ok record and their label on disk are done.
+  void FindFramesToDo() {
     const auto records =
-        options.force ? std::map<std::string, FrameRecord>{} : ReadShardLogs(out);
-    for (const std::string& f : mine) {
+        options_.force ? std::map<std::string, FrameRecord>{} : ReadShardLogs(out_);
+    for (const std::string& f : mine_) {
       const auto it = records.find(f);
       if (it != records.end() && it->second.status == "ok" &&
-          fs::exists(LabelFilePath(out, f))) {
-        ++done_before;
+          fs::exists(LabelFilePath(out_, f))) {
+        ++done_before_;
       } else {
-        todo.push_back(f);
+        todo_.push_back(f);
       }
     }
-  }
-  if (done_before > 0 && !options.resume && !options.force) {
-    throw InputError(
-        job.source_file, "output.dir",
-        "a folder without finished frames of this shard, or --resume to skip "
-        "them, or --force to label them again",
-        std::to_string(done_before) + " finished frame(s) in " + out);
-  }
-
-  FrameLog log(log_path);
-  const BuildInfo build = GetBuildInfo();
-  LabelContext context;
-  context.job = &job;
-  context.fitter = stages.fitter;
-  context.side = stages.side;
-  context.provenance = {stages.predictor ? stages.predictor->ModelName() : "",
-                        weights_sha,
-                        stages.hand_model_name,
-                        job_hash,
-                        build.version,
-                        build.git_hash,
-                        job.seed};
-
-  const int threads = job.threads > 0 ? job.threads : tbb::info::default_concurrency();
-  if (options.log) {
-    *options.log << "label: job '" << job.name << "', shard " << options.shard.ToString()
-                 << ": " << mine.size() << " of " << all_frames.size() << " frames, "
-                 << done_before << " done before, " << todo.size() << " to label; "
-                 << threads << " thread(s)\n  input: " << stages.source->Describe()
-                 << "\n  network: "
-                 << (stages.predictor ? stages.predictor->ModelName()
-                                      : std::string("none"))
-                 << ", refine: " << ToString(job.refine_mode) << ", fitter: "
-                 << (stages.fitter ? stages.fitter->Describe() : std::string("none"))
-                 << "\n  output: " << out << "\n";
+    if (done_before_ > 0 && !options_.resume && !options_.force) {
+      throw InputError(
+          job_.source_file, "output.dir",
+          "a folder without finished frames of this shard, or --resume to skip "
+          "them, or --force to label them again",
+          std::to_string(done_before_) + " finished frame(s) in " + out_);
+    }
   }
 
-  std::ostringstream discard;
-  Progress progress(static_cast<int>(todo.size()), options.log ? *options.log : discard,
-                    options.interactive);
+  void LogStart() const {
+    if (!options_.log) return;
+    *options_.log << "label: job '" << job_.name << "', shard "
+                  << options_.shard.ToString() << ": " << mine_.size() << " of "
+                  << all_frames_.size() << " frames, " << done_before_ << " done before, "
+                  << todo_.size() << " to label; " << (in_order_ ? 1 : threads_)
+                  << " thread(s)"
+                  << (in_order_ ? " (fit.init previous: frames in order)" : "")
+                  << "\n  input: " << stages_.source->Describe() << "\n  network: "
+                  << (stages_.predictor ? stages_.predictor->ModelName()
+                                        : std::string("none"))
+                  << ", refine: " << ToString(job_.refine_mode) << ", fitter: "
+                  << (stages_.fitter ? stages_.fitter->Describe() : std::string("none"))
+                  << "\n  output: " << out_ << "\n";
+  }
 
-  auto finish_frame = [&](Batch& batch, size_t i) {
+  // The next batch of frames to do (serial), or nullptr when all are handed out.
+  std::shared_ptr<Batch> NextBatch(size_t size) {
+    if (next_ >= todo_.size()) return nullptr;
+    auto batch = std::make_shared<Batch>();
+    const size_t end = std::min(todo_.size(), next_ + size);
+    batch->ids.assign(todo_.begin() + next_, todo_.begin() + end);
+    next_ = end;
+    const size_t n = batch->ids.size();
+    batch->inputs.resize(n);
+    batch->predictions.resize(n);
+    batch->errors.resize(n);
+    batch->network_errors.resize(n);
+    batch->seconds.assign(n, 0.0);
+    return batch;
+  }
+
+  // Reads one frame of the batch; a read error fails that frame only.
+  void Load(Batch& batch, size_t i) const {
+    const Clock::time_point t = Clock::now();
+    try {
+      batch.inputs[i] = stages_.source->Load(batch.ids[i]);
+    } catch (...) {
+      batch.errors[i] = "read: " + Describe(std::current_exception());
+    }
+    batch.seconds[i] += SecondsSince(t);
+  }
+
+  // The network on the batch's readable frames (one caller at a time). If the batch
+  // fails, the frames run one by one so that a bad frame fails alone.
+  void Predict(Batch& batch) const {
+    if (!stages_.predictor) return;
+    std::vector<size_t> ready;
+    std::vector<const FrameInput*> frames;
+    for (size_t i = 0; i < batch.ids.size(); ++i) {
+      if (batch.errors[i].empty()) {
+        ready.push_back(i);
+        frames.push_back(&*batch.inputs[i]);
+      }
+    }
+    if (frames.empty()) return;
+    const Clock::time_point t = Clock::now();
+    try {
+      std::vector<MeshPrediction> predictions = stages_.predictor->Predict(frames);
+      HL_CHECK(predictions.size() == frames.size(), "one prediction per frame");
+      for (size_t k = 0; k < ready.size(); ++k) {
+        batch.predictions[ready[k]] = std::move(predictions[k]);
+      }
+    } catch (...) {
+      for (size_t k = 0; k < ready.size(); ++k) {
+        try {
+          auto single = stages_.predictor->Predict({frames[k]});
+          HL_CHECK(single.size() == 1, "one prediction per frame");
+          batch.predictions[ready[k]] = std::move(single[0]);
+        } catch (...) {
+          batch.network_errors[ready[k]] =
+              "network failed: " + Describe(std::current_exception());
+        }
+      }
+    }
+    const double share = SecondsSince(t) / frames.size();
+    for (size_t i : ready) batch.seconds[i] += share;
+  }
+
+  // fit.init previous: the label parameters of the frame before `frame` in the job's
+  // frame order, when its label is on disk (written by this run or an earlier one).
+  std::optional<HandParams> PreviousParams(const std::string& frame) const {
+    if (!in_order_) return std::nullopt;
+    const auto it = std::find(all_frames_.begin(), all_frames_.end(), frame);
+    if (it == all_frames_.begin() || it == all_frames_.end()) return std::nullopt;
+    const std::string path = LabelFilePath(out_, *(it - 1));
+    if (!fs::exists(path)) return std::nullopt;
+    return ReadLabelFile(path).params;
+  }
+
+  // Labels one frame (policy, outputs) and records it in the shard log.
+  void FinishFrame(Batch& batch, size_t i) {
     const Clock::time_point frame_start = Clock::now();
     FrameRecord record;
     record.frame = batch.ids[i];
     std::string error = batch.errors[i];
     const std::string& network_error = batch.network_errors[i];
     const bool fit_instead =
-        job.refine_mode == RefineMode::kFallback && context.fitter != nullptr;
+        job_.refine_mode == RefineMode::kFallback && context_.fitter != nullptr;
     if (error.empty() && !network_error.empty() && !fit_instead) error = network_error;
     if (error.empty()) {
       try {
-        const FrameInput& frame = *batch.inputs[i];
-        const MeshPrediction* prediction =
-            batch.predictions[i] ? &*batch.predictions[i] : nullptr;
-        FrameOutcome outcome =
-            LabelFrame(context, frame, prediction, FrameSeed(job.seed, frame.id));
-        if (!network_error.empty()) outcome.label.fit["why"] = network_error;
-        if (stages.overlays && job.overlays)
-          stages.overlays->Write(out, frame, outcome.label);
-        WriteLabelFiles(out, outcome.label, stages.faces, job.meshes);
-        record.status = "ok";
-        record.path = ToString(outcome.label.path);
-        record.metrics = std::move(outcome.metrics);
+        WriteFrame(batch, i, &record);
       } catch (...) {
         error = Describe(std::current_exception());
         if (!network_error.empty()) error = network_error + "; fallback fit: " + error;
@@ -249,123 +375,120 @@ LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
     if (!error.empty()) {
       record.status = "failed";
       record.reason = error;
-      std::error_code ignored;
-      fs::remove(LabelFilePath(out, record.frame),
-                 ignored);  // no stale label of a failed frame
+      std::error_code ignored;  // no stale label of a failed frame
+      fs::remove(LabelFilePath(out_, record.frame), ignored);
     }
     record.seconds = batch.seconds[i] + SecondsSince(frame_start);
-    log.Record(record);
-    progress.FrameDone(!error.empty());
+    log_->Record(record);
+    progress_->FrameDone(!error.empty());
     batch.inputs[i].reset();  // free the frame's memory early
-  };
+  }
 
-  const size_t batch_size = static_cast<size_t>(job.batch_size);
-  size_t next = 0;
-  tbb::task_arena arena(threads);
-  arena.execute([&] {
-    tbb::parallel_pipeline(
-        static_cast<size_t>(2 * threads),
-        tbb::make_filter<void, std::shared_ptr<Batch>>(
-            tbb::filter_mode::serial_in_order,
-            [&](tbb::flow_control& control) -> std::shared_ptr<Batch> {
-              if (next >= todo.size()) {
-                control.stop();
-                return nullptr;
-              }
-              auto batch = std::make_shared<Batch>();
-              const size_t end = std::min(todo.size(), next + batch_size);
-              batch->ids.assign(todo.begin() + next, todo.begin() + end);
-              next = end;
-              const size_t n = batch->ids.size();
-              batch->inputs.resize(n);
-              batch->predictions.resize(n);
-              batch->errors.resize(n);
-              batch->network_errors.resize(n);
-              batch->seconds.assign(n, 0.0);
-              return batch;
-            }) &
-            tbb::make_filter<std::shared_ptr<Batch>, std::shared_ptr<Batch>>(
-                tbb::filter_mode::parallel,
-                [&](std::shared_ptr<Batch> batch) {
-                  tbb::parallel_for(size_t(0), batch->ids.size(), [&](size_t i) {
-                    const Clock::time_point t = Clock::now();
-                    try {
-                      batch->inputs[i] = stages.source->Load(batch->ids[i]);
-                    } catch (...) {
-                      batch->errors[i] = "read: " + Describe(std::current_exception());
-                    }
-                    batch->seconds[i] += SecondsSince(t);
-                  });
-                  return batch;
-                }) &
-            tbb::make_filter<std::shared_ptr<Batch>, std::shared_ptr<Batch>>(
-                tbb::filter_mode::serial_out_of_order,
-                [&](std::shared_ptr<Batch> batch) {
-                  if (!stages.predictor) return batch;
-                  std::vector<size_t> ready;
-                  std::vector<const FrameInput*> frames;
-                  for (size_t i = 0; i < batch->ids.size(); ++i) {
-                    if (batch->errors[i].empty()) {
-                      ready.push_back(i);
-                      frames.push_back(&*batch->inputs[i]);
-                    }
-                  }
-                  if (frames.empty()) return batch;
-                  const Clock::time_point t = Clock::now();
-                  bool batch_ok = false;
-                  try {
-                    std::vector<MeshPrediction> predictions =
-                        stages.predictor->Predict(frames);
-                    HL_CHECK(predictions.size() == frames.size(),
-                             "one prediction per frame");
-                    for (size_t k = 0; k < ready.size(); ++k) {
-                      batch->predictions[ready[k]] = std::move(predictions[k]);
-                    }
-                    batch_ok = true;
-                  } catch (...) {
-                  }
-                  if (!batch_ok) {  // find the bad frame(s): one by one
-                    for (size_t k = 0; k < ready.size(); ++k) {
-                      try {
-                        auto single = stages.predictor->Predict({frames[k]});
-                        HL_CHECK(single.size() == 1, "one prediction per frame");
-                        batch->predictions[ready[k]] = std::move(single[0]);
-                      } catch (...) {
-                        batch->network_errors[ready[k]] =
-                            "network failed: " + Describe(std::current_exception());
-                      }
-                    }
-                  }
-                  const double share = SecondsSince(t) / frames.size();
-                  for (size_t i : ready) batch->seconds[i] += share;
-                  return batch;
-                }) &
-            tbb::make_filter<std::shared_ptr<Batch>, void>(
-                tbb::filter_mode::parallel, [&](std::shared_ptr<Batch> batch) {
-                  tbb::parallel_for(size_t(0), batch->ids.size(),
-                                    [&](size_t i) { finish_frame(*batch, i); });
-                }));
-  });
-  progress.Finish();
+  void WriteFrame(Batch& batch, size_t i, FrameRecord* record) const {
+    const FrameInput& frame = *batch.inputs[i];
+    const MeshPrediction* prediction =
+        batch.predictions[i] ? &*batch.predictions[i] : nullptr;
+    const std::optional<HandParams> previous = PreviousParams(frame.id);
+    FrameOutcome outcome =
+        LabelFrame(context_, frame, prediction, FrameSeed(job_.seed, frame.id),
+                   previous ? &*previous : nullptr);
+    if (!batch.network_errors[i].empty()) {
+      outcome.label.fit["why"] = batch.network_errors[i];
+    }
+    if (stages_.overlays && job_.overlays)
+      stages_.overlays->Write(out_, frame, outcome.label);
+    WriteLabelFiles(out_, outcome.label, stages_.faces, job_.meshes);
+    record->status = "ok";
+    record->path = ToString(outcome.label.path);
+    record->metrics = std::move(outcome.metrics);
+  }
 
-  LabelSummary summary = Summarize(mine, ReadShardLogs(out));
-  summary.skipped = done_before;
-  summary.wall_seconds = SecondsSince(start);
-  WriteFileAtomically(ShardSummaryPath(out, options.shard),
-                      summary.ToJson().dump(1) + "\n");
-  if (options.shard.count == 1) MergeLabelOutputs(out, job.name, job_hash, all_frames);
-  if (options.log) {
-    *options.log << summary.ToText();
-    if (options.shard.count == 1) {
-      *options.log << "labels in " << out << "/labels, manifest " << ManifestPath(out)
-                   << "\n";
-    } else {
-      *options.log << "shard log " << log_path
-                   << "; join shards with: handlabel merge --job " << job.source_file
-                   << "\n";
+  // Four TBB stages over batches: hand out (serial), read (parallel), network (serial,
+  // batched), label and write (parallel).
+  void LabelPipelined() {
+    using BatchPtr = std::shared_ptr<Batch>;
+    const size_t batch_size = static_cast<size_t>(job_.batch_size);
+    tbb::task_arena arena(threads_);
+    arena.execute([&] {
+      tbb::parallel_pipeline(
+          static_cast<size_t>(2 * threads_),
+          tbb::make_filter<void, BatchPtr>(tbb::filter_mode::serial_in_order,
+                                           [&](tbb::flow_control& control) {
+                                             BatchPtr batch = NextBatch(batch_size);
+                                             if (!batch) control.stop();
+                                             return batch;
+                                           }) &
+              tbb::make_filter<BatchPtr, BatchPtr>(
+                  tbb::filter_mode::parallel,
+                  [&](BatchPtr batch) {
+                    tbb::parallel_for(size_t(0), batch->ids.size(),
+                                      [&](size_t i) { Load(*batch, i); });
+                    return batch;
+                  }) &
+              tbb::make_filter<BatchPtr, BatchPtr>(tbb::filter_mode::serial_out_of_order,
+                                                   [&](BatchPtr batch) {
+                                                     Predict(*batch);
+                                                     return batch;
+                                                   }) &
+              tbb::make_filter<BatchPtr, void>(
+                  tbb::filter_mode::parallel, [&](BatchPtr batch) {
+                    tbb::parallel_for(size_t(0), batch->ids.size(),
+                                      [&](size_t i) { FinishFrame(*batch, i); });
+                  }));
+    });
+  }
+
+  // The same steps one frame at a time, in the job's frame order.
+  void LabelInOrder() {
+    while (const std::shared_ptr<Batch> batch = NextBatch(1)) {
+      Load(*batch, 0);
+      Predict(*batch);
+      FinishFrame(*batch, 0);
     }
   }
-  return summary;
+
+  // The shard's summary file, the merge of a whole-job run, the closing lines.
+  LabelSummary Finish(double wall_seconds) const {
+    LabelSummary summary = Summarize(mine_, ReadShardLogs(out_));
+    summary.skipped = done_before_;
+    summary.wall_seconds = wall_seconds;
+    WriteFileAtomically(ShardSummaryPath(out_, options_.shard),
+                        summary.ToJson().dump(1) + "\n");
+    const bool whole_job = options_.shard.count == 1;
+    if (whole_job) MergeLabelOutputs(out_, job_.name, job_hash_, all_frames_);
+    if (!options_.log) return summary;
+    *options_.log << summary.ToText();
+    if (whole_job) {
+      *options_.log << "labels in " << out_ << "/labels, manifest " << ManifestPath(out_)
+                    << "\n";
+    } else {
+      *options_.log << "shard log " << log_path_
+                    << "; join shards with: handlabel merge --job " << job_.source_file
+                    << "\n";
+    }
+    return summary;
+  }
+
+  const JobConfig& job_;
+  const LabelStageSet& stages_;
+  const LabelRunOptions& options_;
+  const std::string out_;
+  std::string weights_sha_, job_hash_, log_path_;
+  std::vector<std::string> all_frames_, mine_, todo_;
+  int done_before_ = 0;
+  int threads_ = 1;
+  bool in_order_ = false;
+  size_t next_ = 0;  // next frame of todo_ to hand out
+  LabelContext context_;
+  FrameLog* log_ = nullptr;
+  Progress* progress_ = nullptr;
+};
+
+}  // namespace
+
+LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
+                         const LabelRunOptions& options) {
+  return LabelJobRun(job, stages, options).Run();
 }
 
 }  // namespace handlabel

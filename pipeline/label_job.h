@@ -1,7 +1,10 @@
 #pragma once
 // The labeling runner: for the frames of one shard, read -> batched network
 // inference -> quality checks -> refine or fallback fit (label_policy.h) -> atomic
-// writes (label_record.h), with TBB over frames.
+// writes (label_record.h), with TBB over frames (four pipeline stages: hand out
+// batches, read, network, label and write). With fit.init previous the same steps run
+// one frame at a time in the job's frame order. `handlabel fit` is this runner on a
+// job without a network (fit_capture.h).
 //
 //  - Resume: a frame is finished once its files are renamed into place and its record
 //    appended to the shard log (frame_log.h). A re-run with resume skips finished
@@ -52,9 +55,11 @@ struct LabelRunOptions {
   std::ostream* log = nullptr;  // progress and summary; nullptr = quiet
 };
 
-// Hash of everything in the job that can change a label (inputs, cameras, hand model,
-// the weights' content, refine mode and thresholds, evidence, seed), not of where the
-// outputs go or how many threads run. SHA-256 hex.
+// Hash of everything in the job that can change a label (inputs, cameras, the hand
+// model setting, the weights' content, refine mode and thresholds, evidence, fit
+// settings, seed), not of where the outputs go or how many threads run. SHA-256 hex.
+// Paths enter as written (input.path, hand_model: a file path or "capsule"), not the
+// files' content, except the weights, whose SHA-256 the network reports.
 std::string JobHash(const JobConfig& job, const std::string& weights_sha256);
 
 // The job's frames from every frame of the capture, per job field input.frames:
@@ -62,6 +67,10 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256);
 // Throws InputError naming `source` and input.frames for an unknown id or a bad range.
 std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames,
                                       const std::string& spec, const std::string& source);
+
+// The job's frames: SelectFrames over the source's frames per input.frames, then the
+// first input.max_frames of them.
+std::vector<std::string> JobFrames(const JobConfig& job, const FrameSource& source);
 
 // Runs the shard; returns its summary (also written to the shard's summary file).
 // Throws InputError when the output folder belongs to another job (unless force), or

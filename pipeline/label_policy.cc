@@ -49,6 +49,14 @@ std::vector<std::optional<Keypoints2dView>> FitEvidence(
       if (!evidence[v]) evidence[v] = prediction->keypoints_2d[v];
     }
   }
+  for (const std::string& name : job.ignore_views) {
+    const int v = frame.rig.IndexOf(name);
+    if (v < 0) {
+      throw InputError(job.source_file, "evidence.ignore_views",
+                       "camera names of the capture", "'" + name + "'");
+    }
+    evidence[v].reset();
+  }
   for (const auto& view : evidence) {
     if (view) return evidence;
   }
@@ -62,86 +70,125 @@ std::vector<std::optional<Keypoints2dView>> FitEvidence(
               ")");
 }
 
-FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
-                        const MeshPrediction* prediction, uint64_t seed) {
-  const JobConfig& job = *context.job;
-  FrameOutcome outcome;
-  LabelRecord& label = outcome.label;
-  label.frame = frame.id;
-  label.side = context.side;
-  label.provenance = context.provenance;
-  label.fit = nullptr;
+namespace {
 
-  if (prediction) label.quality = CheckPrediction(frame.rig, *prediction, job.quality);
-  const bool accept_network =
-      prediction &&
-      (job.refine_mode == RefineMode::kOff ||
-       (job.refine_mode == RefineMode::kFallback && label.quality.Passed()));
+// One frame's labelling steps: choose the label (network, refined or fitted), then
+// evaluate it against ground truth.
+class FrameLabeler {
+ public:
+  FrameLabeler(const LabelContext& context, const FrameInput& frame,
+               const MeshPrediction* prediction, uint64_t seed,
+               const HandParams* previous)
+      : context_(context),
+        job_(*context.job),
+        frame_(frame),
+        prediction_(prediction),
+        seed_(seed),
+        previous_(previous) {}
 
-  auto fit = [&](const MeshPrediction* init) {
-    if (!context.fitter) throw Error("refine.mode needs a fitter, and none was built");
+  FrameOutcome Run() {
+    FrameOutcome outcome;
+    LabelRecord& label = outcome.label;
+    label.frame = frame_.id;
+    label.side = context_.side;
+    label.provenance = context_.provenance;
+    label.fit = nullptr;
+    if (prediction_) {
+      label.quality = CheckPrediction(frame_.rig, *prediction_, job_.quality);
+    }
+    Choose(&label);
+    if (!label.mesh.vertices.array().isFinite().all() ||
+        !label.mesh.keypoints.array().isFinite().all()) {
+      throw Error("the " + ToString(label.path) + " result is not finite");
+    }
+    if (job_.evaluate && frame_.ground_truth) Evaluate(&outcome);
+    return outcome;
+  }
+
+ private:
+  // A fit from `init` (the network's mesh) or, with nullptr, from 2D evidence alone.
+  LabelFit Fit(const MeshPrediction* init) const {
+    if (!context_.fitter) throw Error("refine.mode needs a fitter, and none was built");
     LabelFitRequest request;
-    request.frame = &frame;
+    request.frame = &frame_;
     request.init = init;
-    request.keypoints_2d = FitEvidence(job, frame, prediction);
-    if (job.masks == MaskSource::kNetwork && prediction)
-      request.masks = prediction->masks;
-    request.seed = seed;
-    return context.fitter->Fit(request);
-  };
+    request.keypoints_2d = FitEvidence(job_, frame_, prediction_);
+    if (job_.masks == MaskSource::kNetwork && prediction_)
+      request.masks = prediction_->masks;
+    request.previous = previous_;
+    request.seed = seed_;
+    return context_.fitter->Fit(request);
+  }
 
-  if (accept_network) {
-    label.path = LabelPath::kNetwork;
-    label.params = prediction->params;
-    label.mesh.vertices = prediction->vertices;
-    label.mesh.keypoints = prediction->keypoints;
-    label.mesh.joints = NativeJointsFromKeypoints(prediction->keypoints);
-  } else if (job.refine_mode == RefineMode::kOff) {
-    throw Error("refine.mode is off and there is no network prediction");
-  } else {
-    const bool refine = prediction && job.refine_mode == RefineMode::kAlways;
-    LabelFit result = fit(refine ? prediction : nullptr);
-    label.path = refine ? LabelPath::kRefined : LabelPath::kFallbackFit;
-    label.params = result.params;
-    label.mesh = std::move(result.mesh);
-    label.fit = std::move(result.report);
-    if (!prediction && job.refine_mode == RefineMode::kFallback) {
-      label.fit["why"] = "no network";
+  // The policy of label_policy.h.
+  void Choose(LabelRecord* label) const {
+    const bool accept_network =
+        prediction_ &&
+        (job_.refine_mode == RefineMode::kOff ||
+         (job_.refine_mode == RefineMode::kFallback && label->quality.Passed()));
+    if (accept_network) {
+      label->path = LabelPath::kNetwork;
+      label->params = prediction_->params;
+      label->mesh.vertices = prediction_->vertices;
+      label->mesh.keypoints = prediction_->keypoints;
+      label->mesh.joints = NativeJointsFromKeypoints(prediction_->keypoints);
+      return;
+    }
+    if (job_.refine_mode == RefineMode::kOff) {
+      throw Error("refine.mode is off and there is no network prediction");
+    }
+    const bool refine = prediction_ && job_.refine_mode == RefineMode::kAlways;
+    LabelFit result = Fit(refine ? prediction_ : nullptr);
+    label->path = refine ? LabelPath::kRefined : LabelPath::kFallbackFit;
+    label->params = result.params;
+    label->mesh = std::move(result.mesh);
+    label->fit = std::move(result.report);
+    if (!prediction_ && job_.refine_mode == RefineMode::kFallback) {
+      label->fit["why"] = "no network";
     } else if (!refine) {
-      label.fit["why"] = "quality checks failed: " + label.quality.FailedNames();
+      label->fit["why"] = "quality checks failed: " + label->quality.FailedNames();
     }
-  }
-  if (!label.mesh.vertices.array().isFinite().all() ||
-      !label.mesh.keypoints.array().isFinite().all()) {
-    throw Error("the " + ToString(label.path) + " result is not finite");
   }
 
-  if (job.evaluate && frame.ground_truth) {
-    const FrameGroundTruth& truth = *frame.ground_truth;
-    AddMetrics("labels", label.mesh.keypoints, label.mesh.vertices, truth,
-               &outcome.metrics);
+  void Evaluate(FrameOutcome* outcome) const {
+    const FrameGroundTruth& truth = *frame_.ground_truth;
+    const LabelRecord& label = outcome->label;
+    auto* metrics = &outcome->metrics;
+    AddMetrics("labels", label.mesh.keypoints, label.mesh.vertices, truth, metrics);
     AddMetrics(ToString(label.path), label.mesh.keypoints, label.mesh.vertices, truth,
-               &outcome.metrics);
-    if (prediction && prediction->keypoints.array().isFinite().all()) {
-      AddMetrics("network_raw", prediction->keypoints, prediction->vertices, truth,
-                 &outcome.metrics);
+               metrics);
+    if (prediction_ && prediction_->keypoints.array().isFinite().all()) {
+      AddMetrics("network_raw", prediction_->keypoints, prediction_->vertices, truth,
+                 metrics);
     }
-    if (job.baseline && context.fitter) {
-      if (label.path == LabelPath::kFallbackFit) {
-        AddMetrics("fit_only", label.mesh.keypoints, label.mesh.vertices, truth,
-                   &outcome.metrics);
-      } else {
-        // The baseline is for comparison only; its failure does not fail the frame.
-        try {
-          const LabelFit baseline = fit(nullptr);
-          AddMetrics("fit_only", baseline.mesh.keypoints, baseline.mesh.vertices, truth,
-                     &outcome.metrics);
-        } catch (const std::exception&) {
-        }
-      }
+    if (!job_.baseline || !context_.fitter) return;
+    if (label.path == LabelPath::kFallbackFit) {
+      AddMetrics("fit_only", label.mesh.keypoints, label.mesh.vertices, truth, metrics);
+      return;
+    }
+    // The baseline is for comparison only; its failure does not fail the frame.
+    try {
+      const LabelFit baseline = Fit(nullptr);
+      AddMetrics("fit_only", baseline.mesh.keypoints, baseline.mesh.vertices, truth,
+                 metrics);
+    } catch (const std::exception&) {
     }
   }
-  return outcome;
+
+  const LabelContext& context_;
+  const JobConfig& job_;
+  const FrameInput& frame_;
+  const MeshPrediction* prediction_;
+  const uint64_t seed_;
+  const HandParams* previous_;
+};
+
+}  // namespace
+
+FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
+                        const MeshPrediction* prediction, uint64_t seed,
+                        const HandParams* previous) {
+  return FrameLabeler(context, frame, prediction, seed, previous).Run();
 }
 
 }  // namespace handlabel

@@ -32,15 +32,19 @@ struct FrameOutcome {
 
 // The 2D evidence for the fitter per job field evidence.keypoints_2d: the network's
 // keypoints, the capture's keypoint files, or both (files where a view has one, else
-// the network's). Throws Error when the chosen source has nothing for this frame.
+// the network's); none for the cameras of evidence.ignore_views. Throws Error when the
+// chosen source has nothing for this frame, InputError for an unknown camera name.
 std::vector<std::optional<Keypoints2dView>> FitEvidence(const JobConfig& job,
                                                         const FrameInput& frame,
                                                         const MeshPrediction* prediction);
 
-// Labels one frame. `prediction` is nullptr when the job has no network. Throws when
-// the frame cannot be labelled (the runner records the message as the reason).
+// Labels one frame. `prediction` is nullptr when the job has no network; `previous` is
+// the previous frame's label parameters when the job fits from them (fit.init:
+// previous), else nullptr. Throws when the frame cannot be labelled (the runner
+// records the message as the reason).
 FrameOutcome LabelFrame(const LabelContext& context, const FrameInput& frame,
-                        const MeshPrediction* prediction, uint64_t seed);
+                        const MeshPrediction* prediction, uint64_t seed,
+                        const HandParams* previous = nullptr);
 
 // The deterministic per-frame seed: the job's seed mixed with the frame id.
 uint64_t FrameSeed(uint64_t job_seed, const std::string& frame);

@@ -1,16 +1,42 @@
 #include "pipeline/label_stage_factory.h"
 
-#include "core/errors.h"
-#include "pipeline/ceres_label_fitter.h"
 #include "capture/dexycb_frame_source.h"
-#include "pipeline/hand_model_source.h"
 #include "capture/ho3d_frame_source.h"
-#include "pipeline/label_overlay.h"
 #include "capture/native_frame_source.h"
 #include "capture/oakink_frame_source.h"
+#include "core/errors.h"
+#include "pipeline/ceres_label_fitter.h"
+#include "pipeline/hand_model_source.h"
+#include "pipeline/label_overlay.h"
 #include "pipeline/poem_mesh_predictor.h"
 
 namespace handlabel {
+namespace {
+
+// The fitter's settings from the job: fields of section `fit` that are set replace
+// the fitter's defaults.
+CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
+  const FitSettings& s = job.fit;
+  CeresLabelFitterOptions o;
+  o.use_masks = job.masks == MaskSource::kFiles;
+  o.network_mask_sigma_px = job.network_mask_sigma_px;
+  o.init = s.init;
+  o.fit.num_threads = 1;  // frames run in parallel
+  if (s.keypoint_loss) {
+    o.fit.keypoint_loss.type =
+        RobustLossFromName(*s.keypoint_loss, job.source_file + " fit.keypoint_loss");
+  }
+  o.fit.keypoint_loss.scale = s.keypoint_loss_scale.value_or(o.fit.keypoint_loss.scale);
+  o.fit.keypoint_sigma_px = s.keypoint_sigma_px.value_or(o.fit.keypoint_sigma_px);
+  o.fit.silhouette_sigma_px = s.silhouette_sigma_px.value_or(o.fit.silhouette_sigma_px);
+  o.fit.silhouette_rounds = s.silhouette_rounds.value_or(o.fit.silhouette_rounds);
+  o.config.pose_pca_comps = s.pose_pca_comps.value_or(o.config.pose_pca_comps);
+  o.config.use_joint_limits = s.joint_limits.value_or(o.config.use_joint_limits);
+  o.config.optimise_shape = s.optimise_shape.value_or(o.config.optimise_shape);
+  return o;
+}
+
+}  // namespace
 
 LabelStageSet BuiltLabelStages::Set() const {
   LabelStageSet set;
@@ -29,7 +55,8 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
   if (job.cameras_source == "file")
     cameras = ReadCamerasFile(job.cameras_file, job.source_file);
   if (job.input_format == "native") {
-    return std::make_unique<NativeFrameSource>(job.input_path, cameras);
+    return std::make_unique<NativeFrameSource>(job.input_path, cameras,
+                                               job.keypoint_files, job.mask_files);
   }
   if (job.input_format == "dexycb") {
     return std::make_unique<DexYcbFrameSource>(job.input_path, cameras);
@@ -62,11 +89,8 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
                          : "network, but no network.weights");
   }
   if (job.refine_mode != RefineMode::kOff || job.baseline) {
-    HandFitOptions options;
-    options.num_threads = 1;  // frames run in parallel
-    built.fitter = std::make_unique<CeresLabelFitter>(
-        built.hand_model, job.masks == MaskSource::kFiles, HandFitConfig(), options,
-        job.network_mask_sigma_px);
+    built.fitter =
+        std::make_unique<CeresLabelFitter>(built.hand_model, FitterOptions(job));
   }
   if (job.overlays)
     built.overlays = std::make_unique<RasterOverlayWriter>(built.hand_model);

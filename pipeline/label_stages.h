@@ -56,6 +56,8 @@ struct LabelFitRequest {
   // Silhouettes to fit to instead of the capture's mask files, one per rig camera
   // (evidence.masks: network); empty = the fitter's own choice.
   std::vector<MaskImage> masks;
+  // The previous frame's label parameters (job field fit.init: previous), or nullptr.
+  const HandParams* previous = nullptr;
   uint64_t seed = 0;
 };
 

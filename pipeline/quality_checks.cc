@@ -39,6 +39,104 @@ double HandSpan(const Points3d& keypoints) {
   return span;
 }
 
+// Views whose mean keypoint confidence makes them evidence.
+std::vector<bool> ConfidentViews(const MeshPrediction& prediction, int num_views,
+                                 const QualityThresholds& t) {
+  std::vector<bool> confident(num_views, false);
+  for (int v = 0; v < num_views; ++v) {
+    confident[v] = prediction.keypoints_2d[v].confidence.mean() >= t.min_confidence;
+  }
+  return confident;
+}
+
+// Hand span within the allowed range and no keypoint behind a confident camera.
+QualityFlag RangeFlag(const Rig& rig, const MeshPrediction& prediction,
+                      const std::vector<bool>& confident, const QualityThresholds& t) {
+  QualityFlag range{"range", false, HandSpan(prediction.keypoints), t.max_hand_span_m,
+                    ""};
+  int behind = 0;
+  for (int v = 0; v < static_cast<int>(confident.size()); ++v) {
+    if (!confident[v]) continue;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      const Eigen::Vector3d p =
+          rig[v].cam_from_world * prediction.keypoints.row(k).transpose();
+      behind += p.z() <= 0;
+    }
+  }
+  range.passed =
+      range.value >= t.min_hand_span_m && range.value <= t.max_hand_span_m && behind == 0;
+  range.detail = "hand span " + Format(range.value) + " m (allowed " +
+                 Format(t.min_hand_span_m) + ".." + Format(t.max_hand_span_m) + "), " +
+                 std::to_string(behind) + " keypoint(s) behind a camera";
+  return range;
+}
+
+// The worst confident view's RMS distance between the projected 3D keypoints and its
+// own confident 2D keypoints.
+QualityFlag ReprojectionFlag(const Rig& rig, const MeshPrediction& prediction,
+                             const std::vector<bool>& confident, int confident_views,
+                             const QualityThresholds& t) {
+  QualityFlag reprojection{"reprojection", false, 0, t.max_reprojection_px, ""};
+  int worst_view = -1;
+  for (int v = 0; v < static_cast<int>(confident.size()); ++v) {
+    if (!confident[v]) continue;
+    double sum_sq = 0;
+    int count = 0;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (prediction.keypoints_2d[v].confidence(k) < t.min_confidence) continue;
+      Eigen::Vector2d uv;
+      const bool in_front =
+          rig[v].ProjectWorld(prediction.keypoints.row(k).transpose(), &uv);
+      const double err =
+          in_front ? (uv - prediction.keypoints_2d[v].uv_px.row(k).transpose()).norm()
+                   : kInf;
+      sum_sq += err * err;
+      ++count;
+    }
+    const double rms = count > 0 ? std::sqrt(sum_sq / count) : 0.0;
+    if (rms >= reprojection.value) {
+      reprojection.value = rms;
+      worst_view = v;
+    }
+  }
+  reprojection.passed =
+      confident_views > 0 && reprojection.value <= t.max_reprojection_px;
+  reprojection.detail = confident_views == 0
+                            ? "no confident view"
+                            : "worst view " + rig[worst_view].name + ": RMS " +
+                                  Format(reprojection.value) + " px";
+  return reprojection;
+}
+
+// Mean distance between the 3D keypoints and those triangulated from the confident
+// 2D keypoints.
+QualityFlag ViewAgreementFlag(const Rig& rig, const MeshPrediction& prediction,
+                              const std::vector<bool>& confident,
+                              const QualityThresholds& t) {
+  QualityFlag agreement{"view_agreement", false, kInf, t.max_view_disagreement_mm, ""};
+  double sum_mm = 0;
+  int triangulated = 0;
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    std::vector<ViewObservation> observations;
+    for (int v = 0; v < static_cast<int>(confident.size()); ++v) {
+      const double c = prediction.keypoints_2d[v].confidence(k);
+      if (!confident[v] || c < t.min_confidence) continue;
+      observations.push_back({v, prediction.keypoints_2d[v].uv_px.row(k).transpose(), c});
+    }
+    const auto point = TriangulateWeighted(rig, observations);
+    if (!point) continue;
+    sum_mm += 1000.0 * (*point - prediction.keypoints.row(k).transpose()).norm();
+    ++triangulated;
+  }
+  if (triangulated > 0) agreement.value = sum_mm / triangulated;
+  agreement.passed = triangulated > 0 && agreement.value <= t.max_view_disagreement_mm;
+  agreement.detail = triangulated == 0
+                         ? "no keypoint seen confidently in two views"
+                         : "mean distance " + Format(agreement.value) + " mm over " +
+                               std::to_string(triangulated) + " triangulated keypoints";
+  return agreement;
+}
+
 }  // namespace
 
 bool QualityReport::Passed() const {
@@ -78,91 +176,18 @@ QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
   }
   report.flags.push_back(finite);
 
-  // Which views count as evidence.
-  std::vector<bool> confident(num_views, false);
+  const std::vector<bool> confident = ConfidentViews(prediction, num_views, t);
   int confident_views = 0;
-  for (int v = 0; v < num_views; ++v) {
-    confident[v] = prediction.keypoints_2d[v].confidence.mean() >= t.min_confidence;
-    confident_views += confident[v];
-  }
-
-  QualityFlag range{"range", false, HandSpan(prediction.keypoints), t.max_hand_span_m,
-                    ""};
-  int behind = 0;
-  for (int v = 0; v < num_views; ++v) {
-    if (!confident[v]) continue;
-    for (int k = 0; k < kNumHandKeypoints; ++k) {
-      const Eigen::Vector3d p =
-          rig[v].cam_from_world * prediction.keypoints.row(k).transpose();
-      behind += p.z() <= 0;
-    }
-  }
-  range.passed =
-      range.value >= t.min_hand_span_m && range.value <= t.max_hand_span_m && behind == 0;
-  range.detail = "hand span " + Format(range.value) + " m (allowed " +
-                 Format(t.min_hand_span_m) + ".." + Format(t.max_hand_span_m) + "), " +
-                 std::to_string(behind) + " keypoint(s) behind a camera";
-  report.flags.push_back(range);
-
+  for (bool c : confident) confident_views += c;
+  report.flags.push_back(RangeFlag(rig, prediction, confident, t));
   report.flags.push_back(
       {"enough_views", confident_views >= t.min_views, double(confident_views),
        double(t.min_views),
        std::to_string(confident_views) + " of " + std::to_string(num_views) +
            " views with mean confidence >= " + Format(t.min_confidence)});
-
-  QualityFlag reprojection{"reprojection", false, 0, t.max_reprojection_px, ""};
-  int worst_view = -1;
-  for (int v = 0; v < num_views; ++v) {
-    if (!confident[v]) continue;
-    double sum_sq = 0;
-    int count = 0;
-    for (int k = 0; k < kNumHandKeypoints; ++k) {
-      if (prediction.keypoints_2d[v].confidence(k) < t.min_confidence) continue;
-      Eigen::Vector2d uv;
-      const bool in_front =
-          rig[v].ProjectWorld(prediction.keypoints.row(k).transpose(), &uv);
-      const double err =
-          in_front ? (uv - prediction.keypoints_2d[v].uv_px.row(k).transpose()).norm()
-                   : kInf;
-      sum_sq += err * err;
-      ++count;
-    }
-    const double rms = count > 0 ? std::sqrt(sum_sq / count) : 0.0;
-    if (rms >= reprojection.value) {
-      reprojection.value = rms;
-      worst_view = v;
-    }
-  }
-  reprojection.passed =
-      confident_views > 0 && reprojection.value <= t.max_reprojection_px;
-  reprojection.detail = confident_views == 0
-                            ? "no confident view"
-                            : "worst view " + rig[worst_view].name + ": RMS " +
-                                  Format(reprojection.value) + " px";
-  report.flags.push_back(reprojection);
-
-  QualityFlag agreement{"view_agreement", false, kInf, t.max_view_disagreement_mm, ""};
-  double sum_mm = 0;
-  int triangulated = 0;
-  for (int k = 0; k < kNumHandKeypoints; ++k) {
-    std::vector<ViewObservation> observations;
-    for (int v = 0; v < num_views; ++v) {
-      const double c = prediction.keypoints_2d[v].confidence(k);
-      if (!confident[v] || c < t.min_confidence) continue;
-      observations.push_back({v, prediction.keypoints_2d[v].uv_px.row(k).transpose(), c});
-    }
-    const auto point = TriangulateWeighted(rig, observations);
-    if (!point) continue;
-    sum_mm += 1000.0 * (*point - prediction.keypoints.row(k).transpose()).norm();
-    ++triangulated;
-  }
-  if (triangulated > 0) agreement.value = sum_mm / triangulated;
-  agreement.passed = triangulated > 0 && agreement.value <= t.max_view_disagreement_mm;
-  agreement.detail = triangulated == 0
-                         ? "no keypoint seen confidently in two views"
-                         : "mean distance " + Format(agreement.value) + " mm over " +
-                               std::to_string(triangulated) + " triangulated keypoints";
-  report.flags.push_back(agreement);
+  report.flags.push_back(
+      ReprojectionFlag(rig, prediction, confident, confident_views, t));
+  report.flags.push_back(ViewAgreementFlag(rig, prediction, confident, t));
   return report;
 }
 

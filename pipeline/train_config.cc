@@ -7,9 +7,7 @@
 #include <set>
 
 #include "core/errors.h"
-#include "core/hand_model_io.h"
-#include "pipeline/build_config.h"
-#include "openhand/builder.h"
+#include "pipeline/hand_model_source.h"
 #include "pipeline/yaml_section.h"
 
 namespace handlabel {
@@ -45,139 +43,151 @@ nlohmann::json ToJson(const YAML::Node& node) {
   return text;
 }
 
-}  // namespace
-
-TrainConfig LoadTrainConfig(const std::string& path) {
+YAML::Node ReadYamlFile(const std::string& path) {
   if (!std::filesystem::exists(path)) {
     throw InputError(path, "", "an existing training config (YAML)", "no such file");
   }
-  YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    return YAML::LoadFile(path);
   } catch (const YAML::Exception& e) {
     throw InputError(path, "", "valid YAML", e.what());
   }
-  TrainConfig c;
-  c.source_file = path;
-  Section top(root, path, "");
-  top.Read("network", &c.network_name);
-  top.Read("hand_model", &c.hand_model);
+}
 
-  Section data = top.Child("data");
-  bool objects = c.synth.scene.objects, clutter = c.synth.view.background.clutter;
-  data.Read("preset", &c.synth.rig.preset);
-  data.Read("width", &c.synth.rig.width);
-  data.Read("height", &c.synth.rig.height);
-  data.Read("seed", &c.synth.seed);
-  data.Read("validation_seed", &c.validation_seed);
+// data.*: the synthetic training data.
+void ReadData(Section data, TrainConfig* c) {
+  bool objects = c->synth.scene.objects, clutter = c->synth.view.background.clutter;
+  data.Read("preset", &c->synth.rig.preset);
+  data.Read("width", &c->synth.rig.width);
+  data.Read("height", &c->synth.rig.height);
+  data.Read("seed", &c->synth.seed);
+  data.Read("validation_seed", &c->validation_seed);
   data.Read("objects", &objects);
-  data.Read("max_objects", &c.synth.scene.max_objects);
+  data.Read("max_objects", &c->synth.scene.max_objects);
   data.Read("clutter", &clutter);
-  data.Read("frame_reuse", &c.samples.frame_reuse);
-  data.Read("box_scale", &c.samples.box_scale);
-  data.Read("generator_threads", &c.synth.num_threads);
+  data.Read("frame_reuse", &c->samples.frame_reuse);
+  data.Read("box_scale", &c->samples.box_scale);
+  data.Read("generator_threads", &c->synth.num_threads);
   data.RejectUnknownKeys();
-  c.synth.scene.objects = objects;
-  c.synth.view.background.clutter = clutter;
+  c->synth.scene.objects = objects;
+  c->synth.view.background.clutter = clutter;
+}
 
-  Section aug = top.Child("augment");
-  TrainingAugmentOptions& a = c.samples.augment;
-  aug.Read("enabled", &a.enabled);
-  aug.Read("scale_sigma", &a.scale_sigma);
-  aug.Read("rotation_probability", &a.rotation_probability);
-  aug.Read("rotation_sigma_deg", &a.rotation_sigma_deg);
-  aug.Read("gain_min", &a.gain_min);
-  aug.Read("gain_max", &a.gain_max);
-  aug.Read("noise_rect_probability", &a.noise_rect_probability);
-  aug.Read("noise_rect_max_side", &a.noise_rect_max_side);
+// augment.*
+void ReadAugment(Section aug, TrainingAugmentOptions* a) {
+  aug.Read("enabled", &a->enabled);
+  aug.Read("scale_sigma", &a->scale_sigma);
+  aug.Read("rotation_probability", &a->rotation_probability);
+  aug.Read("rotation_sigma_deg", &a->rotation_sigma_deg);
+  aug.Read("gain_min", &a->gain_min);
+  aug.Read("gain_max", &a->gain_max);
+  aug.Read("noise_rect_probability", &a->noise_rect_probability);
+  aug.Read("noise_rect_max_side", &a->noise_rect_max_side);
   aug.RejectUnknownKeys();
+}
 
-  Section train = top.Child("train");
-  PoemTrainerOptions& t = c.trainer;
-  t.steps = 20000;
-  train.Read("steps", &t.steps);
-  train.Read("batch_size", &t.batch_size);
-  train.Read("learning_rate", &t.learning_rate);
-  train.Read("warmup_steps", &t.warmup_steps);
-  train.Read("decay_at", &t.decay_at);
-  train.Read("decay_factor", &t.decay_factor);
-  train.Read("grad_clip_norm", &t.grad_clip_norm);
-  train.Read("checkpoint_every", &t.checkpoint_every);
-  train.Read("keep_checkpoints", &t.keep_checkpoints);
-  train.Read("keep_every", &t.keep_every);
-  train.Read("log_every", &t.log_every);
-  train.Read("validate_every", &t.validate_every);
-  train.Read("validation_samples", &t.validation_samples);
-  train.Read("seed", &t.seed);
-  train.Read("threads", &t.threads);
-  train.Read("prefetch_batches", &t.prefetch_batches);
-  train.Read("out_dir", &t.out_dir);
+// train.*: optimisation, checkpoints, validation and the run folder.
+void ReadTrain(Section train, const std::string& path, PoemTrainerOptions* t) {
+  t->steps = 20000;
+  train.Read("steps", &t->steps);
+  train.Read("batch_size", &t->batch_size);
+  train.Read("learning_rate", &t->learning_rate);
+  train.Read("warmup_steps", &t->warmup_steps);
+  train.Read("decay_at", &t->decay_at);
+  train.Read("decay_factor", &t->decay_factor);
+  train.Read("grad_clip_norm", &t->grad_clip_norm);
+  train.Read("checkpoint_every", &t->checkpoint_every);
+  train.Read("keep_checkpoints", &t->keep_checkpoints);
+  train.Read("keep_every", &t->keep_every);
+  train.Read("log_every", &t->log_every);
+  train.Read("validate_every", &t->validate_every);
+  train.Read("validation_samples", &t->validation_samples);
+  train.Read("seed", &t->seed);
+  train.Read("threads", &t->threads);
+  train.Read("prefetch_batches", &t->prefetch_batches);
+  train.Read("out_dir", &t->out_dir);
   std::string trainable = "all";
   train.Read("trainable", &trainable);
   if (trainable != "all" && trainable != "mask_head") {
     throw InputError(path, "train.trainable", "all or mask_head", trainable);
   }
-  t.mask_head_only = trainable == "mask_head";
+  t->mask_head_only = trainable == "mask_head";
   train.RejectUnknownKeys();
+}
 
-  Section loss = top.Child("loss");
-  loss.Read("heatmap_weight", &t.heatmap_weight);
-  loss.Read("triangulation_weight", &t.triangulation_weight);
-  loss.Read("joints_weight", &t.joints_weight);
-  loss.Read("vertices_weight", &t.vertices_weight);
-  loss.Read("joints_2d_weight", &t.joints_2d_weight);
-  loss.Read("mask_weight", &t.mask_weight);
+// loss.*: the weights of the loss terms.
+void ReadLoss(Section loss, PoemTrainerOptions* t) {
+  loss.Read("heatmap_weight", &t->heatmap_weight);
+  loss.Read("triangulation_weight", &t->triangulation_weight);
+  loss.Read("joints_weight", &t->joints_weight);
+  loss.Read("vertices_weight", &t->vertices_weight);
+  loss.Read("joints_2d_weight", &t->joints_2d_weight);
+  loss.Read("mask_weight", &t->mask_weight);
   loss.RejectUnknownKeys();
+}
 
-  const YAML::Node overrides = top.Raw("network_overrides");
-  top.RejectUnknownKeys();
-
-  c.synth.Check();
-  const int views = static_cast<int>(MakePresetRig(c.synth.rig, c.synth.seed).size());
-  c.network = PoemConfigByName(c.network_name, views);
+// The named network for the rig's view count, then network_overrides on top.
+void ResolveNetwork(const YAML::Node& overrides, const std::string& path,
+                    TrainConfig* c) {
+  const int views = static_cast<int>(MakePresetRig(c->synth.rig, c->synth.seed).size());
+  c->network = PoemConfigByName(c->network_name, views);
   if (overrides && !overrides.IsNull()) {
     if (!overrides.IsMap()) throw InputError(path, "network_overrides", "a mapping");
-    nlohmann::json j = nlohmann::json::parse(c.network.ToJson());
+    nlohmann::json j = nlohmann::json::parse(c->network.ToJson());
     // A named object: items() of a temporary would dangle inside the loop.
     const nlohmann::json given = ToJson(overrides);
     for (const auto& [key, value] : given.items()) j[key] = value;
-    c.network = PoemConfig::FromJson(j.dump(), path + " (network_overrides)");
+    c->network = PoemConfig::FromJson(j.dump(), path + " (network_overrides)");
   }
-  if (c.network.num_views != views) {
+  if (c->network.num_views != views) {
     throw InputError(path, "network", std::to_string(views) + " views (the rig's)",
-                     std::to_string(c.network.num_views));
+                     std::to_string(c->network.num_views));
   }
-  if (t.mask_head_only && !c.network.mask_head) {
+  if (c->trainer.mask_head_only && !c->network.mask_head) {
     throw InputError(path, "train.trainable",
                      "all (mask_head needs network_overrides: {mask_head: true})",
                      "mask_head");
   }
-  c.samples.crop_size = c.network.crop_size;
-  c.samples.masks = c.network.mask_head;  // the mask head's targets
-  c.samples.reuse_group = c.trainer.batch_size;
-  c.samples.augment_seed = c.synth.seed;
-  c.samples.Check(path);
-  if (!c.trainer.out_dir.empty()) c.trainer.Check(path);
+}
+
+// Sample options that follow from the network and trainer, then the final checks.
+void DeriveSampleOptions(const std::string& path, TrainConfig* c) {
+  c->samples.crop_size = c->network.crop_size;
+  c->samples.masks = c->network.mask_head;  // the mask head's targets
+  c->samples.reuse_group = c->trainer.batch_size;
+  c->samples.augment_seed = c->synth.seed;
+  c->samples.Check(path);
+  if (!c->trainer.out_dir.empty()) c->trainer.Check(path);
+}
+
+}  // namespace
+
+TrainConfig LoadTrainConfig(const std::string& path) {
+  const YAML::Node root = ReadYamlFile(path);
+  TrainConfig c;
+  c.source_file = path;
+  Section top(root, path, "");
+  top.Read("network", &c.network_name);
+  top.Read("hand_model", &c.hand_model);
+  ReadData(top.Child("data"), &c);
+  ReadAugment(top.Child("augment"), &c.samples.augment);
+  ReadTrain(top.Child("train"), path, &c.trainer);
+  ReadLoss(top.Child("loss"), &c.trainer);
+  const YAML::Node overrides = top.Raw("network_overrides");
+  top.RejectUnknownKeys();
+
+  c.synth.Check();
+  ResolveNetwork(overrides, path, &c);
+  DeriveSampleOptions(path, &c);
   return c;
 }
 
 HandModel LoadTrainingHandModel(const TrainConfig& config, std::string* source) {
-  if (!config.hand_model.empty()) {
-    if (!std::filesystem::exists(config.hand_model)) {
-      throw InputError(config.source_file, "hand_model", "an existing model file",
-                       config.hand_model);
-    }
-    *source = config.hand_model;
-    return LoadHandModel(config.hand_model);
-  }
-  const std::string shipped =
-      std::string(HANDLABEL_SOURCE_DIR) + "/models/open_hand_right.npz";
-  if (std::filesystem::exists(shipped)) {
-    *source = shipped;
-    return LoadHandModel(shipped);
-  }
-  *source = "builtin:open_hand_right (built in memory)";
-  return BuildOpenHand(DefaultOpenHandDesign(), OpenHandBuildOptions());
+  // No side asked for: a given file trains with its own side.
+  ResolvedHandModel r = ResolveHandModel(config.hand_model, std::nullopt,
+                                         {config.source_file, "hand_model"});
+  *source = r.source;
+  return std::move(r.model);
 }
 
 SynthCaptureOptions ValidationSynthOptions(const TrainConfig& config) {

@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <string>
 
+#include "capture/synth_capture.h"
 #include "core/hand_model.h"
 #include "network/poem_config.h"
 #include "network/poem_trainer.h"
-#include "capture/synth_capture.h"
 #include "pipeline/training_samples.h"
 
 namespace handlabel {
@@ -20,7 +20,8 @@ struct TrainConfig {
   // per-field overrides in network_overrides (PoemConfig JSON field names).
   std::string network_name = "small";
   PoemConfig network = SmallPoemConfig(8);
-  // Hand model file; empty = the shipped open hand (models/open_hand_right.npz).
+  // Hand model file or "capsule"; empty = $HANDLABEL_HAND_MODEL, else the shipped open
+  // hand (models/open_hand_right.npz).
   std::string hand_model;
   // Synthetic training data (data.*): rig preset, seed, scene and backgrounds.
   SynthCaptureOptions synth;
@@ -33,9 +34,11 @@ struct TrainConfig {
 // Throws InputError naming the file and field on bad content.
 TrainConfig LoadTrainConfig(const std::string& path);
 
-// The hand model of a config: `hand_model` if set, else the shipped
-// models/open_hand_right.npz, else the open hand built in memory from its default
-// design (the same model, bit for bit). `source` receives where it came from.
+// The hand model of a config, chosen by ResolveHandModel (pipeline/hand_model_source.h):
+// `hand_model` if set (a file trains with its own side), else $HANDLABEL_HAND_MODEL,
+// else the shipped models/open_hand_right.npz of the data folder, else the open hand
+// built in memory from its default design (what the shipped file holds). `source`
+// receives where it came from.
 HandModel LoadTrainingHandModel(const TrainConfig& config, std::string* source);
 
 // The validation data of a config: same rig and scene settings, validation_seed, no

@@ -42,6 +42,136 @@ float Bilinear(const ImageU8& img, double x, double y, int c) {
   return static_cast<float>((1 - ay) * top + ay * bottom);
 }
 
+using Keypoints2d = Eigen::Matrix<double, 21, 2, Eigen::RowMajor>;
+
+// The 21 keypoints projected exactly (pinhole), their weights (0 behind the camera)
+// and the box of the weighted ones (the principal point if none).
+void ProjectKeypoints(const RigCamera& cam, const Eigen::Matrix4d& cam_from_world,
+                      const Points3d& keypoints, Keypoints2d* uv,
+                      std::array<float, 21>* weight, Eigen::Vector2d* lo,
+                      Eigen::Vector2d* hi) {
+  const double fx = cam.camera.fx(), fy = cam.camera.fy();
+  const double cx = cam.camera.cx(), cy = cam.camera.cy();
+  *lo = Eigen::Vector2d(1e300, 1e300);
+  *hi = Eigen::Vector2d(-1e300, -1e300);
+  for (int k = 0; k < 21; ++k) {
+    const Eigen::Vector3d p =
+        (cam_from_world * keypoints.row(k).transpose().homogeneous()).head<3>();
+    const double z = std::max(p.z(), 1e-6);
+    uv->row(k) << fx * p.x() / z + cx, fy * p.y() / z + cy;
+    (*weight)[k] = p.z() > 1e-6 ? 1.0f : 0.0f;
+    if ((*weight)[k] > 0) {
+      *lo = lo->cwiseMin(uv->row(k).transpose());
+      *hi = hi->cwiseMax(uv->row(k).transpose());
+    }
+  }
+  if (lo->x() > hi->x()) *lo = *hi = Eigen::Vector2d(cx, cy);  // hand behind the camera
+}
+
+// The crop of one view: crop pixel = lin * image pixel + offset, with lin = s * rot *
+// diag(f / fx, f / fy) (square pixels of focal length f, turned, scaled to the crop).
+struct CropTransform {
+  Eigen::Matrix2d rot;
+  Eigen::Matrix2d lin;
+  Affine2 affine;
+  double f = 0, s = 0;
+};
+
+CropTransform MakeCropTransform(const Camera& camera, const Eigen::Vector2d& lo,
+                                const Eigen::Vector2d& hi, const ViewAugmentation& aug,
+                                const TrainingSampleOptions& o) {
+  const double fx = camera.fx(), fy = camera.fy();
+  CropTransform t;
+  // The box is measured in square pixels.
+  t.f = 0.5 * (fx + fy);
+  const Eigen::Vector2d center = 0.5 * (lo + hi);
+  const double box = std::max(
+      {(hi.x() - lo.x()) * t.f / fx, (hi.y() - lo.y()) * t.f / fy, o.min_box_px});
+  const double side = box * o.box_scale * aug.scale;
+  t.s = o.crop_size / side;
+  const double co = std::cos(aug.rotation_rad), si = std::sin(aug.rotation_rad);
+  t.rot << co, -si, si, co;
+  t.lin = t.s * t.rot * Eigen::Vector2d(t.f / fx, t.f / fy).asDiagonal();
+  t.affine.leftCols<2>() = t.lin;
+  t.affine.col(2) = Eigen::Vector2d::Constant(0.5 * o.crop_size) -
+                    t.lin * center;  // as network/hand_crop.h
+  return t;
+}
+
+// Resamples the image (gain, noise rectangle) and the hand mask through the inverse
+// crop transform into the network's layout.
+void ResampleCrop(const SynthView& src, const CropTransform& t,
+                  const ViewAugmentation& aug, const TrainingSampleOptions& o,
+                  TrainingView* view) {
+  const int S = o.crop_size;
+  const Eigen::Matrix2d inv = t.lin.inverse();
+  const Eigen::Vector2d inv_t = -inv * t.affine.col(2);
+  view->image.assign(3 * S * S, 0.0f);
+  if (o.masks) view->mask.assign(S * S, 0.0f);
+  std::mt19937_64 noise_rng(aug.noise_seed);
+  std::uniform_real_distribution<float> noise(0.0f, 255.0f);
+  for (int y = 0; y < S; ++y) {
+    for (int x = 0; x < S; ++x) {
+      const Eigen::Vector2d p = inv * Eigen::Vector2d(x, y) + inv_t;
+      const bool in_rect = aug.noise_rect && x >= aug.rect_x0 && x < aug.rect_x1 &&
+                           y >= aug.rect_y0 && y < aug.rect_y1;
+      for (int ch = 0; ch < 3; ++ch) {
+        float v = static_cast<float>(Bilinear(src.rgb, p.x(), p.y(), ch) * aug.gain[ch]);
+        v = std::min(255.0f, v);
+        if (in_rect) v = noise(noise_rng);
+        view->image[(ch * S + y) * S + x] = v / 255.0f - 0.5f;
+      }
+      if (o.masks)
+        view->mask[y * S + x] = Bilinear(src.hand_mask, p.x(), p.y(), 0) / 255.0f;
+    }
+  }
+}
+
+// One view of the sample; returns the (turned) camera's cam_from_world. Throws
+// InputError for a camera with lens distortion.
+Eigen::Matrix4d MakeTrainingView(const RigCamera& cam, const SynthView& src,
+                                 const Points3d& keypoints, const ViewAugmentation& aug,
+                                 const TrainingSampleOptions& o, TrainingView* view) {
+  const CameraModelId model = cam.camera.model();
+  if (model != CameraModelId::kPinhole && model != CameraModelId::kSimplePinhole) {
+    throw InputError("training samples", "camera " + cam.name,
+                     "a pinhole camera (crops assume no lens distortion)",
+                     CameraModelName(model));
+  }
+  const Eigen::Matrix4d original = ToMatrix4(cam.cam_from_world);
+  // Keypoint box from the exact projections (points behind the camera are skipped).
+  Keypoints2d uv;
+  std::array<float, 21> weight{};
+  Eigen::Vector2d lo, hi;
+  ProjectKeypoints(cam, original, keypoints, &uv, &weight, &lo, &hi);
+  const CropTransform t = MakeCropTransform(cam.camera, lo, hi, aug, o);
+
+  const Eigen::Vector2d pp =
+      t.lin * Eigen::Vector2d(cam.camera.cx(), cam.camera.cy()) + t.affine.col(2);
+  view->intrinsics << t.s * t.f, 0, pp.x(), 0, t.s * t.f, pp.y(), 0, 0, 1;
+  for (int k = 0; k < 21; ++k) {
+    view->joints_2d.row(k) =
+        (t.lin * uv.row(k).transpose() + t.affine.col(2)).transpose();
+  }
+  view->joints_2d_weight = weight;
+  ResampleCrop(src, t, aug, o, view);
+  Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+  turn.topLeftCorner<2, 2>() = t.rot;  // cam' = turn * cam
+  return turn * original;
+}
+
+// World points in the master frame.
+Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> ToMaster(
+    const Eigen::Matrix4d& master_from_world, const Points3d& world) {
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> out(world.rows(), 3);
+  const Eigen::Matrix3d R = master_from_world.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = master_from_world.topRightCorner<3, 1>();
+  for (Eigen::Index i = 0; i < world.rows(); ++i) {
+    out.row(i) = (R * world.row(i).transpose() + t).transpose();
+  }
+  return out;
+}
+
 }  // namespace
 
 void TrainingAugmentOptions::Check(const std::string& source) const {
@@ -105,116 +235,26 @@ TrainingSample MakeTrainingSample(const SynthFrame& frame, const Rig& rig,
                                   const TrainingSampleOptions& o,
                                   const std::vector<ViewAugmentation>& augmentations) {
   const int N = static_cast<int>(rig.size());
-  const int S = o.crop_size;
   HL_CHECK(static_cast<int>(frame.views.size()) == N, "one rendered view per camera");
   HL_CHECK(static_cast<int>(augmentations.size()) == N, "one augmentation per view");
   const Points3d& keypoints = frame.scene.hand.keypoints;  // world, SNAP order
-  const Points3d& vertices = frame.scene.hand.vertices;
 
   TrainingSample sample;
   sample.frame = frame.index;
   sample.views.resize(N);
   std::vector<Eigen::Matrix4d> cam_from_world(N);
   for (int c = 0; c < N; ++c) {
-    const RigCamera& cam = rig[c];
-    const CameraModelId model = cam.camera.model();
-    if (model != CameraModelId::kPinhole && model != CameraModelId::kSimplePinhole) {
-      throw InputError("training samples", "camera " + cam.name,
-                       "a pinhole camera (crops assume no lens distortion)",
-                       CameraModelName(model));
-    }
-    const ViewAugmentation& aug = augmentations[c];
-    const double fx = cam.camera.fx(), fy = cam.camera.fy();
-    const double cx = cam.camera.cx(), cy = cam.camera.cy();
-    const Eigen::Matrix4d original = ToMatrix4(cam.cam_from_world);
-
-    // Keypoint box from the exact projections (points behind the camera are skipped).
-    Eigen::Matrix<double, 21, 2, Eigen::RowMajor> uv;
-    std::array<float, 21> weight{};
-    Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
-    for (int k = 0; k < 21; ++k) {
-      const Eigen::Vector3d p =
-          (original * keypoints.row(k).transpose().homogeneous()).head<3>();
-      const double z = std::max(p.z(), 1e-6);
-      uv.row(k) << fx * p.x() / z + cx, fy * p.y() / z + cy;
-      weight[k] = p.z() > 1e-6 ? 1.0f : 0.0f;
-      if (weight[k] > 0) {
-        lo = lo.cwiseMin(uv.row(k).transpose());
-        hi = hi.cwiseMax(uv.row(k).transpose());
-      }
-    }
-    if (lo.x() > hi.x()) lo = hi = Eigen::Vector2d(cx, cy);  // hand behind the camera
-    // Crop affine: square pixels (f / fx, f / fy), turn, scale to the crop. The box is
-    // measured in square pixels.
-    const double f = 0.5 * (fx + fy);
-    const Eigen::Vector2d center = 0.5 * (lo + hi);
-    const double box =
-        std::max({(hi.x() - lo.x()) * f / fx, (hi.y() - lo.y()) * f / fy, o.min_box_px});
-    const double side = box * o.box_scale * aug.scale;
-    const double s = S / side;
-    const double co = std::cos(aug.rotation_rad), si = std::sin(aug.rotation_rad);
-    Eigen::Matrix2d rot;
-    rot << co, -si, si, co;
-    const Eigen::Matrix2d lin = s * rot * Eigen::Vector2d(f / fx, f / fy).asDiagonal();
-    Affine2 A;
-    A.leftCols<2>() = lin;
-    A.col(2) =
-        Eigen::Vector2d::Constant(0.5 * S) - lin * center;  // as network/hand_crop.h
-
-    TrainingView& view = sample.views[c];
-    const Eigen::Vector2d pp = lin * Eigen::Vector2d(cx, cy) + A.col(2);
-    view.intrinsics << s * f, 0, pp.x(), 0, s * f, pp.y(), 0, 0, 1;
-    Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
-    turn.topLeftCorner<2, 2>() = rot;  // cam' = turn * cam
-    cam_from_world[c] = turn * original;
-    for (int k = 0; k < 21; ++k) {
-      view.joints_2d.row(k) = (lin * uv.row(k).transpose() + A.col(2)).transpose();
-    }
-    view.joints_2d_weight = weight;
-
-    // Resample the image (and mask) through the inverse affine.
-    const Eigen::Matrix2d inv = lin.inverse();
-    const Eigen::Vector2d inv_t = -inv * A.col(2);
-    const SynthView& src = frame.views[c];
-    view.image.assign(3 * S * S, 0.0f);
-    if (o.masks) view.mask.assign(S * S, 0.0f);
-    std::mt19937_64 noise_rng(aug.noise_seed);
-    std::uniform_real_distribution<float> noise(0.0f, 255.0f);
-    for (int y = 0; y < S; ++y) {
-      for (int x = 0; x < S; ++x) {
-        const Eigen::Vector2d p = inv * Eigen::Vector2d(x, y) + inv_t;
-        const bool in_rect = aug.noise_rect && x >= aug.rect_x0 && x < aug.rect_x1 &&
-                             y >= aug.rect_y0 && y < aug.rect_y1;
-        for (int ch = 0; ch < 3; ++ch) {
-          float v =
-              static_cast<float>(Bilinear(src.rgb, p.x(), p.y(), ch) * aug.gain[ch]);
-          v = std::min(255.0f, v);
-          if (in_rect) v = noise(noise_rng);
-          view.image[(ch * S + y) * S + x] = v / 255.0f - 0.5f;
-        }
-        if (o.masks)
-          view.mask[y * S + x] = Bilinear(src.hand_mask, p.x(), p.y(), 0) / 255.0f;
-      }
-    }
+    cam_from_world[c] = MakeTrainingView(rig[c], frame.views[c], keypoints,
+                                         augmentations[c], o, &sample.views[c]);
   }
-
   // Master frame = the (turned) camera 0.
   const Eigen::Matrix4d master_from_world = cam_from_world[0];
   for (int c = 0; c < N; ++c) {
     sample.views[c].master_from_cam = master_from_world * cam_from_world[c].inverse();
   }
   sample.views[0].master_from_cam = Eigen::Matrix4d::Identity();
-  auto to_master = [&](const Points3d& world) {
-    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> out(world.rows(), 3);
-    const Eigen::Matrix3d R = master_from_world.topLeftCorner<3, 3>();
-    const Eigen::Vector3d t = master_from_world.topRightCorner<3, 1>();
-    for (Eigen::Index i = 0; i < world.rows(); ++i) {
-      out.row(i) = (R * world.row(i).transpose() + t).transpose();
-    }
-    return out;
-  };
-  sample.joints_3d = to_master(keypoints);
-  sample.vertices_3d = to_master(vertices);
+  sample.joints_3d = ToMaster(master_from_world, keypoints);
+  sample.vertices_3d = ToMaster(master_from_world, frame.scene.hand.vertices);
   return sample;
 }
 

@@ -1,5 +1,12 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
+#include "pipeline/label_outputs.h"
+#include "pipeline/label_record.h"
+#include "tests/apps/label_test_capture.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 
@@ -7,6 +14,7 @@ namespace handlabel {
 namespace {
 
 using testing::CommandResult;
+using ::testing::HasSubstr;
 using testing::RunHandlabelCommand;
 
 TEST(FitCommand, HelpDescribesTheOptions) {
@@ -32,6 +40,67 @@ TEST(FitCommand, BadLossIsAnError) {
       {"fit", "--capture", dir, "--out", dir + "/out", "--loss", "magic"});
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("--loss"), std::string::npos) << r.err;
+}
+
+// `fit` is a label job without a network: on the same capture it writes the same label
+// files, byte for byte, as `label` with the matching job (default rules: detections
+// and detection masks, triangulated start), and reports the errors against the truth.
+TEST(FitCommand, WritesTheSameLabelsAsANetworkFreeLabelJob) {
+  const std::string dir = testing::ScratchDir();
+  testing::WriteTestCapture(dir + "/capture", 3, 5);
+  const CommandResult fit =
+      RunHandlabelCommand({"fit", "--capture", dir + "/capture", "--out", dir + "/fit",
+                           "--hand-model", "capsule", "--threads", "2"});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_THAT(fit.out, HasSubstr("fitted 3 frames"));
+  EXPECT_THAT(fit.out, HasSubstr("MPJPE"));
+  const std::string job = dir + "/job.yaml";
+  std::ofstream(job) << "name: same\nhand_model: capsule\n"
+                     << "input: {format: native, path: capture}\n"
+                     << "network: {threads: 1}\nrefine: {mode: always}\n"
+                     << "evidence: {keypoints_2d: files, masks: files}\n"
+                     << "output: {dir: label, overlays: false}\n";
+  const CommandResult label = RunHandlabelCommand({"label", "--job", job});
+  ASSERT_EQ(label.status, 0) << label.err;
+  const auto fit_labels = testing::FilesUnder(dir + "/fit/labels");
+  const auto job_labels = testing::FilesUnder(dir + "/label/labels");
+  ASSERT_EQ(fit_labels.size(), 3u);
+  EXPECT_EQ(fit_labels, job_labels);  // names and bytes
+  const LabelRecord record = ReadLabelFile(LabelFilePath(dir + "/fit", "000002"));
+  EXPECT_EQ(record.path, LabelPath::kFallbackFit);
+  EXPECT_EQ(record.fit.at("silhouettes"), "files");
+  const nlohmann::json summary =
+      nlohmann::json::parse(testing::ReadFileBytes(SummaryJsonPath(dir + "/fit")));
+  // Simulated detections and noisy masks at 160x120: within ~2 cm (15 mm measured).
+  EXPECT_LT(summary.at("metrics").at("labels").at("mpjpe_mm").get<double>(), 20.0);
+}
+
+// Flags the job format had no field for are job fields now: a YAML job can ask for
+// the same fit (here: exact keypoints, true masks, Huber loss, a camera left out).
+TEST(FitCommand, FlagsMapToJobFields) {
+  const std::string dir = testing::ScratchDir();
+  testing::WriteTestCapture(dir + "/capture", 2, 6);
+  const CommandResult fit = RunHandlabelCommand(
+      {"fit", "--capture", dir + "/capture", "--out", dir + "/fit", "--hand-model",
+       "capsule", "--evidence", "keypoints", "--masks", "truth", "--loss", "huber",
+       "--silhouette-rounds", "1", "--ignore-views", "cam00", "--max-frames", "1"});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  const std::string job = dir + "/job.yaml";
+  std::ofstream(job) << "hand_model: capsule\n"
+                     << "input: {format: native, path: capture, max_frames: 1}\n"
+                     << "refine: {mode: always}\n"
+                     << "evidence: {keypoints_2d: files, masks: files, keypoint_files: "
+                        "keypoints, mask_files: truth, ignore_views: [cam00]}\n"
+                     << "fit: {keypoint_loss: huber, silhouette_rounds: 1}\n"
+                     << "output: {dir: label, overlays: false}\n";
+  const CommandResult label = RunHandlabelCommand({"label", "--job", job});
+  ASSERT_EQ(label.status, 0) << label.err;
+  const auto fit_labels = testing::FilesUnder(dir + "/fit/labels");
+  ASSERT_EQ(fit_labels.size(), 1u);
+  EXPECT_EQ(fit_labels, testing::FilesUnder(dir + "/label/labels"));
+  // cam00 has neither keypoints nor a mask in the fit.
+  const LabelRecord record = ReadLabelFile(LabelFilePath(dir + "/fit", "000000"));
+  EXPECT_EQ(record.fit.at("view_rms_px").size(), 7u);
 }
 
 }  // namespace

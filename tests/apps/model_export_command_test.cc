@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -72,6 +73,44 @@ TEST(ModelExportCommand, BadPoseOrExtensionIsAnErrorNamingIt) {
   r = testing::RunHandlabelCommand({"model", "export", kModel, "--out", dir + "/a.stl"});
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find(".ply or .obj"), std::string::npos) << r.err;
+}
+
+TEST(ModelExportCommand, SideAndTipsAreTakenLikeModelInfo) {
+  // A MANO pickle whose name records no side, with 12 vertices and no default tips.
+  const std::string dir = testing::ScratchDir();
+  const std::string model = dir + "/hand.pkl";
+  std::filesystem::copy_file(
+      std::string(HANDLABEL_SOURCE_DIR) + "/tests/data/mano/mano_py2_right.pkl", model);
+  const std::string out = dir + "/hand.obj";
+  auto r = testing::RunHandlabelCommand(
+      {"model", "export", model, "--tips", "1,7,5,8,6", "--out", out});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("side"), std::string::npos) << r.err;
+  r = testing::RunHandlabelCommand({"model", "export", model, "--side", "left", "--tips",
+                                    "1,7,5,8,6", "--pose", "fist", "--out", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+
+  HandModelLoadOptions options;
+  options.side = HandSide::kLeft;
+  options.tip_vertex_ids = std::array<int, 5>{1, 7, 5, 8, 6};
+  const HandModel loaded = LoadHandModel(model, options);
+  EXPECT_EQ(loaded.side, HandSide::kLeft);
+  HandParams params;
+  for (const NamedHandPose& p : PreviewHandPoses(loaded)) {
+    if (p.name == "fist") params = p.params;
+  }
+  const HandMesh expected = PoseHand(loaded, params);
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Eigen::Vector3i> faces;
+  ReadObj(out, &vertices, &faces);
+  ASSERT_EQ(static_cast<int>(vertices.size()), 12);
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    ASSERT_LT((vertices[i] - expected.vertices.row(i).transpose()).norm(), 1e-6) << i;
+  }
+  EXPECT_EQ(testing::RunHandlabelCommand(
+                {"model", "export", model, "--side", "up", "--out", out})
+                .status,
+            2);
 }
 
 }  // namespace

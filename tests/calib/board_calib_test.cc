@@ -5,9 +5,11 @@
 #include <cmath>
 #include <iomanip>
 
+#include "calib/board_calib_init.h"
 #include "calib/rig_compare.h"
 #include "calib/synthetic_board_capture.h"
 #include "core/errors.h"
+#include "tests/pin_digest.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -36,6 +38,60 @@ TEST(BoardCalib, DexYcbLikeRigFromNoisyCornersMeetsTheAccuracyTargets) {
   EXPECT_EQ(result.world, "camera:cam0");
   ASSERT_EQ(result.stats.size(), 8u);
   for (const CameraCalibStats& s : result.stats) EXPECT_GT(s.observations, 100) << s.name;
+}
+
+void AddRig(const Rig& rig, testing::PinDigest* d) {
+  for (size_t c = 0; c < rig.size(); ++c) {
+    d->Add(rig[c].name).Add(rig[c].camera.params()).Add(rig[c].cam_from_world);
+  }
+}
+
+// Pins every bit of the synthetic capture, one camera's initial values and the
+// calibration (with an outlier round and the board as the world) on one input.
+TEST(BoardCalib, SameInputGivesTheSameBits) {
+  SyntheticBoardCaptureOptions options;
+  options.seed = 11;
+  options.num_cameras = 3;
+  options.num_frames = 12;
+  options.near_frames_per_camera = 4;
+  SyntheticBoardCapture capture = SynthesizeBoardCapture(kBoard, options);
+  testing::PinDigest in;
+  AddRig(capture.rig, &in);
+  in.Add(capture.world_from_board);
+  for (const CameraBoardViews& v : capture.views) {
+    in.Add(v.name).Add(v.width).Add(v.height);
+    for (const auto& [key, obs] : v.frames) in.Add(key).Add(obs.ids).Add(obs.pixels);
+  }
+  EXPECT_EQ(in.Hex(), "59cdc0bef8aa1ef4");
+  capture.views[1].frames.begin()->second.pixels[2] += Eigen::Vector2d(25, -12);
+
+  const InitialCamera initial =
+      InitialIntrinsics(capture.views[0], kBoard, CameraModelId::kOpenCV);
+  testing::PinDigest init;
+  init.Add(initial.camera.params()).Add(initial.cam_from_board).Add(initial.rms_px);
+  EXPECT_EQ(init.Hex(), "76408cfc3c31f087");
+
+  BoardCalibOptions calib;
+  calib.world = "board";
+  const BoardCalibResult result = CalibrateBoardRig(capture.views, kBoard, calib);
+  testing::PinDigest out;
+  AddRig(result.rig, &out);
+  out.Add(result.world).Add(result.world_from_board).Add(result.rms_px);
+  for (const CameraCalibStats& s : result.stats) {
+    out.Add(s.name).Add(s.frames).Add(s.observations).Add(s.outliers);
+    out.Add(s.rms_px).Add(s.initial_rms_px);
+  }
+  for (const CornerResidual& r : result.residuals) {
+    out.Add(r.camera).Add(r.frame).Add(r.corner_id).Add(r.observed).Add(r.residual);
+    out.Add(r.inlier);
+  }
+  for (const auto& [parent, child, weight] : result.tree) {
+    out.Add(parent).Add(child).Add(weight);
+  }
+  int outliers = 0;
+  for (const CameraCalibStats& s : result.stats) outliers += s.outliers;
+  EXPECT_GE(outliers, 1);
+  EXPECT_EQ(out.Hex(), "ce481e11a45f07c8");
 }
 
 TEST(BoardCalib, RejectsGrossOutliers) {

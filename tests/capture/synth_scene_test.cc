@@ -4,10 +4,12 @@
 
 #include <map>
 
-#include "core/capsule_hand.h"
 #include "capture/rig_presets.h"
+#include "capture/synth_background.h"
 #include "capture/synth_detections.h"
 #include "capture/synth_view.h"
+#include "core/capsule_hand.h"
+#include "tests/pin_digest.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -78,6 +80,54 @@ TEST(SynthScene, ObjectsAreHeldNearTheHand) {
       EXPECT_LT((obj.world_from_object.translation - palm).norm(), 0.25) << obj.kind;
     }
   }
+}
+
+void AddMesh(const RenderMesh& m, testing::PinDigest* d) {
+  d->Add(m.vertices).Add(m.faces).Add(m.normals).Add(m.colors).Add(m.color).Add(m.uvs);
+  if (m.texture) d->Add(m.texture->width).Add(m.texture->height).Add(m.texture->data);
+}
+
+// Pins every bit of a run of scenes (every pose kind, objects on and off).
+TEST(SynthScene, SameRngGivesTheSameBits) {
+  SceneFixture s;
+  testing::PinDigest digest;
+  for (bool objects : {true, false}) {
+    SynthSceneOptions o;
+    o.objects = objects;
+    std::mt19937_64 rng(objects ? 21 : 22);
+    for (int i = 0; i < 25; ++i) {
+      const SynthScene scene =
+          SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, rng);
+      digest.Add(static_cast<int>(scene.side)).Add(scene.pose_kind);
+      const HandParams& p = scene.params;
+      digest.Add(p.global_orient).Add(p.hand_pose).Add(p.betas).Add(p.transl);
+      digest.Add(scene.hand.vertices).Add(scene.hand.joints).Add(scene.hand.keypoints);
+      AddMesh(scene.hand_render, &digest);
+      digest.Add(scene.skin).Add(scene.lighting.ambient);
+      for (const DirectionalLight& l : scene.lighting.lights) {
+        digest.Add(l.direction_in_world).Add(l.color);
+      }
+      for (const SynthObject& b : scene.objects) {
+        digest.Add(b.kind).Add(b.size).Add(b.world_from_object).Add(b.color);
+        digest.Add(b.texture_kind);
+        AddMesh(b.mesh, &digest);
+      }
+      digest.Add(scene.cameras_seeing_hand);
+    }
+    digest.Add(rng());
+  }
+  EXPECT_EQ(digest.Hex(), "ef79cf8391ce9a14");
+}
+
+// Pins every pixel of a run of backgrounds (every base, bands, shapes and noise).
+TEST(SynthBackground, SameRngGivesTheSameBits) {
+  std::mt19937_64 rng(5);
+  testing::PinDigest digest;
+  BackgroundOptions o;
+  o.max_noise = 12.0;
+  for (int i = 0; i < 16; ++i) digest.Add(MakeBackground(97, 61, o, rng).data);
+  digest.Add(rng());
+  EXPECT_EQ(digest.Hex(), "652fdeea58177d42");
 }
 
 TEST(SynthView, OccludedAndOutOfFrameKeypointsAreMarked) {

@@ -8,6 +8,7 @@
 #include "core/errors.h"
 #include "core/hand_lbs.h"
 #include "tests/core/lbs_fixture.h"
+#include "tests/pin_digest.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -189,6 +190,29 @@ TEST(HandEvaluator, DualJacobianMatchesCentralDifferences) {
 
 namespace handlabel {
 namespace {
+
+// Pins every bit of the analytic keypoints and Jacobian (axis-angle and PCA modes).
+TEST(HandEvaluator, AnalyticKeypointJacobianGivesTheSameBits) {
+  const nlohmann::json fixture = testing::LoadLbsFixtureJson();
+  const HandModel model = testing::LbsFixtureModel(fixture);
+  testing::PinDigest digest;
+  for (int pca : {0, 7}) {
+    HandEvaluatorOptions options;
+    options.num_pca_comps = pca;
+    const HandEvaluator ev(model, options);
+    const int np = ev.num_params(), pd = ev.pose_dim();
+    for (int trial = 0; trial < 3; ++trial) {
+      Eigen::VectorXd x(np);
+      for (int i = 0; i < np; ++i) x[i] = testing::Uniform(-0.6, 0.6);
+      Eigen::Matrix<double, 63, Eigen::Dynamic, Eigen::RowMajor> jac(63, np);
+      Eigen::Matrix<double, 63, 1> keypoints;
+      ev.KeypointsAndJacobian(x.data(), x.data() + 3, x.data() + 3 + pd,
+                              x.data() + 3 + pd + 10, keypoints.data(), jac.data());
+      digest.Add(keypoints).Add(jac);
+    }
+  }
+  EXPECT_EQ(digest.Hex(), "253c700cccdf88e3");
+}
 
 // Analytic keypoint Jacobian against Dual forward mode, axis-angle and PCA modes.
 TEST(HandEvaluator, AnalyticKeypointJacobianMatchesDuals) {

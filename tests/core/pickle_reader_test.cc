@@ -7,9 +7,11 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/pickle_globals.h"
 #include "core/torch_archive.h"
 #include "core/zip_reader.h"
 #include "core/zip_writer.h"
+#include "tests/pin_digest.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -69,6 +71,22 @@ TEST_P(SmallPickle, EveryProtocolDecodesTheSameValues) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Protocols, SmallPickle, ::testing::Range(0, 6));
+
+// Pins the name (or none) of every byte value as an opcode.
+TEST(PickleOpcodeName, EveryByteGivesTheSameName) {
+  testing::PinDigest digest;
+  int named = 0;
+  for (int op = 0; op < 256; ++op) {
+    const char* name = pickle::PickleOpcodeName(static_cast<uint8_t>(op));
+    digest.Add(op).Add(name);
+    named += name != nullptr;
+  }
+  EXPECT_EQ(named, 68);
+  EXPECT_STREQ(pickle::PickleOpcodeName('('), "MARK");
+  EXPECT_STREQ(pickle::PickleOpcodeName(0x98), "READONLY_BUFFER");
+  EXPECT_EQ(pickle::PickleOpcodeName(0x99), nullptr);
+  EXPECT_EQ(digest.Hex(), "9ac33fe039df3df6");
+}
 
 TEST(PickleReader, ReadsTheOfficialMANOStructure) {
   const PickleValue v = ReadPickleFile(DataPath("mano/mano_py2_right.pkl"));

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/mesh_primitives.h"
+#include "tests/pin_digest.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -78,6 +79,32 @@ void ExpectCoverageMatchesRayCasting(const Camera& camera) {
     EXPECT_EQ(mismatched, 0) << "trial " << trial;
   }
   EXPECT_GT(covered, 200) << "the triangles must cover pixels";
+}
+
+// Pins every bit of the visibility buffer (depth, ids, barycentrics) and the count of
+// tested faces for two meshes seen by a pinhole and a distorted camera, including
+// faces that leave the image, lie behind the near plane or fold under distortion.
+TEST(Rasterizer, SameSceneGivesTheSameBits) {
+  const Camera pinhole(CameraModelId::kPinhole, 160, 120, {150.0, 152.0, 81.3, 58.7});
+  testing::PinDigest digest;
+  for (const Camera& camera : {pinhole, DistortedCamera()}) {
+    const PixelRays rays(camera);
+    RenderMesh box = MakeBox(Eigen::Vector3d(0.5, 0.3, 0.4), 6);
+    TransformMesh(Rigid3(testing::RandomRotation(), Eigen::Vector3d(0.2, 0.05, 0.25)),
+                  &box);
+    RenderMesh sphere = MakeSphere(0.1, 20, 30);
+    TransformMesh(Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-0.1, 0, 0.7)),
+                  &sphere);
+    const Rigid3 cam_from_world(
+        testing::RandomRotation().slerp(0.95, Eigen::Quaterniond::Identity()),
+        Eigen::Vector3d(0.01, -0.02, 0.03));
+    VisibilityBuffer buffer;
+    buffer.Reset(camera.width(), camera.height());
+    digest.Add(RasterizeMesh(box, 0, cam_from_world, rays, &buffer));
+    digest.Add(RasterizeMesh(sphere, 1, cam_from_world, rays, &buffer));
+    digest.Add(buffer.depth).Add(buffer.mesh_id).Add(buffer.face_id).Add(buffer.bary);
+  }
+  EXPECT_EQ(digest.Hex(), "ad1d0c6f212fe18a");
 }
 
 TEST(Rasterizer, TriangleCoverageAndDepthEqualRayCastingPinhole) {

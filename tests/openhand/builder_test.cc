@@ -8,10 +8,11 @@
 #include "core/errors.h"
 #include "core/hand_anatomy.h"
 #include "core/hand_lbs.h"
-#include "openhand/mesh_checks.h"
 #include "openhand/builder.h"
+#include "openhand/mesh_checks.h"
 #include "openhand/shape_space.h"
 #include "tests/openhand/open_hand_checks.h"
+#include "tests/pin_digest.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -92,6 +93,23 @@ TEST(OpenHandBuilder, SameSeedSameModelDifferentSeedDifferentShapes) {
   EXPECT_TRUE(again.pose_pca_basis == first.pose_pca_basis);
   EXPECT_TRUE(again.pose_mean == first.pose_mean);
   EXPECT_EQ(again.tip_vertex_ids, first.tip_vertex_ids);
+}
+
+// Pins every bit of the coarse model (surface, skinning, shapes, regressor, tips, pose
+// PCA) and of the build report.
+TEST(OpenHandBuilder, SameOptionsGiveTheSameBits) {
+  OpenHandBuildReport report;
+  const HandModel m = BuildOpenHand(DefaultOpenHandDesign(), CoarseOptions(), &report);
+  testing::PinDigest digest;
+  digest.Add(m.name).Add(static_cast<int>(m.side)).Add(m.v_template).Add(m.faces);
+  digest.Add(m.shapedirs).Add(m.posedirs).Add(m.skinning_weights);
+  digest.Add(Eigen::MatrixXd(m.joint_regressor)).Add(m.pose_pca_basis).Add(m.pose_mean);
+  for (int p : m.parents) digest.Add(p);
+  for (int t : m.tip_vertex_ids) digest.Add(t);
+  digest.Add(report.fine_vertices).Add(report.fine_faces);
+  digest.Add(report.shape_variance_explained).Add(report.max_regressor_error);
+  digest.Add(report.max_regressor_error_mean).Add(report.pose_variance_explained_6);
+  EXPECT_EQ(digest.Hex(), "acf65eee7d6e7eb1");
 }
 
 TEST(OpenHandBuilder, LeftIsTheMirrorOfRight) {

@@ -7,6 +7,7 @@
 #include "openhand/mesh_checks.h"
 #include "openhand/mesh_decimation.h"
 #include "openhand/nnls.h"
+#include "tests/pin_digest.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -45,6 +46,26 @@ TEST(ImplicitMesher, SphereIsClosedOutwardAndHasTheRightVolume) {
   EXPECT_NEAR(SignedVolume(v, f), exact, 0.01 * exact);
   for (const auto& p : mesh.vertices)
     EXPECT_NEAR((p - Eigen::Vector3d(0.0013, -0.0007, 0.0021)).norm(), r, 2e-4);
+}
+
+// Pins every bit of a torus's vertices and faces (the grid does not divide the box, so
+// the last samples lie beyond `hi`).
+TEST(ImplicitMesher, SameFieldGivesTheSameBits) {
+  ImplicitMesherOptions options;
+  options.step = 0.0023;
+  const TriangleMesh mesh = MeshImplicitSurface(
+      [](const Eigen::Vector3d& p) {
+        const double ring = std::hypot(p.x(), p.y()) - 0.02;
+        return std::hypot(ring, p.z()) - 0.008;
+      },
+      Eigen::Vector3d(-0.031, -0.03, -0.012), Eigen::Vector3d(0.03, 0.032, 0.011),
+      options);
+  Points3d v;
+  Faces f;
+  ToArrays(mesh, &v, &f);
+  EXPECT_GT(f.rows(), 500);
+  testing::PinDigest digest;
+  EXPECT_EQ(digest.Add(v).Add(f).Hex(), "2deafba8a5cd9117");
 }
 
 TEST(MeshDecimation, KeepsASphereClosedAndRound) {

@@ -27,8 +27,8 @@ inline HandParams PoseOneAngle(const HandAnatomy& anatomy, int joint, int axis,
   return p;
 }
 
-inline void ExpectPlausibleOpenHand(const HandModel& model) {
-  ASSERT_NO_THROW(model.Check("open hand"));
+// A closed, outward-facing, self-intersection-free mesh of adult size.
+inline void ExpectClosedAdultSurface(const HandModel& model) {
   const int nv = model.num_vertices();
   EXPECT_GE(nv, 700);
   EXPECT_LE(nv, 900);
@@ -45,12 +45,14 @@ inline void ExpectPlausibleOpenHand(const HandModel& model) {
   const double length = HandLength(model);
   EXPECT_GT(length, 0.17);
   EXPECT_LT(length, 0.20);
+}
 
-  // Skinning weights: non-negative rows summing to 1.
+// Skinning weights: non-negative rows summing to 1; joint regressor: convex
+// combinations.
+inline void ExpectConvexWeights(const HandModel& model) {
   EXPECT_GE(model.skinning_weights.minCoeff(), 0.0);
-  for (int v = 0; v < nv; ++v)
+  for (int v = 0; v < model.num_vertices(); ++v)
     EXPECT_NEAR(model.skinning_weights.row(v).sum(), 1.0, 1e-12);
-  // Joint regressor: convex combinations.
   for (int j = 0; j < kNumHandJoints; ++j) {
     double sum = 0.0;
     for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
@@ -61,8 +63,11 @@ inline void ExpectPlausibleOpenHand(const HandModel& model) {
     }
     EXPECT_NEAR(sum, 1.0, 1e-12) << "joint " << j;
   }
+}
 
-  // MANO axes: fingers along -x (right) / +x (left), thumb on +z, back of hand +y.
+// MANO axes: fingers along -x (right) / +x (left), thumb on +z, back of hand +y; the
+// palm centre's outward normal points -y.
+inline void ExpectManoAxes(const HandModel& model) {
   const double sx = model.side == HandSide::kRight ? 1.0 : -1.0;
   const HandMesh rest = PoseHand(model, HandParams());
   const Eigen::Vector3d wrist = rest.keypoints.row(0);
@@ -75,11 +80,10 @@ inline void ExpectPlausibleOpenHand(const HandModel& model) {
                         pinky_mcp = rest.keypoints.row(17);
   EXPECT_GT(thumb_tip.z(), index_mcp.z() + 0.02);
   EXPECT_GT(index_mcp.z(), pinky_mcp.z() + 0.03);
-  // Palm normal: the palm centre's outward normal points -y.
   const Eigen::Vector3d palm_centre = (wrist + middle_mcp) / 2.0;
   Eigen::Index best = 0;
   double best_score = 1e9;
-  for (int v = 0; v < nv; ++v) {
+  for (int v = 0; v < model.num_vertices(); ++v) {
     const Eigen::Vector3d q = model.v_template.row(v).transpose() - palm_centre;
     const double score = std::hypot(q.x(), q.z()) - (q.y() < 0 ? 1.0 : 0.0);
     if (score < best_score) best_score = score, best = v;
@@ -96,21 +100,20 @@ inline void ExpectPlausibleOpenHand(const HandModel& model) {
   }
   EXPECT_LT(normal.normalized().y(), -0.8)
       << "palm normal " << normal.normalized().transpose();
+}
 
-  // Tips: distinct, each the vertex farthest along its finger.
+// Distinct tips; a positive bend flexes every finger towards the palm (-y); posed at
+// every single-angle limit (DefaultHandLimits), few faces turn over.
+inline void ExpectTipsBendAndLimits(const HandModel& model, const HandAnatomy& anatomy) {
   for (int a = 0; a < 5; ++a)
     for (int b = a + 1; b < 5; ++b)
       EXPECT_NE(model.tip_vertex_ids[a], model.tip_vertex_ids[b]);
-
-  // Anatomy: positive bend flexes every finger towards the palm (-y).
-  const HandAnatomy anatomy = ComputeHandAnatomy(model);
+  const HandMesh rest = PoseHand(model, HandParams());
   for (int first : {1, 4, 7, 10}) {
     const HandMesh bent = PoseHand(model, PoseOneAngle(anatomy, first, kBend, 60.0));
     const int tip_keypoint = first == 1 ? 8 : first == 4 ? 12 : first == 7 ? 20 : 16;
     EXPECT_LT(bent.keypoints(tip_keypoint, 1), rest.keypoints(tip_keypoint, 1) - 0.03);
   }
-
-  // Posed at every single-angle limit (DefaultHandLimits): few faces turn over.
   const HandLimits limits = DefaultHandLimits();
   double worst = 0.0;
   for (int j = 1; j < kNumHandJoints; ++j) {
@@ -124,14 +127,16 @@ inline void ExpectPlausibleOpenHand(const HandModel& model) {
     }
   }
   EXPECT_LT(worst, 0.01) << "worst fraction of inverted faces at a single-joint limit";
+}
 
-  // No candy-wrapper collapse: at a 90 degree bend the surface around the joint keeps
-  // most of its distance from the joint centre (measured 72-82 % on the shipped model).
+// No candy-wrapper collapse: at a 90 degree bend the surface around the joint keeps
+// most of its distance from the joint centre (measured 72-82 % on the shipped model).
+inline void ExpectNoCandyWrapper(const HandModel& model, const HandAnatomy& anatomy) {
   const HandMesh rest_mesh = PoseHand(model, HandParams());
   for (int j : {1, 2, 4, 5, 10, 11, 7, 8, 14}) {
     const HandMesh bent = PoseHand(model, PoseOneAngle(anatomy, j, kBend, 90.0));
     double before = 1e9, after = 1e9;
-    for (int v = 0; v < nv; ++v) {
+    for (int v = 0; v < model.num_vertices(); ++v) {
       if (model.skinning_weights(v, j) + model.skinning_weights(v, model.parents[j]) <
           0.9)
         continue;
@@ -141,13 +146,25 @@ inline void ExpectPlausibleOpenHand(const HandModel& model) {
     }
     EXPECT_GT(after, 0.6 * before) << JointName(j) << " collapses at 90 degrees";
   }
+}
 
-  // Pose PCA: orthonormal rows, 45 x 45.
+// Pose PCA: orthonormal rows, 45 x 45; posedirs: zero (plain LBS, documented).
+inline void ExpectPosePcaAndPlainLbs(const HandModel& model) {
   ASSERT_EQ(model.pose_pca_basis.rows(), kNumPoseParams);
   const Eigen::MatrixXd gram = model.pose_pca_basis * model.pose_pca_basis.transpose();
   EXPECT_LT((gram - Eigen::MatrixXd::Identity(45, 45)).cwiseAbs().maxCoeff(), 1e-9);
-  // Posedirs: zero (plain LBS, documented).
   EXPECT_EQ(model.posedirs.cwiseAbs().maxCoeff(), 0.0);
+}
+
+inline void ExpectPlausibleOpenHand(const HandModel& model) {
+  ASSERT_NO_THROW(model.Check("open hand"));
+  ExpectClosedAdultSurface(model);
+  ExpectConvexWeights(model);
+  ExpectManoAxes(model);
+  const HandAnatomy anatomy = ComputeHandAnatomy(model);
+  ExpectTipsBendAndLimits(model, anatomy);
+  ExpectNoCandyWrapper(model, anatomy);
+  ExpectPosePcaAndPlainLbs(model);
 }
 
 // `left` is the exact mirror image (x -> -x) of `right`.

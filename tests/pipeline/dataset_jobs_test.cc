@@ -1,5 +1,6 @@
 // Label jobs over the dataset readers in place (input.format dexycb, ho3d, oakink): the
-// job file selects the reader and a whole job runs over a fixture in the dataset's layout.
+// job file selects the reader and a whole job runs over a fixture in the dataset's
+// layout.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -80,34 +81,26 @@ output:
   EXPECT_GT(same, static_cast<int>(image.data.size() / 2));
 }
 
+// The frame source that a minimal job file with input.format and input.path selects.
+std::unique_ptr<FrameSource> SourceOfJob(const std::string& dir,
+                                         const std::string& format,
+                                         const std::string& path) {
+  std::ofstream(dir + "/job.yaml")
+      << "input:\n  format: " << format << "\n  path: " << path
+      << "\nnetwork:\n  weights: poem.pt\noutput:\n  dir: out\n";
+  return BuildFrameSource(LoadJobConfig(dir + "/job.yaml"));
+}
+
 TEST(Ho3dJob, JobFileSelectsIt) {
   const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir(), 1);
-  std::ofstream(fx.root + "/job.yaml") << R"(input:
-  format: ho3d
-  path: train/ABF1
-network:
-  weights: poem.pt
-output:
-  dir: out
-)";
-  const std::unique_ptr<FrameSource> source =
-      BuildFrameSource(LoadJobConfig(fx.root + "/job.yaml"));
+  const auto source = SourceOfJob(fx.root, "ho3d", "train/ABF1");
   EXPECT_THAT(source->Describe(), HasSubstr("HO3D v3"));
   EXPECT_EQ(source->FrameIds(), std::vector<std::string>{"0000"});
 }
 
 TEST(OakInkJob, JobFileSelectsIt) {
   const OakInkFixture fx = WriteOakInkFixture(testing::ScratchDir(), 1);
-  std::ofstream(fx.image_dir + "/../job.yaml") << R"(input:
-  format: oakink
-  path: image
-network:
-  weights: poem.pt
-output:
-  dir: out
-)";
-  const std::unique_ptr<FrameSource> source =
-      BuildFrameSource(LoadJobConfig(fx.image_dir + "/../job.yaml"));
+  const auto source = SourceOfJob(fx.image_dir + "/..", "oakink", "image");
   EXPECT_THAT(source->Describe(), HasSubstr("OakInk"));
   EXPECT_EQ(source->FrameIds(), fx.ids);
 }

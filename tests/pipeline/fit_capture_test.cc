@@ -6,9 +6,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/errors.h"
-#include "core/capsule_hand.h"
 #include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
+#include "core/errors.h"
+#include "pipeline/label_record.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -35,21 +36,44 @@ TEST(FitCaptureTest, ExactKeypointsRecoverGroundTruth) {
   o.out_dir = scratch + "/fit";
   o.evidence = "keypoints";
   o.masks = "none";
-  const FitCaptureSummary s = FitCapture(o, MakeCapsuleHand(HandSide::kRight));
+  o.hand_model = "capsule";
+  const FitCaptureSummary s = FitCapture(o);
   EXPECT_EQ(s.frames, 2);
+  EXPECT_EQ(s.job.ok, 2);
   EXPECT_TRUE(s.has_ground_truth);
   EXPECT_LT(s.mpjpe, 0.001);
   EXPECT_GT(s.auc_joints, 0.9);
   std::ifstream in(s.summary_path);
   const nlohmann::json summary = nlohmann::json::parse(in);
   EXPECT_EQ(summary["frames"], 2);
-  EXPECT_TRUE(summary.contains("errors_mm"));
-  EXPECT_TRUE(std::filesystem::exists(o.out_dir + "/frames/000000.json"));
-  // The fitted parameters serve as an initialisation folder for a second run.
+  EXPECT_LT(summary.at("metrics").at("labels").at("mpjpe_mm").get<double>(), 1.0);
+  EXPECT_TRUE(std::filesystem::exists(LabelFilePath(o.out_dir, "000000")));
+  // The fitted labels serve as an initialisation folder for a second run.
   FitCaptureOptions again = o;
-  again.init = o.out_dir;
+  again.fit.init = o.out_dir;
   again.out_dir = scratch + "/fit2";
-  EXPECT_LT(FitCapture(again, MakeCapsuleHand(HandSide::kRight)).mpjpe, 0.001);
+  const FitCaptureSummary from_labels = FitCapture(again);
+  EXPECT_LT(from_labels.mpjpe, 0.001);
+  EXPECT_EQ(ReadLabelFile(LabelFilePath(again.out_dir, "000001")).fit.at("init"), "file");
+}
+
+// --init previous: frames run in order, each fit starting from the previous label.
+TEST(FitCaptureTest, PreviousStartsFromThePreviousLabel) {
+  const std::string scratch = testing::ScratchDir();
+  FitCaptureOptions o;
+  o.capture_dir = SmallCapture(scratch, 3);
+  o.out_dir = scratch + "/fit";
+  o.evidence = "keypoints";
+  o.masks = "none";
+  o.hand_model = "capsule";
+  o.fit.init = "previous";
+  const FitCaptureSummary s = FitCapture(o);
+  EXPECT_EQ(s.job.ok, 3);
+  EXPECT_LT(s.mpjpe, 0.003);  // the temporal pull costs a little against exact keypoints
+  EXPECT_EQ(ReadLabelFile(LabelFilePath(o.out_dir, "000000")).fit.at("init"),
+            "triangulated_views");
+  EXPECT_EQ(ReadLabelFile(LabelFilePath(o.out_dir, "000002")).fit.at("init"),
+            "previous_label");
 }
 
 TEST(FitCaptureTest, BadOptionsNameTheFlag) {

@@ -93,6 +93,55 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
               "evidence.network_mask_sigma_px", "> 0 pixels");
 }
 
+// The fields `handlabel fit` sets: unset fitter fields stay unset (the fitter's
+// defaults), set ones are read and checked naming the field.
+TEST(JobConfig, FitSectionAndFileEvidence) {
+  const JobConfig plain = LoadJobConfig(WriteJob(kValidJob));
+  EXPECT_TRUE(plain.fit.IsDefault());
+  EXPECT_EQ(plain.keypoint_files, "auto");
+  EXPECT_EQ(plain.max_frames, 0);
+  const std::string path = WriteJob(std::string(kValidJob) +
+                                    "evidence: {keypoint_files: keypoints, mask_files: "
+                                    "truth, ignore_views: [cam01]}\n"
+                                    "fit: {init: gt, keypoint_loss: huber, "
+                                    "silhouette_rounds: 0, joint_limits: false}\n");
+  const JobConfig job = LoadJobConfig(path);
+  EXPECT_EQ(job.keypoint_files, "keypoints");
+  EXPECT_EQ(job.mask_files, "truth");
+  EXPECT_EQ(job.ignore_views, std::vector<std::string>{"cam01"});
+  EXPECT_EQ(job.fit.init, "gt");
+  EXPECT_EQ(job.fit.keypoint_loss, std::optional<std::string>("huber"));
+  EXPECT_EQ(job.fit.silhouette_rounds, std::optional<int>(0));
+  EXPECT_EQ(job.fit.joint_limits, std::optional<bool>(false));
+  EXPECT_FALSE(job.fit.keypoint_sigma_px.has_value());
+  EXPECT_FALSE(job.fit.IsDefault());
+  // A folder start resolves against the job's folder.
+  const std::string with_folder =
+      WriteJob(std::string(kValidJob) + "fit: {init: starts}\n");
+  const fs::path starts = fs::path(with_folder).parent_path() / "starts";
+  fs::create_directories(starts);
+  EXPECT_EQ(LoadJobConfig(with_folder).fit.init, starts.string());
+}
+
+TEST(JobConfig, FitSectionErrorsNameTheField) {
+  const std::string base = "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n";
+  ExpectError(base + "fit: {init: nowhere}\n", "fit.init", "triangulate | gt");
+  ExpectError(base + "fit: {keypoint_loss: l1}\n", "fit.keypoint_loss",
+              "cauchy | huber | trivial");
+  ExpectError(base + "fit: {keypoint_sigma_px: 0}\n", "fit.keypoint_sigma_px", "> 0");
+  ExpectError(base + "fit: {pose_pca_comps: 7}\n", "fit.pose_pca_comps", "0, 12 or 45");
+  ExpectError(base + "fit: {rounds: 2}\n", "fit.rounds", "a known key");
+  ExpectError(base + "evidence: {keypoint_files: guesses}\n", "evidence.keypoint_files",
+              "auto | detections | keypoints");
+  ExpectError(
+      "input: {path: c, format: ho3d}\noutput: {dir: o}\nnetwork: {weights: "
+      "w}\nevidence: {mask_files: truth}\n",
+      "evidence.mask_files", "native only");
+  ExpectError(
+      "input: {path: c, max_frames: -2}\noutput: {dir: o}\nnetwork: {weights: w}\n",
+      "input.max_frames", ">= 0");
+}
+
 TEST(JobConfig, MissingOrBrokenFileIsAClearError) {
   EXPECT_THROW(LoadJobConfig("/nonexistent/job.yaml"), InputError);
   try {

@@ -5,8 +5,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 #include "core/errors.h"
+#include "core/sha256.h"
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
 #include "tests/pipeline/label_test_stages.h"
@@ -305,6 +307,38 @@ TEST(LabelJob, JobHashIgnoresWhereOutputsGoButNotWhatChangesLabels) {
   EXPECT_NE(JobHash(a, "w"), JobHash(a, "v"));
   b.quality.max_reprojection_px = 3;
   EXPECT_NE(JobHash(a, "w"), JobHash(b, "w"));
+}
+
+// The fields `handlabel fit` brought into the job change the hash only when set, so a
+// job that does not use them keeps the hash it had before they existed.
+TEST(LabelJob, JobHashCoversTheFitFieldsOnlyWhenSet) {
+  const JobConfig a = MakeJob("/tmp/a", RefineMode::kFallback);
+  const std::string plain = JobHash(a, "w");
+  // The hash of such a job before the fields existed (computed as JobHash did then).
+  const QualityThresholds& q = a.quality;
+  const nlohmann::json before = {
+      {"label_format", kLabelFormatVersion},
+      {"input", {a.input_format, a.input_path, a.frames}},
+      {"cameras", {a.cameras_source, a.cameras_file}},
+      {"hand_model", a.hand_model},
+      {"weights_sha256", "w"},
+      {"refine",
+       {ToString(a.refine_mode), q.max_reprojection_px, q.max_view_disagreement_mm,
+        q.min_confidence, q.min_views, q.min_hand_span_m, q.max_hand_span_m}},
+      {"evidence", {static_cast<int>(a.keypoints), static_cast<int>(a.masks)}},
+      {"seed", a.seed}};
+  EXPECT_EQ(plain, Sha256Hex(before.dump()));
+  for (const auto& change : std::vector<std::function<void(JobConfig*)>>{
+           [](JobConfig* j) { j->fit.init = "gt"; },
+           [](JobConfig* j) { j->fit.keypoint_loss = "huber"; },
+           [](JobConfig* j) { j->fit.joint_limits = false; },
+           [](JobConfig* j) { j->keypoint_files = "keypoints"; },
+           [](JobConfig* j) { j->ignore_views = {"cam1"}; },
+           [](JobConfig* j) { j->max_frames = 3; }}) {
+    JobConfig b = a;
+    change(&b);
+    EXPECT_NE(JobHash(b, "w"), plain);
+  }
 }
 
 }  // namespace
