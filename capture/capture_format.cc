@@ -3,31 +3,17 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/json_util.h"
 
 namespace handlabel {
 namespace {
 
 using nlohmann::json;
 
-const json& Member(const json& j, const char* key, const std::string& source,
-                   const std::string& where = "") {
-  if (!j.is_object())
-    throw InputError(source, where, "an object", j.dump().substr(0, 80));
-  const auto it = j.find(key);
-  if (it == j.end()) throw InputError(source, where + key, "a value", "missing");
-  return *it;
-}
-
-std::string String(const json& j, const char* key, const std::string& source,
-                   const std::string& where = "") {
-  const json& v = Member(j, key, source, where);
-  if (!v.is_string()) throw InputError(source, where + key, "a string", v.dump());
-  return v.get<std::string>();
-}
-
+// A non-empty list of non-empty strings.
 std::vector<std::string> StringList(const json& j, const char* key,
                                     const std::string& source) {
-  const json& v = Member(j, key, source);
+  const json& v = JsonMember(j, key, source);
   if (!v.is_array()) throw InputError(source, key, "an array of strings", v.dump());
   std::vector<std::string> out;
   for (const json& s : v) {
@@ -36,63 +22,6 @@ std::vector<std::string> StringList(const json& j, const char* key,
     }
     out.push_back(s.get<std::string>());
   }
-  return out;
-}
-
-double Number(const json& v, const std::string& source, const std::string& field) {
-  if (!v.is_number()) throw InputError(source, field, "a number", v.dump());
-  return v.get<double>();
-}
-
-// A number, or null for NaN.
-json NumberOrNull(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
-double NumberOrNan(const json& v, const std::string& source, const std::string& field) {
-  return v.is_null() ? std::nan("") : Number(v, source, field);
-}
-
-json Points(const Points3d& p) {
-  json out = json::array();
-  for (Eigen::Index i = 0; i < p.rows(); ++i) out.push_back({p(i, 0), p(i, 1), p(i, 2)});
-  return out;
-}
-
-Points3d PointsFrom(const json& j, const std::string& source, const std::string& field,
-                    Eigen::Index expected_rows) {
-  if (!j.is_array() ||
-      (expected_rows >= 0 && static_cast<Eigen::Index>(j.size()) != expected_rows)) {
-    throw InputError(source, field,
-                     expected_rows >= 0
-                         ? std::to_string(expected_rows) + " points [x, y, z]"
-                         : "an array of [x, y, z]",
-                     j.is_array() ? std::to_string(j.size()) + " entries" : j.dump());
-  }
-  Points3d p(j.size(), 3);
-  for (size_t i = 0; i < j.size(); ++i) {
-    if (!j[i].is_array() || j[i].size() != 3) {
-      throw InputError(source, field + "[" + std::to_string(i) + "]", "[x, y, z]",
-                       j[i].dump());
-    }
-    for (int c = 0; c < 3; ++c) p(i, c) = Number(j[i][c], source, field);
-  }
-  return p;
-}
-
-Eigen::VectorXd VectorFrom(const json& j, const std::string& source,
-                           const std::string& field, int expected) {
-  if (!j.is_array() || (expected >= 0 && static_cast<int>(j.size()) != expected)) {
-    throw InputError(source, field,
-                     expected >= 0 ? std::to_string(expected) + " numbers" : "numbers",
-                     j.dump().substr(0, 80));
-  }
-  Eigen::VectorXd v(j.size());
-  for (size_t i = 0; i < j.size(); ++i) v[i] = Number(j[i], source, field);
-  return v;
-}
-
-template <typename V>
-json Array(const V& v) {
-  json out = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(v[i]);
   return out;
 }
 
@@ -116,22 +45,22 @@ json ManifestToJson(const CaptureManifest& m) {
 
 CaptureManifest ManifestFromJson(const json& j, const std::string& source) {
   CaptureManifest m;
-  if (String(j, "format", source) != "handlabel-capture") {
+  if (JsonString(j, "format", source) != "handlabel-capture") {
     throw InputError(source, "format", "\"handlabel-capture\"",
-                     Member(j, "format", source).dump());
+                     JsonMember(j, "format", source).dump());
   }
-  const json& version = Member(j, "version", source);
+  const json& version = JsonMember(j, "version", source);
   if (!version.is_number_integer() || version.get<int>() != kCaptureFormatVersion) {
     throw InputError(
         source, "version",
         std::to_string(kCaptureFormatVersion) + " (this build reads only it)",
         version.dump());
   }
-  m.rig_file = String(j, "rig", source);
-  if (j.contains("colmap")) m.colmap_dir = String(j, "colmap", source);
+  m.rig_file = JsonString(j, "rig", source);
+  if (j.contains("colmap")) m.colmap_dir = JsonString(j, "colmap", source);
   m.cameras = StringList(j, "cameras", source);
   m.frames = StringList(j, "frames", source);
-  const json& files = Member(j, "files", source);
+  const json& files = JsonMember(j, "files", source);
   if (!files.is_object())
     throw InputError(source, "files", "an object of patterns", files.dump());
   for (const auto& [kind, pattern] : files.items()) {
@@ -141,12 +70,12 @@ CaptureManifest ManifestFromJson(const json& j, const std::string& source) {
     m.files[kind] = pattern.get<std::string>();
   }
   if (j.contains("depth_unit_m")) {
-    m.depth_unit_m = Number(j["depth_unit_m"], source, "depth_unit_m");
+    m.depth_unit_m = JsonNumber(j["depth_unit_m"], source, "depth_unit_m");
     if (!(m.depth_unit_m > 0)) throw InputError(source, "depth_unit_m", "> 0");
   }
-  if (j.contains("world")) m.world = String(j, "world", source);
+  if (j.contains("world")) m.world = JsonString(j, "world", source);
   if (j.contains("hand_side")) {
-    m.hand_side = String(j, "hand_side", source);
+    m.hand_side = JsonString(j, "hand_side", source);
     if (m.hand_side != "right" && m.hand_side != "left") {
       throw InputError(source, "hand_side", "\"right\" or \"left\"", m.hand_side);
     }
@@ -185,7 +114,7 @@ json ViewKeypointsToJson(const std::string& frame,
     json kp = json::array();
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       kp.push_back(
-          {NumberOrNull(v.keypoints.uv_px(k, 0)), NumberOrNull(v.keypoints.uv_px(k, 1))});
+          {JsonNumberOrNull(v.keypoints.uv_px(k, 0)), JsonNumberOrNull(v.keypoints.uv_px(k, 1))});
     }
     jv["keypoints"] = kp;
     if (ground_truth) {
@@ -203,15 +132,15 @@ json ViewKeypointsToJson(const std::string& frame,
 
 std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
                                                  const std::string& source) {
-  const json& views = Member(j, "views", source);
+  const json& views = JsonMember(j, "views", source);
   if (!views.is_array()) throw InputError(source, "views", "an array", views.dump());
   std::vector<ViewKeypoints> out;
   for (size_t i = 0; i < views.size(); ++i) {
     const std::string where = "views[" + std::to_string(i) + "].";
     const json& jv = views[i];
     ViewKeypoints v;
-    v.camera = String(jv, "camera", source, where);
-    const json& kp = Member(jv, "keypoints", source, where);
+    v.camera = JsonString(jv, "camera", source, where);
+    const json& kp = JsonMember(jv, "keypoints", source, where);
     if (!kp.is_array() || kp.size() != kNumHandKeypoints) {
       throw InputError(source, where + "keypoints", "21 [x, y] pairs",
                        kp.dump().substr(0, 80));
@@ -221,14 +150,16 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
         throw InputError(source, where + "keypoints", "[x, y] or [null, null]",
                          kp[k].dump());
       }
-      v.keypoints.uv_px(k, 0) = NumberOrNan(kp[k][0], source, where + "keypoints");
-      v.keypoints.uv_px(k, 1) = NumberOrNan(kp[k][1], source, where + "keypoints");
+      v.keypoints.uv_px(k, 0) =
+          JsonNumber(kp[k][0], source, where + "keypoints", JsonNull::kAsNan);
+      v.keypoints.uv_px(k, 1) =
+          JsonNumber(kp[k][1], source, where + "keypoints", JsonNull::kAsNan);
     }
     v.visibility.fill(-1);
     v.keypoints.confidence.setOnes();
     if (jv.contains("visibility")) {
       const Eigen::VectorXd vis =
-          VectorFrom(jv["visibility"], source, where + "visibility", 21);
+          JsonVector(jv["visibility"], source, where + "visibility", 21);
       for (int k = 0; k < kNumHandKeypoints; ++k) {
         v.visibility[k] = static_cast<int>(vis[k]);
         if (vis[k] != 0 && vis[k] != 1 && vis[k] != 2) {
@@ -239,13 +170,13 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
     }
     if (jv.contains("confidence")) {
       const Eigen::VectorXd c =
-          VectorFrom(jv["confidence"], source, where + "confidence", 21);
+          JsonVector(jv["confidence"], source, where + "confidence", 21);
       v.keypoints.confidence = c;
     }
-    if (jv.contains("status")) v.status = String(jv, "status", source, where);
+    if (jv.contains("status")) v.status = JsonString(jv, "status", source, where);
     if (jv.contains("hand_pixels")) {
       v.hand_pixels =
-          static_cast<int>(Number(jv["hand_pixels"], source, where + "hand_pixels"));
+          static_cast<int>(JsonNumber(jv["hand_pixels"], source, where + "hand_pixels"));
     }
     out.push_back(v);
   }
@@ -258,39 +189,33 @@ json GroundTruthToJson(const std::string& frame, const HandGroundTruth& gt) {
   j["hand_model"] = gt.hand_model;
   j["side"] = gt.side;
   j["pose_kind"] = gt.pose_kind;
-  j["global_orient"] = Array(gt.params.global_orient);
-  j["hand_pose"] = Array(gt.params.hand_pose);
-  j["betas"] = Array(gt.params.betas);
-  j["transl"] = Array(gt.params.transl);
-  j["keypoints3d"] = Points(gt.keypoints);
-  j["joints3d"] = Points(gt.joints);
-  j["vertices"] = Points(gt.vertices);
+  j.update(JsonHandParams(gt.params));  // the parameters sit at the top level
+  j["keypoints3d"] = JsonPoints(gt.keypoints);
+  j["joints3d"] = JsonPoints(gt.joints);
+  j["vertices"] = JsonPoints(gt.vertices);
   j["objects"] = json::array();
   for (const ObjectGroundTruth& o : gt.objects) {
     const Eigen::Quaterniond& q = o.world_from_object.rotation;
-    j["objects"].push_back({{"kind", o.kind},
-                            {"size", Array(o.size)},
-                            {"world_from_object",
-                             {{"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
-                              {"translation", Array(o.world_from_object.translation)}}}});
+    j["objects"].push_back(
+        {{"kind", o.kind},
+         {"size", JsonArray(o.size)},
+         {"world_from_object",
+          {{"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
+           {"translation", JsonArray(o.world_from_object.translation)}}}});
   }
   return j;
 }
 
 HandGroundTruth GroundTruthFromJson(const json& j, const std::string& source) {
   HandGroundTruth gt;
-  gt.hand_model = String(j, "hand_model", source);
-  gt.side = String(j, "side", source);
-  gt.pose_kind = String(j, "pose_kind", source);
-  gt.params.global_orient =
-      VectorFrom(Member(j, "global_orient", source), source, "global_orient", 3);
-  gt.params.hand_pose =
-      VectorFrom(Member(j, "hand_pose", source), source, "hand_pose", 45);
-  gt.params.betas = VectorFrom(Member(j, "betas", source), source, "betas", -1);
-  gt.params.transl = VectorFrom(Member(j, "transl", source), source, "transl", 3);
-  gt.keypoints = PointsFrom(Member(j, "keypoints3d", source), source, "keypoints3d", 21);
-  gt.joints = PointsFrom(Member(j, "joints3d", source), source, "joints3d", 16);
-  gt.vertices = PointsFrom(Member(j, "vertices", source), source, "vertices", -1);
+  gt.hand_model = JsonString(j, "hand_model", source);
+  gt.side = JsonString(j, "side", source);
+  gt.pose_kind = JsonString(j, "pose_kind", source);
+  gt.params = HandParamsFromJson(j, source);
+  gt.keypoints =
+      JsonPointList(JsonMember(j, "keypoints3d", source), source, "keypoints3d", 21);
+  gt.joints = JsonPointList(JsonMember(j, "joints3d", source), source, "joints3d", 16);
+  gt.vertices = JsonPointList(JsonMember(j, "vertices", source), source, "vertices", -1);
   if (j.contains("objects")) {
     const json& objects = j["objects"];
     if (!objects.is_array())
@@ -298,13 +223,14 @@ HandGroundTruth GroundTruthFromJson(const json& j, const std::string& source) {
     for (size_t i = 0; i < objects.size(); ++i) {
       const std::string where = "objects[" + std::to_string(i) + "].";
       ObjectGroundTruth o;
-      o.kind = String(objects[i], "kind", source, where);
-      o.size = VectorFrom(Member(objects[i], "size", source, where), source,
+      o.kind = JsonString(objects[i], "kind", source, where);
+      o.size = JsonVector(JsonMember(objects[i], "size", source, where), source,
                           where + "size", 3);
-      const json& pose = Member(objects[i], "world_from_object", source, where);
-      const Eigen::VectorXd q = VectorFrom(Member(pose, "rotation_xyzw", source, where),
-                                           source, where + "rotation_xyzw", 4);
-      const Eigen::VectorXd t = VectorFrom(Member(pose, "translation", source, where),
+      const json& pose = JsonMember(objects[i], "world_from_object", source, where);
+      const Eigen::VectorXd q =
+          JsonVector(JsonMember(pose, "rotation_xyzw", source, where), source,
+                     where + "rotation_xyzw", 4);
+      const Eigen::VectorXd t = JsonVector(JsonMember(pose, "translation", source, where),
                                            source, where + "translation", 3);
       if (!(q.norm() > 0.5))
         throw InputError(source, where + "rotation_xyzw", "a unit quaternion");

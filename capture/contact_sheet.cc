@@ -3,45 +3,117 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/draw.h"
 #include "core/errors.h"
+#include "core/hand_skeleton.h"
 #include "core/mask_outline.h"
+#include "core/mesh_render.h"
 
 namespace handlabel {
 namespace {
 
-// SNAP skeleton: (parent, child) pairs, with one colour per finger.
-constexpr int kBones[20][2] = {{0, 1},   {1, 2},   {2, 3},   {3, 4},   {0, 5},
-                               {5, 6},   {6, 7},   {7, 8},   {0, 9},   {9, 10},
-                               {10, 11}, {11, 12}, {0, 13},  {13, 14}, {14, 15},
-                               {15, 16}, {0, 17},  {17, 18}, {18, 19}, {19, 20}};
-constexpr uint8_t kFingerColors[5][3] = {
-    {255, 60, 60}, {255, 200, 0}, {60, 220, 60}, {40, 160, 255}, {200, 80, 255}};
+constexpr int kGap = 4;  // pixels between tiles and around the sheet
 
-int FingerOf(int keypoint) { return keypoint == 0 ? 0 : (keypoint - 1) / 4; }
+// The part of a view a tile shows: tile pixel (x, y) samples image point
+// (x0 + (x + 0.5) / scale, y0 + (y + 0.5) / scale); scale is tile pixels per image pixel.
+struct TileWindow {
+  double x0 = -0.5, y0 = -0.5, scale = 1;
+  Eigen::Vector2d ToTile(double u, double v) const {
+    return Eigen::Vector2d((u - x0) * scale - 0.5, (v - y0) * scale - 0.5);
+  }
+};
 
-void PutPixel(ImageU8* img, int x, int y, const uint8_t* c) {
-  if (!img->Contains(x, y)) return;
-  for (int k = 0; k < 3; ++k) img->at(x, y, k) = c[k];
+// The whole view scaled to the tile width, or with crop_to_hand a square around the
+// in-frame keypoints (the whole view, fitted into the tile, when none is in frame).
+TileWindow ChooseWindow(const ImageU8& image, const ViewKeypoints* keypoints, int tw,
+                        int th) {
+  TileWindow w;
+  w.scale = static_cast<double>(tw) / image.width;
+  if (keypoints == nullptr) return w;
+  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (keypoints->visibility[k] == 0) continue;
+    lo = lo.cwiseMin(keypoints->keypoints.uv_px.row(k).transpose());
+    hi = hi.cwiseMax(keypoints->keypoints.uv_px.row(k).transpose());
+  }
+  if (lo.x() <= hi.x()) {
+    const double side = std::max(48.0, 1.6 * (hi - lo).maxCoeff());
+    w.x0 = 0.5 * (lo.x() + hi.x()) - 0.5 * side;
+    w.y0 = 0.5 * (lo.y() + hi.y()) - 0.5 * side;
+    w.scale = tw / side;
+  } else {
+    w.scale = std::min(static_cast<double>(tw) / image.width,
+                       static_cast<double>(th) / image.height);
+  }
+  return w;
 }
 
-void DrawLine(ImageU8* img, double x0, double y0, double x1, double y1,
-              const uint8_t* c) {
-  const int steps = static_cast<int>(std::max(std::abs(x1 - x0), std::abs(y1 - y0))) + 1;
-  for (int i = 0; i <= steps; ++i) {
-    const double t = static_cast<double>(i) / steps;
-    PutPixel(img, static_cast<int>(std::lround(x0 + t * (x1 - x0))),
-             static_cast<int>(std::lround(y0 + t * (y1 - y0))), c);
+// Nearest-neighbour sampling of the window; outside the image stays dark. `source`
+// gets the image pixel index per tile pixel (-1 outside).
+ImageU8 SampleTile(const ImageU8& image, const TileWindow& w, int tw, int th,
+                   std::vector<int>* source) {
+  ImageU8 tile(tw, th, 3, 0);
+  source->assign(static_cast<size_t>(tw) * th, -1);
+  for (int y = 0; y < th; ++y) {
+    for (int x = 0; x < tw; ++x) {
+      const int sx = static_cast<int>(std::floor(w.x0 + (x + 0.5) / w.scale + 0.5));
+      const int sy = static_cast<int>(std::floor(w.y0 + (y + 0.5) / w.scale + 0.5));
+      if (!image.Contains(sx, sy)) continue;
+      (*source)[y * tw + x] = sy * image.width + sx;
+      for (int k = 0; k < 3; ++k) tile.at(x, y, k) = image.at(sx, sy, k);
+    }
+  }
+  return tile;
+}
+
+// Paints tile pixels whose mask value differs from a neighbour's.
+void DrawMaskOutline(const ImageU8& mask, const std::vector<int>& source, ImageU8* tile) {
+  const Rgb outline = {0, 255, 80};
+  auto on = [&](int x, int y) {
+    const int i = source[y * tile->width + x];
+    return i >= 0 && mask.data[i] != 0;
+  };
+  for (int y = 1; y + 1 < tile->height; ++y) {
+    for (int x = 1; x + 1 < tile->width; ++x) {
+      if (OnMaskOutline(on, x, y)) SetPixel(tile, x, y, outline);
+    }
   }
 }
 
-void DrawDot(ImageU8* img, double x, double y, int r, const uint8_t* c, bool filled) {
-  for (int dy = -r; dy <= r; ++dy) {
-    for (int dx = -r; dx <= r; ++dx) {
-      const int d2 = dx * dx + dy * dy;
-      if (d2 > r * r || (!filled && d2 < (r - 1) * (r - 1))) continue;
-      PutPixel(img, static_cast<int>(std::lround(x)) + dx,
-               static_cast<int>(std::lround(y)) + dy, c);
+// The sheets' line: one sample more than DrawLine's when the extent is a whole number
+// of pixels (kept so that sheets stay as they were).
+void SheetLine(ImageU8* tile, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+               const Rgb& color) {
+  const double extent = std::max(std::abs(b.x() - a.x()), std::abs(b.y() - a.y()));
+  DrawLineSamples(tile, a, b, static_cast<int>(extent) + 1, color);
+}
+
+// Skeleton, then keypoints: visible filled, occluded hollow, out of frame left out.
+void DrawKeypoints(const ViewKeypoints& v, const TileWindow& w, ImageU8* tile) {
+  auto at = [&](int k) { return w.ToTile(v.keypoints.uv_px(k, 0), v.keypoints.uv_px(k, 1)); };
+  for (int k = 1; k < kNumHandKeypoints; ++k) {
+    const int parent = kSnapParents[k];
+    if (v.visibility[parent] == 0 || v.visibility[k] == 0) continue;
+    SheetLine(tile, at(parent), at(k), SnapKeypointColor(k));
+  }
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (v.visibility[k] == 0) continue;
+    if (v.visibility[k] == 2) {
+      DrawDisc(tile, at(k), 3, SnapKeypointColor(k));
+    } else {
+      DrawRing(tile, at(k), 3, SnapKeypointColor(k));
     }
+  }
+}
+
+// A white cross per detected keypoint.
+void DrawDetections(const ViewKeypoints& d, const TileWindow& w, ImageU8* tile) {
+  const Rgb white = {255, 255, 255};
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (!(d.keypoints.confidence[k] > 0)) continue;
+    const Eigen::Vector2d p = w.ToTile(d.keypoints.uv_px(k, 0), d.keypoints.uv_px(k, 1));
+    SheetLine(tile, p + Eigen::Vector2d(-3, -3), p + Eigen::Vector2d(3, 3), white);
+    SheetLine(tile, p + Eigen::Vector2d(-3, 3), p + Eigen::Vector2d(3, -3), white);
   }
 }
 
@@ -68,8 +140,7 @@ ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
   const int tw = o.tile_width;
   const int th = o.crop_to_hand ? tw : static_cast<int>(std::lround(tw * aspect));
   const int cols = std::min(o.columns, n), rows = (n + cols - 1) / cols;
-  const int gap = 4;
-  ImageU8 sheet(cols * tw + (cols + 1) * gap, rows * th + (rows + 1) * gap, 3, 30);
+  ImageU8 sheet(cols * tw + (cols + 1) * kGap, rows * th + (rows + 1) * kGap, 3, 30);
   const bool has_kp = o.keypoints && capture.Has(kFileKeypoints);
   const std::vector<ViewKeypoints> kps = has_kp || o.crop_to_hand
                                              ? capture.ReadKeypoints(frame)
@@ -77,85 +148,17 @@ ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
   const bool has_det = o.detections && capture.Has(kFileDetections);
   const std::vector<ViewKeypoints> dets =
       has_det ? capture.ReadDetections(frame) : std::vector<ViewKeypoints>();
-  const uint8_t outline[3] = {0, 255, 80};
+  const bool masked = o.mask_overlay && capture.Has(kFileMask);
   for (int c = 0; c < n; ++c) {
     const ImageU8 image = capture.ReadImage(frame, c);
-    const bool masked = o.mask_overlay && capture.Has(kFileMask);
-    const ImageU8 mask = masked ? capture.ReadMask(frame, c) : ImageU8();
-    // Source window: origin (x0, y0) and scale s (tile pixels per image pixel).
-    double x0 = -0.5, y0 = -0.5, s = static_cast<double>(tw) / image.width;
-    if (o.crop_to_hand) {
-      Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
-      for (int k = 0; k < kNumHandKeypoints; ++k) {
-        if (kps[c].visibility[k] == 0) continue;
-        lo = lo.cwiseMin(kps[c].keypoints.uv_px.row(k).transpose());
-        hi = hi.cwiseMax(kps[c].keypoints.uv_px.row(k).transpose());
-      }
-      if (lo.x() <= hi.x()) {
-        const double side = std::max(48.0, 1.6 * (hi - lo).maxCoeff());
-        x0 = 0.5 * (lo.x() + hi.x()) - 0.5 * side;
-        y0 = 0.5 * (lo.y() + hi.y()) - 0.5 * side;
-        s = tw / side;
-      } else {
-        s = std::min(static_cast<double>(tw) / image.width,
-                     static_cast<double>(th) / image.height);
-      }
-    }
-    const int ox = gap + (c % cols) * (tw + gap), oy = gap + (c / cols) * (th + gap);
-    // Nearest-neighbour sampling of the window; outside the image stays dark.
-    ImageU8 tile(tw, th, 3, 0);
-    std::vector<int> src(static_cast<size_t>(tw) * th,
-                         -1);  // source pixel per tile pixel
-    for (int y = 0; y < th; ++y) {
-      for (int x = 0; x < tw; ++x) {
-        const int sx = static_cast<int>(std::floor(x0 + (x + 0.5) / s + 0.5));
-        const int sy = static_cast<int>(std::floor(y0 + (y + 0.5) / s + 0.5));
-        if (!image.Contains(sx, sy)) continue;
-        src[y * tw + x] = sy * image.width + sx;
-        for (int k = 0; k < 3; ++k) tile.at(x, y, k) = image.at(sx, sy, k);
-      }
-    }
-    if (masked) {  // outline: tile pixels whose mask value differs from a neighbour's
-      auto on = [&](int x, int y) {
-        const int i = src[y * tw + x];
-        return i >= 0 && mask.data[i] != 0;
-      };
-      for (int y = 1; y + 1 < th; ++y) {
-        for (int x = 1; x + 1 < tw; ++x) {
-          if (OnMaskOutline(on, x, y)) PutPixel(&tile, x, y, outline);
-        }
-      }
-    }
-    auto px = [&](double u) { return (u - x0) * s - 0.5; };
-    auto py = [&](double v) { return (v - y0) * s - 0.5; };
-    if (has_kp) {
-      const ViewKeypoints& v = kps[c];
-      for (const auto& bone : kBones) {
-        const int a = bone[0], b = bone[1];
-        if (v.visibility[a] == 0 || v.visibility[b] == 0) continue;
-        DrawLine(&tile, px(v.keypoints.uv_px(a, 0)), py(v.keypoints.uv_px(a, 1)),
-                 px(v.keypoints.uv_px(b, 0)), py(v.keypoints.uv_px(b, 1)),
-                 kFingerColors[FingerOf(b)]);
-      }
-      for (int k = 0; k < kNumHandKeypoints; ++k) {
-        if (v.visibility[k] == 0) continue;
-        DrawDot(&tile, px(v.keypoints.uv_px(k, 0)), py(v.keypoints.uv_px(k, 1)), 3,
-                kFingerColors[FingerOf(k)], v.visibility[k] == 2);
-      }
-    }
-    if (has_det) {
-      const uint8_t white[3] = {255, 255, 255};
-      const ViewKeypoints& d = dets[c];
-      for (int k = 0; k < kNumHandKeypoints; ++k) {
-        if (!(d.keypoints.confidence[k] > 0)) continue;
-        const double x = px(d.keypoints.uv_px(k, 0)), y = py(d.keypoints.uv_px(k, 1));
-        DrawLine(&tile, x - 3, y - 3, x + 3, y + 3, white);
-        DrawLine(&tile, x - 3, y + 3, x + 3, y - 3, white);
-      }
-    }
-    for (int y = 0; y < th; ++y)
-      for (int x = 0; x < tw; ++x)
-        for (int k = 0; k < 3; ++k) sheet.at(ox + x, oy + y, k) = tile.at(x, y, k);
+    const TileWindow window =
+        ChooseWindow(image, o.crop_to_hand ? &kps[c] : nullptr, tw, th);
+    std::vector<int> source;
+    ImageU8 tile = SampleTile(image, window, tw, th, &source);
+    if (masked) DrawMaskOutline(capture.ReadMask(frame, c), source, &tile);
+    if (has_kp) DrawKeypoints(kps[c], window, &tile);
+    if (has_det) DrawDetections(dets[c], window, &tile);
+    Paste(tile, kGap + (c % cols) * (tw + kGap), kGap + (c / cols) * (th + kGap), &sheet);
   }
   return sheet;
 }

@@ -12,10 +12,11 @@
 #include "calib/colmap_model.h"
 #include "calib/colmap_rig.h"
 #include "calib/rig_json.h"
-#include "core/errors.h"
-#include "core/atomic_file.h"
-#include "core/version.h"
 #include "capture/capture_format.h"
+#include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/random.h"
+#include "core/version.h"
 
 namespace handlabel {
 namespace {
@@ -23,13 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 
 enum Stream : uint64_t { kSceneStream = 1, kBackgroundStream = 2, kDetectionStream = 3 };
-
-uint64_t SplitMix64(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
 
 // Frame files are plain writes (no fsync): the manifest, written atomically last,
 // is what marks a capture complete.
@@ -66,10 +60,6 @@ void SynthCaptureOptions::Check() const {
     throw InputError("synth options", "png.compression_level", "0..9",
                      std::to_string(png.compression_level));
   }
-}
-
-uint64_t MixSeed(uint64_t seed, uint64_t frame, uint64_t stream) {
-  return SplitMix64(SplitMix64(SplitMix64(seed) ^ frame) ^ stream);
 }
 
 SynthGenerator::SynthGenerator(const HandModel& model, Rig rig,
@@ -150,14 +140,11 @@ nlohmann::json SynthOptionsToJson(const SynthCaptureOptions& o) {
   return j;
 }
 
-SynthCaptureSummary WriteSynthCapture(const HandModel& model,
-                                      const SynthCaptureOptions& options,
-                                      const std::string& out_dir,
-                                      const std::string& hand_model_source,
-                                      bool overwrite,
-                                      const std::function<void(int, int)>& progress) {
-  const auto start = std::chrono::steady_clock::now();
-  options.Check();
+namespace {
+
+// Refuses a file, or a folder holding a capture unless `overwrite`; removes the old
+// manifest, which must not describe half-rewritten frames.
+void PrepareOutputFolder(const std::string& out_dir, bool overwrite) {
   const fs::path root(out_dir);
   const fs::path manifest_path = root / kCaptureManifestFile;
   if (fs::exists(root) && !fs::is_directory(root)) {
@@ -168,13 +155,11 @@ SynthCaptureSummary WriteSynthCapture(const HandModel& model,
     throw InputError(out_dir, "--out", "a folder without a capture (or --overwrite)",
                      "it already holds " + std::string(kCaptureManifestFile));
   }
-  // A stale manifest must not describe half-rewritten frames.
   if (fs::exists(manifest_path)) fs::remove(manifest_path);
+}
 
-  const SynthGenerator generator(model, MakePresetRig(options.rig, options.seed),
-                                 options);
-  const Rig& rig = generator.rig();
-
+CaptureManifest MakeManifest(const HandModel& model, const SynthCaptureOptions& options,
+                             const Rig& rig, const std::string& hand_model_source) {
   CaptureManifest manifest;
   manifest.colmap_dir = "colmap";
   manifest.world = "table frame: z up, origin at the workspace centre, metres";
@@ -198,8 +183,12 @@ SynthCaptureSummary WriteSynthCapture(const HandModel& model,
       {"seed", options.seed},
       {"hand_model", {{"name", model.name}, {"source", hand_model_source}}},
       {"settings", SynthOptionsToJson(options)}};
+  return manifest;
+}
 
-  // Folders first, so that worker threads only write files.
+// Folders first, so that worker threads only write files; then the rig files.
+void WriteCaptureFolders(const fs::path& root, const CaptureManifest& manifest,
+                         const Rig& rig) {
   fs::create_directories(root / manifest.colmap_dir);
   for (const auto& [kind, pattern] : manifest.files) {
     for (const std::string& cam : manifest.cameras) {
@@ -210,68 +199,96 @@ SynthCaptureSummary WriteSynthCapture(const HandModel& model,
   info.world = manifest.world;
   WriteRigJson(rig, (root / manifest.rig_file).string(), info);
   WriteColmapText(ColmapFromRig(rig), (root / manifest.colmap_dir).string());
+}
+
+// Writes every file of frame f; returns its views counted as visible, occluded and
+// out of frame. Thread-safe for different frames.
+std::array<int, 3> WriteFrameFiles(const SynthGenerator& generator,
+                                   const CaptureManifest& manifest, const fs::path& root,
+                                   const SynthCaptureOptions& options,
+                                   const HandModel& model, int f) {
+  const Rig& rig = generator.rig();
+  const SynthFrame frame = generator.Generate(f);
+  const std::string id = FrameId(f);
+  auto path = [&](const char* kind, const std::string& cam) {
+    return (root / ExpandPattern(manifest.files.at(kind), cam, id)).string();
+  };
+  std::array<int, 3> status_counts{};
+  std::vector<ViewKeypoints> gt2d, det2d;
+  for (size_t c = 0; c < rig.size(); ++c) {
+    const std::string& cam = rig[c].name;
+    const SynthView& view = frame.views[c];
+    WriteFile(path(kFileImage, cam), EncodePng(view.rgb, options.png));
+    WriteFile(path(kFileMask, cam), EncodePng(view.hand_mask, options.png));
+    if (options.scene.objects) {
+      WriteFile(path(kFileObjectMask, cam), EncodePng(view.object_mask, options.png));
+    }
+    if (options.write_depth) {
+      WritePng16(path(kFileDepth, cam), DepthToU16(view.depth, manifest.depth_unit_m),
+                 options.png);
+    }
+    ViewKeypoints kp;
+    kp.camera = cam;
+    kp.keypoints.uv_px = view.keypoints;
+    kp.visibility = view.visibility;
+    kp.keypoints.confidence.setOnes();
+    kp.status = view.status;
+    kp.hand_pixels = view.hand_pixels;
+    gt2d.push_back(kp);
+    status_counts[view.status == "visible" ? 0 : view.status == "occluded" ? 1 : 2]++;
+    if (options.write_detections) {
+      const ViewDetections& det = frame.detections[c];
+      WriteFile(path(kFileDetectionMask, cam), EncodePng(det.mask, options.png));
+      ViewKeypoints d;
+      d.camera = cam;
+      d.keypoints = det.keypoints;
+      d.visibility.fill(-1);
+      det2d.push_back(d);
+    }
+  }
+  WriteFile(path(kFileKeypoints, ""), ViewKeypointsToJson(id, gt2d, true).dump() + "\n");
+  if (options.write_detections) {
+    WriteFile(path(kFileDetections, ""),
+              ViewKeypointsToJson(id, det2d, false).dump() + "\n");
+  }
+  HandGroundTruth gt;
+  gt.hand_model = model.name;
+  gt.side = manifest.hand_side;
+  gt.pose_kind = frame.scene.pose_kind;
+  gt.params = frame.scene.params;
+  gt.keypoints = frame.scene.hand.keypoints;
+  gt.joints = frame.scene.hand.joints;
+  gt.vertices = frame.scene.hand.vertices;
+  for (const SynthObject& o : frame.scene.objects) {
+    gt.objects.push_back({o.kind, o.size, o.world_from_object});
+  }
+  WriteFile(path(kFileGroundTruth, ""), GroundTruthToJson(id, gt).dump() + "\n");
+  return status_counts;
+}
+
+}  // namespace
+
+SynthCaptureSummary WriteSynthCapture(const HandModel& model,
+                                      const SynthCaptureOptions& options,
+                                      const std::string& out_dir,
+                                      const std::string& hand_model_source,
+                                      bool overwrite,
+                                      const std::function<void(int, int)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  options.Check();
+  PrepareOutputFolder(out_dir, overwrite);
+  const fs::path root(out_dir);
+  const SynthGenerator generator(model, MakePresetRig(options.rig, options.seed),
+                                 options);
+  const Rig& rig = generator.rig();
+  const CaptureManifest manifest = MakeManifest(model, options, rig, hand_model_source);
+  WriteCaptureFolders(root, manifest, rig);
 
   std::atomic<int> done{0};
   std::mutex progress_mutex;
   std::vector<std::array<int, 3>> status_counts(options.num_frames);
   auto write_frame = [&](int f) {
-    const SynthFrame frame = generator.Generate(f);
-    const std::string id = FrameId(f);
-    auto path = [&](const char* kind, const std::string& cam) {
-      return (root / ExpandPattern(manifest.files.at(kind), cam, id)).string();
-    };
-    std::vector<ViewKeypoints> gt2d, det2d;
-    for (size_t c = 0; c < rig.size(); ++c) {
-      const std::string& cam = rig[c].name;
-      const SynthView& view = frame.views[c];
-      WriteFile(path(kFileImage, cam), EncodePng(view.rgb, options.png));
-      WriteFile(path(kFileMask, cam), EncodePng(view.hand_mask, options.png));
-      if (options.scene.objects) {
-        WriteFile(path(kFileObjectMask, cam), EncodePng(view.object_mask, options.png));
-      }
-      if (options.write_depth) {
-        WritePng16(path(kFileDepth, cam), DepthToU16(view.depth, manifest.depth_unit_m),
-                   options.png);
-      }
-      ViewKeypoints kp;
-      kp.camera = cam;
-      kp.keypoints.uv_px = view.keypoints;
-      kp.visibility = view.visibility;
-      kp.keypoints.confidence.setOnes();
-      kp.status = view.status;
-      kp.hand_pixels = view.hand_pixels;
-      gt2d.push_back(kp);
-      status_counts[f][view.status == "visible"    ? 0
-                       : view.status == "occluded" ? 1
-                                                   : 2]++;
-      if (options.write_detections) {
-        const ViewDetections& det = frame.detections[c];
-        WriteFile(path(kFileDetectionMask, cam), EncodePng(det.mask, options.png));
-        ViewKeypoints d;
-        d.camera = cam;
-        d.keypoints = det.keypoints;
-        d.visibility.fill(-1);
-        det2d.push_back(d);
-      }
-    }
-    WriteFile(path(kFileKeypoints, ""),
-              ViewKeypointsToJson(id, gt2d, true).dump() + "\n");
-    if (options.write_detections) {
-      WriteFile(path(kFileDetections, ""),
-                ViewKeypointsToJson(id, det2d, false).dump() + "\n");
-    }
-    HandGroundTruth gt;
-    gt.hand_model = model.name;
-    gt.side = manifest.hand_side;
-    gt.pose_kind = frame.scene.pose_kind;
-    gt.params = frame.scene.params;
-    gt.keypoints = frame.scene.hand.keypoints;
-    gt.joints = frame.scene.hand.joints;
-    gt.vertices = frame.scene.hand.vertices;
-    for (const SynthObject& o : frame.scene.objects) {
-      gt.objects.push_back({o.kind, o.size, o.world_from_object});
-    }
-    WriteFile(path(kFileGroundTruth, ""), GroundTruthToJson(id, gt).dump() + "\n");
+    status_counts[f] = WriteFrameFiles(generator, manifest, root, options, model, f);
     const int n = ++done;
     if (progress) {
       std::lock_guard<std::mutex> lock(progress_mutex);
@@ -286,7 +303,9 @@ SynthCaptureSummary WriteSynthCapture(const HandModel& model,
     run();
   }
 
-  WriteFileAtomically(manifest_path.string(), ManifestToJson(manifest).dump(2) + "\n");
+  // Written atomically and last: its presence marks the capture complete.
+  WriteFileAtomically((root / kCaptureManifestFile).string(),
+                      ManifestToJson(manifest).dump(2) + "\n");
   SynthCaptureSummary summary;
   summary.frames = options.num_frames;
   summary.views = options.num_frames * static_cast<int>(rig.size());

@@ -69,10 +69,6 @@ class SynthGenerator {
   std::vector<PixelRays> rays_;
 };
 
-// Random stream for one purpose of one frame: seeds are mixed with SplitMix64 so
-// neighbouring seeds and frames give unrelated streams.
-uint64_t MixSeed(uint64_t seed, uint64_t frame, uint64_t stream);
-
 struct SynthCaptureSummary {
   int frames = 0;
   int views = 0;

@@ -1,7 +1,7 @@
 #pragma once
 // Line plots drawn in software on core/image (no plotting library, no Python): axes with
-// tick labels in a built-in 5x7 pixel font, one polyline per series, a legend.
-// Used for training curves (loss.png) and PCK curves.
+// tick labels in the built-in 5x7 pixel font (core/draw.h), one polyline per series, a
+// legend. Used for training curves (loss.png) and PCK curves.
 
 #include <array>
 #include <cstdint>
@@ -33,11 +33,6 @@ struct PlotOptions {
 
 // RGB image of the plot.
 ImageU8 DrawLinePlot(const std::vector<PlotSeries>& series, const PlotOptions& options);
-
-// Draws `text` (ASCII; lower case is drawn as upper case) with its top-left corner at
-// (x, y), each font pixel `scale` x `scale`.
-void DrawText(ImageU8* image, int x, int y, const std::string& text,
-              const std::array<uint8_t, 3>& color, int scale = 1);
 
 // Images one above the other (RGB, same width; narrower ones are padded white).
 ImageU8 StackVertically(const std::vector<ImageU8>& images);

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/line_plot.h"
 
@@ -94,8 +95,7 @@ void DrawTrainingCurves(const std::string& run_dir, const std::string& png_path)
       DrawTrainingCurves(ReadCsvTable((dir / "loss.csv").string()),
                          ReadCsvTable((dir / "validation.csv").string()));
   const std::string out = png_path.empty() ? (dir / "loss.png").string() : png_path;
-  WritePng(out + ".tmp.png", image);
-  std::filesystem::rename(out + ".tmp.png", out);
+  WriteFileAtomically(out, EncodePng(image));  // a viewer never sees half a PNG
 }
 
 }  // namespace handlabel

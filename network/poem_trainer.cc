@@ -15,8 +15,10 @@
 #include <sstream>
 #include <thread>
 
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/metrics.h"
+#include "core/random.h"
 #include "network/poem_batch_norm_update.h"
 #include "network/poem_checkpoint.h"
 #include "network/poem_training_batch.h"
@@ -26,24 +28,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-uint64_t Mix(uint64_t x) {  // SplitMix64
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
-void WriteTextAtomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) throw Error("cannot write " + tmp);
-  }
-  fs::rename(tmp, path);
-}
 
 std::string ReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -81,7 +65,7 @@ void TruncateCsv(const std::string& path, int64_t step) {
     if (header || std::stoll(line.substr(0, line.find(','))) <= step) out += line + "\n";
     header = false;
   }
-  WriteTextAtomic(path, out);
+  WriteFileAtomically(path, out);
 }
 
 void AppendLine(const std::string& path, const std::string& header,
@@ -92,6 +76,13 @@ void AppendLine(const std::string& path, const std::string& header,
   out << line << "\n";
   if (!out) throw Error("cannot append to " + path);
 }
+
+// When training started and how many steps ran since the last log line.
+struct StepClock {
+  Clock::time_point start = Clock::now();
+  Clock::time_point window_start = start;
+  int64_t window_steps = 0;
+};
 
 // Makes the batches of steps [first, last) on a background thread, in order.
 class BatchProducer {
@@ -292,7 +283,7 @@ struct PoemTrainer::State {
     latest["seed"] = options.seed;
     latest["batch_size"] = options.batch_size;
     latest["steps"] = options.steps;
-    WriteTextAtomic(Path("latest.json"), latest.dump(2) + "\n");
+    WriteFileAtomically(Path("latest.json"), latest.dump(2) + "\n");
     // Drop old checkpoints beyond keep_checkpoints, but the weights at keep_every.
     std::vector<std::string> stems;
     for (const auto& e : fs::directory_iterator(Path("checkpoints"))) {
@@ -312,6 +303,115 @@ struct PoemTrainer::State {
       }
       fs::remove(Path("checkpoints/" + stems[i] + ".optim"));
     }
+  }
+
+  // The step training starts from: the run's latest checkpoint when resuming, else
+  // init_weights at init_step, else 0. Drops log rows written after that step.
+  int64_t StartStep(bool resume) {
+    const bool has_run = fs::exists(Path("latest.json"));
+    if (has_run && !resume) {
+      throw InputError(options.out_dir, "run folder", "an empty folder (or --resume)",
+                       "it already holds a run (latest.json)");
+    }
+    int64_t step = 0;
+    if (has_run) {
+      step = LoadLatest();
+    } else if (!options.init_weights.empty()) {
+      LoadPoemCheckpointInto(model, options.init_weights, /*mask_head_may_differ=*/true);
+      step = options.init_step;
+    }
+    TruncateCsv(Path("loss.csv"), step);
+    TruncateCsv(Path("validation.csv"), step);
+    return step;
+  }
+
+  // One optimiser step on `samples` with learning rate `lr`. Torch's random state is
+  // reseeded from (seed, step) so a resumed run repeats the same dropout and noise.
+  TrainStepResult TrainOneStep(const std::vector<TrainingSample>& samples, int64_t step,
+                               double lr) {
+    const PoemTrainingBatch tb = ToPoemTrainingBatch(samples);
+    torch::manual_seed(
+        SplitMix64(options.seed ^ SplitMix64(static_cast<uint64_t>(step))));
+    SetLearningRate(lr);
+    TrainStepOptions step_options;
+    step_options.grad_clip_norm = options.grad_clip_norm;
+    const TrainStepResult r =
+        options.mask_head_only
+            ? TrainMaskHeadStep(model, *optimizer, tb.batch, tb.targets, step_options)
+            : TrainStep(model, *optimizer, tb.batch, tb.targets, regressor, loss,
+                        step_options);
+    if (!std::isfinite(r.total)) {
+      throw Error("training diverged at step " + std::to_string(step) +
+                  " (loss not finite); resume from the last checkpoint with a lower "
+                  "learning_rate");
+    }
+    return r;
+  }
+
+  // Appends a row to loss.csv and reports a progress line (rate over the steps since
+  // the last log, ETA to `end`); restarts the clock's window.
+  void LogStep(int64_t step, int64_t end, double lr, const TrainStepResult& r,
+               StepClock* clock) {
+    const auto now = Clock::now();
+    const double window =
+        std::chrono::duration<double>(now - clock->window_start).count();
+    const double per_step = window / std::max<int64_t>(1, clock->window_steps);
+    const double rate = options.batch_size / std::max(per_step, 1e-9);
+    const double wall = std::chrono::duration<double>(now - clock->start).count();
+    std::ostringstream header, row, line;
+    header << "step,lr,total";
+    row << step << "," << lr << "," << r.total;
+    line << "step " << step << "/" << options.steps;
+    if (end < options.steps) line << " (stop at " << end << ")";
+    line << " loss " << r.total;
+    for (const auto& [name, value] : r.terms) {
+      header << "," << name;
+      row << "," << value;
+    }
+    for (const auto& [name, value] : r.terms) {
+      if (name == "heatmap_joints" || name == "triangulated_joints" ||
+          name == "joints_3d" || name == "vertices_3d" || name == "masks") {
+        line << " " << name << " " << value;
+      }
+    }
+    header << ",samples_per_s,wall_s";
+    row << "," << rate << "," << wall;
+    char rate_text[64];
+    std::snprintf(rate_text, sizeof(rate_text), " | %.2f samples/s lr %.2g ETA ", rate,
+                  lr);
+    line << rate_text << Duration(per_step * (end - step));
+    AppendLine(Path("loss.csv"), header.str(), row.str());
+    if (hooks.progress) hooks.progress(line.str());
+    clock->window_start = now;
+    clock->window_steps = 0;
+  }
+
+  // Validates on the held-out samples, appends a row to validation.csv and reports it.
+  PoemValidation ValidateAndLog(int64_t step) {
+    PoemValidation v =
+        ValidatePoem(model, *validation, options.validation_samples, options.batch_size);
+    v.step = step;
+    std::ostringstream row;
+    std::string header = "step,mpjpe_mm,mpvpe_mm,samples";
+    row << step << "," << v.mpjpe_mm << "," << v.mpvpe_mm << "," << v.samples;
+    if (config.mask_head) {
+      header += ",mask_iou";
+      row << "," << v.mask_iou;
+    }
+    AppendLine(Path("validation.csv"), header, row.str());
+    if (hooks.progress) {
+      char text[160];
+      std::snprintf(text, sizeof(text),
+                    "validation at step %lld: MPJPE %.2f mm, MPVPE %.2f mm (%d samples)",
+                    static_cast<long long>(step), v.mpjpe_mm, v.mpvpe_mm, v.samples);
+      std::string line = text;
+      if (v.mask_iou >= 0) {
+        std::snprintf(text, sizeof(text), ", mask IoU %.3f", v.mask_iou);
+        line += text;
+      }
+      hooks.progress(line);
+    }
+    return v;
   }
 
   int64_t LoadLatest() {
@@ -375,114 +475,29 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
   torch::set_num_threads(o.threads);
   fs::create_directories(o.out_dir);
   PoemTrainSummary summary;
-  const bool has_run = fs::exists(s.Path("latest.json"));
-  if (has_run && !resume) {
-    throw InputError(o.out_dir, "run folder", "an empty folder (or --resume)",
-                     "it already holds a run (latest.json)");
-  }
-  int64_t step = 0;
-  if (has_run) {
-    step = s.LoadLatest();
-  } else if (!o.init_weights.empty()) {
-    LoadPoemCheckpointInto(s.model, o.init_weights, /*mask_head_may_differ=*/true);
-    step = o.init_step;
-  }
+  int64_t step = s.StartStep(resume);
   summary.start_step = step;
-  TruncateCsv(s.Path("loss.csv"), step);
-  TruncateCsv(s.Path("validation.csv"), step);
-
   const int64_t end =
       stop_at_step >= 0 ? std::min<int64_t>(stop_at_step, o.steps) : o.steps;
-  const auto start_time = Clock::now();
-  auto window_start = start_time;
-  int64_t window_steps = 0;
+  StepClock clock;
   double last_loss = 0;
   {
     BatchProducer producer(s.train, o.batch_size, step, end, o.prefetch_batches);
     while (step < end) {
       const std::vector<TrainingSample> samples = producer.Next();
-      const PoemTrainingBatch tb = ToPoemTrainingBatch(samples);
-      torch::manual_seed(Mix(o.seed ^ Mix(static_cast<uint64_t>(step))));
       const double lr = PoemLearningRate(o, step);
-      s.SetLearningRate(lr);
-      TrainStepOptions step_options;
-      step_options.grad_clip_norm = o.grad_clip_norm;
-      const TrainStepResult r =
-          o.mask_head_only ? TrainMaskHeadStep(s.model, *s.optimizer, tb.batch,
-                                               tb.targets, step_options)
-                           : TrainStep(s.model, *s.optimizer, tb.batch, tb.targets,
-                                       s.regressor, s.loss, step_options);
-      if (!std::isfinite(r.total)) {
-        throw Error("training diverged at step " + std::to_string(step) +
-                    " (loss not finite); resume from the last checkpoint with a lower "
-                    "learning_rate");
-      }
+      const TrainStepResult r = s.TrainOneStep(samples, step, lr);
       last_loss = r.total;
       ++step;
-      ++window_steps;
-
+      ++clock.window_steps;
       bool wrote_logs = false;
       if (step % o.log_every == 0 || step == end) {
-        const auto now = Clock::now();
-        const double window = std::chrono::duration<double>(now - window_start).count();
-        const double per_step = window / std::max<int64_t>(1, window_steps);
-        const double rate = o.batch_size / std::max(per_step, 1e-9);
-        const double wall = std::chrono::duration<double>(now - start_time).count();
-        std::ostringstream header, row, line;
-        header << "step,lr,total";
-        row << step << "," << lr << "," << r.total;
-        line << "step " << step << "/" << o.steps;
-        if (end < o.steps) line << " (stop at " << end << ")";
-        line << " loss " << r.total;
-        for (const auto& [name, value] : r.terms) {
-          header << "," << name;
-          row << "," << value;
-        }
-        for (const auto& [name, value] : r.terms) {
-          if (name == "heatmap_joints" || name == "triangulated_joints" ||
-              name == "joints_3d" || name == "vertices_3d" || name == "masks") {
-            line << " " << name << " " << value;
-          }
-        }
-        header << ",samples_per_s,wall_s";
-        row << "," << rate << "," << wall;
-        char rate_text[64];
-        std::snprintf(rate_text, sizeof(rate_text), " | %.2f samples/s lr %.2g ETA ",
-                      rate, lr);
-        line << rate_text << Duration(per_step * (end - step));
-        AppendLine(s.Path("loss.csv"), header.str(), row.str());
-        if (s.hooks.progress) s.hooks.progress(line.str());
-        window_start = now;
-        window_steps = 0;
+        s.LogStep(step, end, lr, r, &clock);
         wrote_logs = true;
       }
       if (s.validation && o.validate_every > 0 && o.validation_samples > 0 &&
           (step % o.validate_every == 0 || step == o.steps)) {
-        PoemValidation v =
-            ValidatePoem(s.model, *s.validation, o.validation_samples, o.batch_size);
-        v.step = step;
-        summary.last_validation = v;
-        std::ostringstream row;
-        std::string header = "step,mpjpe_mm,mpvpe_mm,samples";
-        row << step << "," << v.mpjpe_mm << "," << v.mpvpe_mm << "," << v.samples;
-        if (s.config.mask_head) {
-          header += ",mask_iou";
-          row << "," << v.mask_iou;
-        }
-        AppendLine(s.Path("validation.csv"), header, row.str());
-        if (s.hooks.progress) {
-          char text[160];
-          std::snprintf(
-              text, sizeof(text),
-              "validation at step %lld: MPJPE %.2f mm, MPVPE %.2f mm (%d samples)",
-              static_cast<long long>(step), v.mpjpe_mm, v.mpvpe_mm, v.samples);
-          std::string line = text;
-          if (v.mask_iou >= 0) {
-            std::snprintf(text, sizeof(text), ", mask IoU %.3f", v.mask_iou);
-            line += text;
-          }
-          s.hooks.progress(line);
-        }
+        summary.last_validation = s.ValidateAndLog(step);
         wrote_logs = true;
       }
       if (step % o.checkpoint_every == 0 || step == end) s.SaveCheckpoint(step);
@@ -491,7 +506,7 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
   }
   summary.end_step = step;
   summary.last_loss = last_loss;
-  summary.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
+  summary.seconds = std::chrono::duration<double>(Clock::now() - clock.start).count();
   return summary;
 }
 

@@ -2,50 +2,14 @@
 
 #include <cmath>
 
+#include "core/atomic_file.h"
+#include "core/draw.h"
+#include "core/hand_skeleton.h"
 #include "core/image_file.h"
 #include "core/rasterizer.h"
-#include "core/atomic_file.h"
 #include "pipeline/label_outputs.h"
 
 namespace handlabel {
-namespace {
-
-// SNAP parent of each keypoint (-1: wrist) and finger of each keypoint (0 = wrist).
-constexpr int kSnapParent[kNumHandKeypoints] = {-1, 0,  1, 2,  3,  0,  5, 6,  7,  0, 9,
-                                                10, 11, 0, 13, 14, 15, 0, 17, 18, 19};
-const uint8_t kFingerColor[6][3] = {{255, 255, 255}, {255, 80, 80},  {255, 200, 40},
-                                    {80, 220, 80},   {60, 160, 255}, {220, 90, 255}};
-
-int Finger(int k) { return k == 0 ? 0 : 1 + (k - 1) / 4; }
-
-void PutPixel(int x, int y, const uint8_t* color, ImageU8* rgb) {
-  if (!rgb->Contains(x, y)) return;
-  for (int c = 0; c < 3; ++c) rgb->at(x, y, c) = color[c];
-}
-
-void DrawDisc(const Eigen::Vector2d& center, double radius, const uint8_t* color,
-              ImageU8* rgb) {
-  const int r = static_cast<int>(std::ceil(radius));
-  const int cx = static_cast<int>(std::lround(center.x()));
-  const int cy = static_cast<int>(std::lround(center.y()));
-  for (int dy = -r; dy <= r; ++dy) {
-    for (int dx = -r; dx <= r; ++dx) {
-      if (dx * dx + dy * dy <= radius * radius) PutPixel(cx + dx, cy + dy, color, rgb);
-    }
-  }
-}
-
-void DrawLine(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double width,
-              const uint8_t* color, ImageU8* rgb) {
-  const double length = (b - a).norm();
-  const int steps = std::max(1, static_cast<int>(std::ceil(length)));
-  if (steps > 4 * (rgb->width + rgb->height)) return;  // far outside: skip
-  for (int i = 0; i <= steps; ++i) {
-    DrawDisc(a + (b - a) * (double(i) / steps), width / 2, color, rgb);
-  }
-}
-
-}  // namespace
 
 void DrawLabelOverlay(const RigCamera& camera, const LabelRecord& label,
                       const Faces& faces, ImageU8* rgb) {
@@ -75,13 +39,13 @@ void DrawLabelOverlay(const RigCamera& camera, const LabelRecord& label,
   }
   const double scale = std::max(1.0, rgb->width / 640.0);
   for (int k = 1; k < kNumHandKeypoints; ++k) {
-    const int parent = kSnapParent[k];
+    const int parent = kSnapParents[k];
     if (in_front[k] && in_front[parent]) {
-      DrawLine(uv[parent], uv[k], 2 * scale, kFingerColor[Finger(k)], rgb);
+      DrawThickLine(rgb, uv[parent], uv[k], 2 * scale, SnapKeypointColor(k));
     }
   }
   for (int k = 0; k < kNumHandKeypoints; ++k) {
-    if (in_front[k]) DrawDisc(uv[k], 3 * scale, kFingerColor[Finger(k)], rgb);
+    if (in_front[k]) DrawDisc(rgb, uv[k], 3 * scale, SnapKeypointColor(k));
   }
 }
 

@@ -1,6 +1,7 @@
 #include "pipeline/label_policy.h"
 
 #include "core/errors.h"
+#include "core/random.h"
 #include "pipeline/frame_metrics.h"
 #include "pipeline/quality_checks.h"
 
@@ -18,12 +19,8 @@ void AddMetrics(const std::string& group, const Points3d& keypoints,
 }  // namespace
 
 uint64_t FrameSeed(uint64_t job_seed, const std::string& frame) {
-  uint64_t h = 1469598103934665603ull;  // FNV-1a of the id, then SplitMix64 finaliser
-  for (unsigned char c : frame) h = (h ^ c) * 1099511628211ull;
-  uint64_t z = job_seed + 0x9e3779b97f4a7c15ull * (h | 1);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
+  // FNV-1a of the id, then the SplitMix64 finaliser.
+  return SplitMix64Finalize(job_seed + kSplitMix64Gamma * (Fnv1a64(frame) | 1));
 }
 
 Points3d NativeJointsFromKeypoints(const Points3d& keypoints) {

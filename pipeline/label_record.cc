@@ -5,8 +5,9 @@
 #include <limits>
 #include <sstream>
 
-#include "core/errors.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/json_util.h"
 
 namespace handlabel {
 namespace {
@@ -15,53 +16,9 @@ using nlohmann::json;
 
 constexpr int kManoBetas = 10;
 
-json Points(const Points3d& points) {
-  json rows = json::array();
-  for (int i = 0; i < points.rows(); ++i) {
-    rows.push_back({points(i, 0), points(i, 1), points(i, 2)});
-  }
-  return rows;
-}
-
-json Vector(const Eigen::VectorXd& v) {
-  json out = json::array();
-  for (int i = 0; i < v.size(); ++i) out.push_back(v[i]);
-  return out;
-}
-
-// JSON has no infinity or NaN; nlohmann writes them as null, read back as NaN.
-double Number(const json& j) {
-  return j.is_null() ? std::numeric_limits<double>::quiet_NaN() : j.get<double>();
-}
-
-Points3d ReadPoints(const json& j, const std::string& source, const char* field,
-                    int expected_rows) {
-  if (!j.is_array() || (expected_rows >= 0 && int(j.size()) != expected_rows)) {
-    throw InputError(source, field,
-                     expected_rows >= 0
-                         ? std::to_string(expected_rows) + " points [x, y, z]"
-                         : "a list of points [x, y, z]");
-  }
-  Points3d points(j.size(), 3);
-  for (size_t i = 0; i < j.size(); ++i) {
-    if (!j[i].is_array() || j[i].size() != 3) {
-      throw InputError(source, std::string(field) + "[" + std::to_string(i) + "]",
-                       "[x, y, z]");
-    }
-    for (int c = 0; c < 3; ++c) points(i, c) = Number(j[i][c]);
-  }
-  return points;
-}
-
-Eigen::VectorXd ReadVector(const json& j, const std::string& source,
-                           const std::string& field, int size) {
-  if (!j.is_array() || (size >= 0 && int(j.size()) != size)) {
-    throw InputError(source, field,
-                     size >= 0 ? std::to_string(size) + " numbers" : "numbers");
-  }
-  Eigen::VectorXd v(j.size());
-  for (size_t i = 0; i < j.size(); ++i) v[i] = Number(j[i]);
-  return v;
+// Quality values may be NaN or infinite (nlohmann writes null): null reads as NaN.
+double Number(const json& j, const std::string& source, const std::string& field) {
+  return JsonNumber(j, source, field, JsonNull::kAsNan);
 }
 
 std::string FormatCoordinate(double value) {
@@ -104,17 +61,16 @@ json LabelToJson(const LabelRecord& label) {
     Eigen::VectorXd betas =
         Eigen::VectorXd::Zero(std::max<int>(kManoBetas, label.params->betas.size()));
     betas.head(label.params->betas.size()) = label.params->betas;
-    j["mano"] = {{"global_orient", Vector(label.params->global_orient)},
-                 {"hand_pose", Vector(label.params->hand_pose)},
-                 {"betas", Vector(betas)},
-                 {"transl", Vector(label.params->transl)}};
+    HandParams padded = *label.params;  // MANO's 10 betas at least
+    padded.betas = betas;
+    j["mano"] = JsonHandParams(padded);
   } else {
     j["mano"] = nullptr;
   }
   j["keypoints_order"] = "snap21";
-  j["keypoints_3d"] = Points(label.mesh.keypoints);
-  j["joints_native"] = Points(label.mesh.joints);
-  j["vertices"] = Points(label.mesh.vertices);
+  j["keypoints_3d"] = JsonPoints(label.mesh.keypoints);
+  j["joints_native"] = JsonPoints(label.mesh.joints);
+  j["vertices"] = JsonPoints(label.mesh.vertices);
   json checks = json::array();
   for (const QualityFlag& f : label.quality.flags) {
     checks.push_back({{"name", f.name},
@@ -153,25 +109,20 @@ LabelRecord LabelFromJson(const json& j, const std::string& source) {
     label.path = ParseLabelPath(j.at("path").get<std::string>(), source);
     const json& mano = j.at("mano");
     if (!mano.is_null()) {
-      HandParams params;
-      params.global_orient =
-          ReadVector(mano.at("global_orient"), source, "mano.global_orient", 3);
-      params.hand_pose =
-          ReadVector(mano.at("hand_pose"), source, "mano.hand_pose", kNumPoseParams);
-      params.betas = ReadVector(mano.at("betas"), source, "mano.betas", -1);
-      params.transl = ReadVector(mano.at("transl"), source, "mano.transl", 3);
-      label.params = params;
+      label.params = HandParamsFromJson(mano, source, "mano.", JsonNull::kAsNan);
     }
-    label.mesh.keypoints =
-        ReadPoints(j.at("keypoints_3d"), source, "keypoints_3d", kNumHandKeypoints);
-    label.mesh.joints =
-        ReadPoints(j.at("joints_native"), source, "joints_native", kNumHandJoints);
-    label.mesh.vertices = ReadPoints(j.at("vertices"), source, "vertices", -1);
+    label.mesh.keypoints = JsonPointList(j.at("keypoints_3d"), source, "keypoints_3d",
+                                         kNumHandKeypoints, JsonNull::kAsNan);
+    label.mesh.joints = JsonPointList(j.at("joints_native"), source, "joints_native",
+                                      kNumHandJoints, JsonNull::kAsNan);
+    label.mesh.vertices =
+        JsonPointList(j.at("vertices"), source, "vertices", -1, JsonNull::kAsNan);
     for (const json& c : j.at("quality").at("checks")) {
-      label.quality.flags.push_back({c.at("name").get<std::string>(),
-                                     c.at("passed").get<bool>(), Number(c.at("value")),
-                                     Number(c.at("threshold")),
-                                     c.at("detail").get<std::string>()});
+      label.quality.flags.push_back(
+          {c.at("name").get<std::string>(), c.at("passed").get<bool>(),
+           Number(c.at("value"), source, "quality.value"),
+           Number(c.at("threshold"), source, "quality.threshold"),
+           c.at("detail").get<std::string>()});
     }
     label.fit = j.at("fit");
     const json& p = j.at("provenance");

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/random.h"
 
 namespace handlabel {
 namespace {

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <iterator>
 
+#include "core/random.h"
 #include "tests/test_util.h"
 
 namespace handlabel::testing {
@@ -31,11 +32,8 @@ uint64_t g_seed = 0;
 
 class SeedPerTest : public ::testing::EmptyTestEventListener {
   void OnTestStart(const ::testing::TestInfo& info) override {
-    // FNV-1a, stable across compilers (std::hash is not).
-    uint64_t h = 1469598103934665603ull;
-    for (const char* s : {info.test_suite_name(), ".", info.name()}) {
-      for (; *s; ++s) h = (h ^ static_cast<unsigned char>(*s)) * 1099511628211ull;
-    }
+    // Stable across compilers (std::hash is not).
+    const uint64_t h = Fnv1a64(std::string(info.test_suite_name()) + "." + info.name());
     g_seed = h;
     g_rng.seed(h);
   }

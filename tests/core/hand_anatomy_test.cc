@@ -2,16 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include "core/capsule_hand.h"
 #include "core/dual.h"
 #include "core/errors.h"
 #include "core/hand_lbs.h"
-#include "tests/core/stick_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
 namespace {
 
-using testing::MakeStickHand;
 using testing::MatrixNear;
 using testing::Uniform;
 
@@ -21,6 +20,13 @@ HandPoseVector AnglesOf(const HandAnatomy& anatomy, const HandPoseVector& pose) 
   HandPoseVector angles;
   HandAnatomicalAngles(anatomy, pose.data(), angles.data());
   return angles;
+}
+
+// Rest position of native joint v (v < 16) or of fingertip v - 16 (thumb, index,
+// middle, ring, pinky).
+Eigen::Vector3d RestPoint(const HandModel& model, int v) {
+  if (v >= kNumHandJoints) return model.v_template.row(model.tip_vertex_ids[v - 16]);
+  return (model.joint_regressor.row(v) * model.v_template).transpose();
 }
 
 HandPoseVector MirrorPose(const HandPoseVector& pose) {
@@ -33,7 +39,7 @@ HandPoseVector MirrorPose(const HandPoseVector& pose) {
 }
 
 TEST(HandAnatomy, FramesAreRotationsAndFollowTheBones) {
-  const HandModel model = MakeStickHand(HandSide::kRight);
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
   const HandAnatomy anatomy = ComputeHandAnatomy(model);
   for (int j = 1; j < kNumHandJoints; ++j) {
     const Eigen::Matrix3d& f = anatomy.frames[j];
@@ -41,15 +47,13 @@ TEST(HandAnatomy, FramesAreRotationsAndFollowTheBones) {
     EXPECT_NEAR(f.determinant(), 1.0, 1e-12) << JointName(j);
     // b points from the child back to the joint.
     const int child = j % 3 == 0 ? -1 : j + 1;
-    const Eigen::Vector3d c = child > 0 ? model.v_template.row(child).transpose()
-                                        : Eigen::Vector3d(model.v_template
-                                                              .row(j == 15   ? 16
-                                                                   : j == 3  ? 17
-                                                                   : j == 6  ? 18
-                                                                   : j == 12 ? 19
-                                                                             : 20)
-                                                              .transpose());
-    const Eigen::Vector3d b = (model.v_template.row(j).transpose() - c).normalized();
+    const Eigen::Vector3d c = child > 0 ? RestPoint(model, child)
+                                        : RestPoint(model, j == 15   ? 16
+                                                           : j == 3  ? 17
+                                                           : j == 6  ? 18
+                                                           : j == 12 ? 19
+                                                                     : 20);
+    const Eigen::Vector3d b = (RestPoint(model, j) - c).normalized();
     EXPECT_THAT(f.col(kTwist), MatrixNear(b, 1e-12)) << JointName(j);
   }
   // Straight index finger along -x: b = +x, u = +y, l = +z.
@@ -60,7 +64,7 @@ TEST(HandAnatomy, FramesAreRotationsAndFollowTheBones) {
 
 TEST(HandAnatomy, RecoversKnownAnglesForEveryJoint) {
   for (HandSide side : {HandSide::kRight, HandSide::kLeft}) {
-    const HandAnatomy anatomy = ComputeHandAnatomy(MakeStickHand(side));
+    const HandAnatomy anatomy = ComputeHandAnatomy(MakeCapsuleHand(side));
     for (int trial = 0; trial < 50; ++trial) {
       HandPoseVector angles;
       for (int i = 0; i < 45; ++i) {
@@ -73,7 +77,7 @@ TEST(HandAnatomy, RecoversKnownAnglesForEveryJoint) {
 }
 
 TEST(HandAnatomy, SingleAxisMotionsOfAStraightFinger) {
-  const HandModel model = MakeStickHand(HandSide::kRight);
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
   const HandAnatomy anatomy = ComputeHandAnatomy(model);
   // Index MCP frame is the identity, so rotations about world x, y, z are pure twist,
   // spread and bend.
@@ -98,8 +102,8 @@ TEST(HandAnatomy, SingleAxisMotionsOfAStraightFinger) {
 }
 
 TEST(HandAnatomy, MirroredLeftHandGivesTheSameAnglesAndMirroredMesh) {
-  const HandModel right = MakeStickHand(HandSide::kRight);
-  const HandModel left = MakeStickHand(HandSide::kLeft);
+  const HandModel right = MakeCapsuleHand(HandSide::kRight);
+  const HandModel left = MakeCapsuleHand(HandSide::kLeft);
   const HandAnatomy right_anatomy = ComputeHandAnatomy(right);
   const HandAnatomy left_anatomy = ComputeHandAnatomy(left);
   for (int trial = 0; trial < 20; ++trial) {
@@ -128,7 +132,7 @@ TEST(HandAnatomy, MirroredLeftHandGivesTheSameAnglesAndMirroredMesh) {
 }
 
 TEST(HandAnatomy, DualDerivativesOfAnglesMatchFiniteDifferences) {
-  const HandAnatomy anatomy = ComputeHandAnatomy(MakeStickHand(HandSide::kLeft));
+  const HandAnatomy anatomy = ComputeHandAnatomy(MakeCapsuleHand(HandSide::kLeft));
   for (int j : {1, 5, 13, 15}) {
     for (double scale : {0.0, 0.6}) {
       const Eigen::Vector3d w = scale * testing::RandomVector3(-1, 1);
@@ -152,7 +156,7 @@ TEST(HandAnatomy, DualDerivativesOfAnglesMatchFiniteDifferences) {
 }
 
 TEST(HandAnatomy, RejectsModelsOutsideMANOLayout) {
-  HandModel model = MakeStickHand(HandSide::kRight);
+  HandModel model = MakeCapsuleHand(HandSide::kRight);
   // Rotate the whole hand so that the fingers point along +y (parallel to "up").
   for (int v = 0; v < model.num_vertices(); ++v) {
     const Eigen::Vector3d p = model.v_template.row(v).transpose();

@@ -2,15 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include "core/capsule_hand.h"
 #include "core/errors.h"
 #include "core/hand_lbs.h"
-#include "tests/core/stick_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
 namespace {
-
-using testing::MakeStickHand;
 
 // Mean distance of the four finger tips (SNAP 8, 12, 16, 20) from the wrist.
 double MeanFingerReach(const HandModel& model, const HandPoseVector& pose) {
@@ -32,7 +30,7 @@ double TipDistance(const HandModel& model, const HandPoseVector& pose, int a, in
 
 TEST(HandPoseSampler, EveryKindStaysWithinLimitsOnBothSides) {
   for (HandSide side : {HandSide::kRight, HandSide::kLeft}) {
-    const HandAnatomy anatomy = ComputeHandAnatomy(MakeStickHand(side));
+    const HandAnatomy anatomy = ComputeHandAnatomy(MakeCapsuleHand(side));
     for (const HandLimits& limits : {DefaultHandLimits(), AnchorHandLimits()}) {
       for (HandPoseKind kind :
            {HandPoseKind::kOpen, HandPoseKind::kFist, HandPoseKind::kPinch,
@@ -55,7 +53,7 @@ TEST(HandPoseSampler, EveryKindStaysWithinLimitsOnBothSides) {
 }
 
 TEST(HandPoseSampler, KindsLookLikeTheirNames) {
-  const HandModel model = MakeStickHand(HandSide::kRight);
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
   const HandAnatomy anatomy = ComputeHandAnatomy(model);
   const HandLimits limits = DefaultHandLimits();
   auto sample = [&](HandPoseKind kind) {
@@ -75,7 +73,7 @@ TEST(HandPoseSampler, KindsLookLikeTheirNames) {
 }
 
 TEST(HandPoseSampler, DrawsKindsByWeightAndChecksOptions) {
-  const HandAnatomy anatomy = ComputeHandAnatomy(MakeStickHand(HandSide::kRight));
+  const HandAnatomy anatomy = ComputeHandAnatomy(MakeCapsuleHand(HandSide::kRight));
   HandPoseSamplerOptions options;
   options.weight_open = 0;
   options.weight_fist = 0;

@@ -4,8 +4,8 @@
 
 #include <Eigen/Geometry>
 
+#include "core/capsule_hand.h"
 #include "core/hand_lbs.h"
-#include "tests/core/stick_hand.h"
 #include "tests/fitting/fitting_scene.h"
 #include "tests/test_util.h"
 
@@ -16,7 +16,7 @@ namespace {
 // keypoint exactly where the target is: twist about a bone never moves the bone's end.
 // (Pose blend shapes do depend on the twist, so they are switched off here.)
 TEST(AnalyticHandPose, ReproducesTheKeypointsOfARandomPoseExactly) {
-  HandModel model = testing::MakeStickHand(HandSide::kRight);
+  HandModel model = MakeCapsuleHand(HandSide::kRight);
   model.posedirs.setZero();
   for (int trial = 0; trial < 5; ++trial) {
     const testing::SceneFrame frame =
@@ -40,7 +40,7 @@ TEST(AnalyticHandPose, ReproducesTheKeypointsOfARandomPoseExactly) {
 }
 
 TEST(AnalyticHandPose, UnknownKeypointsLeaveTheirJointsUnturned) {
-  const HandModel model = testing::MakeStickHand(HandSide::kRight);
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
   const testing::SceneFrame frame = testing::RandomSceneFrame(model, testing::TestRng());
   const Points3d rest = PoseHand(model, HandParams()).keypoints;
   Eigen::VectorXd weights = Eigen::VectorXd::Ones(21);

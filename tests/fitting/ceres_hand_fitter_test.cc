@@ -2,10 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include "core/capsule_hand.h"
 #include "core/errors.h"
 #include "core/metrics.h"
 #include "fitting/silhouette_render.h"
-#include "tests/core/stick_hand.h"
 #include "tests/fitting/fitting_scene.h"
 #include "tests/fitting/tube_hand.h"
 #include "tests/test_util.h"
@@ -15,7 +15,7 @@ namespace {
 
 class CeresHandFitterTest : public ::testing::Test {
  protected:
-  HandModel model_ = testing::MakeStickHand(HandSide::kRight);
+  HandModel model_ = MakeCapsuleHand(HandSide::kRight);
 };
 
 TEST_F(CeresHandFitterTest, OptionsCheck) {
@@ -113,6 +113,8 @@ std::vector<MaskImage> RenderMasks(const HandModel& model,
   return masks;
 }
 
+// The tube hand, not the capsule hand: with the capsule hand the same fit reaches
+// only 1.6-2.0 mm vertex error and IoU 0.87-0.90 (below this test's bounds).
 TEST(CeresHandFitterSilhouetteTest, NoiseFreeKeypointsAndMasks) {
   const HandModel model = testing::MakeTubeHand();
   HandFitOptions options;

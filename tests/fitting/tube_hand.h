@@ -4,7 +4,9 @@
 // wrist to each finger's first joint included) and balls at the joints and tips.
 // Tube vertices are rigidly skinned to the bone's first joint and follow the joints'
 // shape blend shapes (interpolated along the bone), so betas change bone lengths and
-// the silhouette together. For silhouette tests until the open hand lands.
+// the silhouette together. Kept for the silhouette fit test (ceres_hand_fitter_test):
+// with the capsule hand (core/capsule_hand.h) the same noise-free fit stays at
+// 1.6-2.0 mm vertex error and IoU 0.87-0.90, outside that test's bounds.
 
 #include <Eigen/Geometry>
 #include <vector>

@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/capsule_hand.h"
 #include "core/errors.h"
 #include "pipeline/label_policy.h"
-#include "tests/core/stick_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 LabelRecord MakeLabel() {
-  const HandModel model = testing::MakeStickHand(HandSide::kRight);
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
   HandParams params;
   params.global_orient = testing::RandomVector3(-1, 1);
   for (int i = 0; i < kNumPoseParams; ++i) params.hand_pose[i] = testing::Gaussian(0.2);
@@ -98,7 +98,7 @@ TEST(LabelRecord, FrameIdsBecomeSafeFileNames) {
 
 TEST(LabelRecord, MeshFilesReadBackWithOpenMesh) {
   const LabelRecord label = MakeLabel();
-  // The stick hand has one face; a fan over all vertices makes a real test.
+  // A fan over all vertices: every face is known (face 3 is 0, 4, 5).
   Faces faces(label.mesh.vertices.rows() - 2, 3);
   for (int f = 0; f < faces.rows(); ++f) faces.row(f) << 0, f + 1, f + 2;
   const std::string out = testing::ScratchDir();

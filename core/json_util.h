@@ -1,0 +1,67 @@
+#pragma once
+// JSON forms of the project's arrays (numbers, vectors, point lists, hand parameters)
+// and checked readers for them, shared by every file format (capture manifests and
+// records, labels, fit outputs). Writers give the same bytes whoever calls them;
+// readers throw InputError naming the source (file), the field and what was expected.
+// JSON has no NaN or infinity: nlohmann writes them as null; readers decide per field
+// whether null reads back as NaN (JsonNull::kAsNan) or is an error.
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/hand_lbs.h"
+
+namespace handlabel {
+
+// What a reader does with null where a number is expected.
+enum class JsonNull { kReject, kAsNan };
+
+// x, or null when x is not finite.
+nlohmann::json JsonNumberOrNull(double x);
+
+// [v0, v1, ...] of any Eigen vector.
+template <typename Derived>
+nlohmann::json JsonArray(const Eigen::DenseBase<Derived>& v) {
+  nlohmann::json out = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(v.derived()[i]);
+  return out;
+}
+
+// [[x, y, z], ...], one entry per row.
+nlohmann::json JsonPoints(const Points3d& points);
+
+// {"betas": [...], "global_orient": [3], "hand_pose": [45], "transl": [3]}.
+nlohmann::json JsonHandParams(const HandParams& params);
+
+// object[key]; throws when `object` is not an object or has no `key`. `where` is
+// prepended to the key in messages ("views[2].").
+const nlohmann::json& JsonMember(const nlohmann::json& object, const char* key,
+                                 const std::string& source,
+                                 const std::string& where = "");
+
+// object[key] as a string.
+std::string JsonString(const nlohmann::json& object, const char* key,
+                       const std::string& source, const std::string& where = "");
+
+// A number (or, with kAsNan, null as NaN).
+double JsonNumber(const nlohmann::json& value, const std::string& source,
+                  const std::string& field, JsonNull nulls = JsonNull::kReject);
+
+// An array of `size` numbers (any count when size < 0).
+Eigen::VectorXd JsonVector(const nlohmann::json& value, const std::string& source,
+                           const std::string& field, int size,
+                           JsonNull nulls = JsonNull::kReject);
+
+// An array of `rows` points [x, y, z] (any count when rows < 0).
+Points3d JsonPointList(const nlohmann::json& value, const std::string& source,
+                       const std::string& field, Eigen::Index rows,
+                       JsonNull nulls = JsonNull::kReject);
+
+// The four parameter arrays of JsonHandParams from `object` (global_orient 3,
+// hand_pose 45, betas any count, transl 3); fields are named where + key.
+HandParams HandParamsFromJson(const nlohmann::json& object, const std::string& source,
+                              const std::string& where = "",
+                              JsonNull nulls = JsonNull::kReject);
+
+}  // namespace handlabel
