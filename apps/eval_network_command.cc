@@ -10,8 +10,8 @@
 #include "apps/commands.h"
 #include "core/errors.h"
 #include "core/hand_model_io.h"
-#include "pipeline/network_evaluation.h"
 #include "core/progress.h"
+#include "pipeline/network_evaluation.h"
 #include "pipeline/train_config.h"
 
 namespace handlabel {

@@ -4,10 +4,10 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "core/progress.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_stage_factory.h"
-#include "core/progress.h"
 #include "pipeline/shard.h"
 
 namespace handlabel {

@@ -9,10 +9,10 @@
 #include "apps/commands.h"
 #include "core/errors.h"
 #include "core/hand_model_io.h"
-#include "core/image.h"
 #include "core/hand_preview.h"
-#include "openhand/mesh_checks.h"
+#include "core/image.h"
 #include "openhand/builder.h"
+#include "openhand/mesh_checks.h"
 
 namespace handlabel {
 

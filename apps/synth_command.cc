@@ -4,12 +4,12 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
-#include "core/errors.h"
 #include "capture/capture_reader.h"
 #include "capture/contact_sheet.h"
-#include "pipeline/hand_model_source.h"
-#include "core/progress.h"
 #include "capture/synth_capture.h"
+#include "core/errors.h"
+#include "core/progress.h"
+#include "pipeline/hand_model_source.h"
 
 namespace handlabel {
 

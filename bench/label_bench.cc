@@ -7,10 +7,10 @@
 
 #include <filesystem>
 
+#include "capture/synth_capture.h"
 #include "core/capsule_hand.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_stage_factory.h"
-#include "capture/synth_capture.h"
 
 namespace handlabel {
 namespace {

@@ -5,9 +5,9 @@
 #include <benchmark/benchmark.h>
 #include <torch/torch.h>
 
+#include "core/capsule_hand.h"
 #include "network/poem_loss.h"
 #include "network/poem_training_batch.h"
-#include "core/capsule_hand.h"
 #include "openhand/builder.h"
 #include "pipeline/training_samples.h"
 

@@ -14,10 +14,10 @@
 
 #include <benchmark/benchmark.h>
 
-#include "core/image.h"
-#include "core/capsule_hand.h"
-#include "pipeline/hand_model_source.h"
 #include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
+#include "core/image.h"
+#include "pipeline/hand_model_source.h"
 
 namespace handlabel {
 namespace {

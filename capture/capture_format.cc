@@ -113,8 +113,8 @@ json ViewKeypointsToJson(const std::string& frame,
     jv["camera"] = v.camera;
     json kp = json::array();
     for (int k = 0; k < kNumHandKeypoints; ++k) {
-      kp.push_back(
-          {JsonNumberOrNull(v.keypoints.uv_px(k, 0)), JsonNumberOrNull(v.keypoints.uv_px(k, 1))});
+      kp.push_back({JsonNumberOrNull(v.keypoints.uv_px(k, 0)),
+                    JsonNumberOrNull(v.keypoints.uv_px(k, 1))});
     }
     jv["keypoints"] = kp;
     if (ground_truth) {

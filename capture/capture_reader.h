@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "capture/capture_format.h"
 #include "core/image.h"
 #include "core/rig.h"
-#include "capture/capture_format.h"
 
 namespace handlabel {
 

@@ -90,7 +90,9 @@ void SheetLine(ImageU8* tile, const Eigen::Vector2d& a, const Eigen::Vector2d& b
 
 // Skeleton, then keypoints: visible filled, occluded hollow, out of frame left out.
 void DrawKeypoints(const ViewKeypoints& v, const TileWindow& w, ImageU8* tile) {
-  auto at = [&](int k) { return w.ToTile(v.keypoints.uv_px(k, 0), v.keypoints.uv_px(k, 1)); };
+  auto at = [&](int k) {
+    return w.ToTile(v.keypoints.uv_px(k, 0), v.keypoints.uv_px(k, 1));
+  };
   for (int k = 1; k < kNumHandKeypoints; ++k) {
     const int parent = kSnapParents[k];
     if (v.visibility[parent] == 0 || v.visibility[k] == 0) continue;

@@ -4,8 +4,8 @@
 // (visible keypoints filled, occluded ones hollow, out-of-frame ones left out), so a
 // person can check a capture at a glance.
 
-#include "core/image.h"
 #include "capture/capture_reader.h"
+#include "core/image.h"
 
 namespace handlabel {
 

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "core/rig.h"
 #include "capture/frame_source.h"
+#include "core/rig.h"
 
 namespace handlabel {
 

@@ -12,9 +12,9 @@
 #include <optional>
 #include <string>
 
-#include "core/rig.h"
 #include "capture/capture_reader.h"
 #include "capture/frame_source.h"
+#include "core/rig.h"
 
 namespace handlabel {
 

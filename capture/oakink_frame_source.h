@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "core/rig.h"
 #include "capture/frame_source.h"
+#include "core/rig.h"
 
 namespace handlabel {
 

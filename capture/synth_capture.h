@@ -15,15 +15,15 @@
 #include <string>
 #include <vector>
 
+#include "capture/rig_presets.h"
+#include "capture/synth_detections.h"
+#include "capture/synth_scene.h"
+#include "capture/synth_view.h"
 #include "core/hand_anatomy.h"
 #include "core/hand_model.h"
 #include "core/image.h"
 #include "core/rasterizer.h"
 #include "core/rig.h"
-#include "capture/rig_presets.h"
-#include "capture/synth_detections.h"
-#include "capture/synth_scene.h"
-#include "capture/synth_view.h"
 
 namespace handlabel {
 

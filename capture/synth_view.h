@@ -19,11 +19,11 @@
 #include <random>
 #include <string>
 
+#include "capture/synth_background.h"
+#include "capture/synth_scene.h"
 #include "core/image.h"
 #include "core/rasterizer.h"
 #include "core/rig.h"
-#include "capture/synth_background.h"
-#include "capture/synth_scene.h"
 
 namespace handlabel {
 

@@ -1,7 +1,7 @@
 #pragma once
-// Progress of a long run (labeling, synthesis, evaluation) on stderr: on a terminal a bar redrawn in place with
-// frames/s and ETA; otherwise (cluster logs, pipes) one plain line per ~5 % of the
-// frames, so logs stay short and greppable. Thread-safe.
+// Progress of a long run (labeling, synthesis, evaluation) on stderr: on a terminal a bar
+// redrawn in place with frames/s and ETA; otherwise (cluster logs, pipes) one plain line
+// per ~5 % of the frames, so logs stay short and greppable. Thread-safe.
 
 #include <chrono>
 #include <mutex>

@@ -18,8 +18,8 @@
 #include <string>
 
 #include "core/hand_model.h"
-#include "openhand/mesh_decimation.h"
 #include "openhand/design.h"
+#include "openhand/mesh_decimation.h"
 #include "openhand/skinning.h"
 
 namespace handlabel {

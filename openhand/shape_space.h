@@ -10,8 +10,8 @@
 #include <Eigen/Core>
 #include <random>
 
-#include "openhand/implicit_mesher.h"
 #include "openhand/design.h"
+#include "openhand/implicit_mesher.h"
 #include "openhand/skinning.h"
 
 namespace handlabel {

@@ -9,8 +9,8 @@
 
 #include <Eigen/Core>
 
-#include "openhand/implicit_mesher.h"
 #include "openhand/design.h"
+#include "openhand/implicit_mesher.h"
 
 namespace handlabel {
 

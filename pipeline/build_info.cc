@@ -4,9 +4,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include "calib/calib_versions.h"
+#include "core/version.h"
 #include "fitting/fitting_versions.h"
 #include "network/network_versions.h"
-#include "core/version.h"
 #include "pipeline/build_config.h"
 #include "pipeline/git_hash.h"
 

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "core/errors.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
 
 namespace handlabel {
 namespace {

@@ -15,12 +15,12 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/progress.h"
 #include "core/sha256.h"
 #include "pipeline/build_info.h"
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
-#include "core/progress.h"
 
 namespace handlabel {
 namespace {

@@ -35,8 +35,8 @@ struct FrameOutcome {
 // the network's); none for the cameras of evidence.ignore_views. Throws Error when the
 // chosen source has nothing for this frame, InputError for an unknown camera name.
 std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
-                                                        const FrameInput& frame,
-                                                        const MeshPrediction* prediction);
+                                                    const FrameInput& frame,
+                                                    const MeshPrediction* prediction);
 
 // Labels one frame. `prediction` is nullptr when the job has no network; `previous` is
 // the previous frame's label parameters when the job fits from them (fit.init:

@@ -8,9 +8,9 @@
 #include <functional>
 #include <string>
 
+#include "capture/synth_capture.h"
 #include "core/hand_model.h"
 #include "core/metrics.h"
-#include "capture/synth_capture.h"
 #include "pipeline/training_samples.h"
 
 namespace handlabel {

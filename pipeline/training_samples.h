@@ -31,9 +31,9 @@
 #include <utility>
 #include <vector>
 
+#include "capture/synth_capture.h"
 #include "core/hand_model.h"
 #include "network/training_sample.h"
-#include "capture/synth_capture.h"
 
 namespace handlabel {
 

@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/capsule_hand.h"
 #include "network/hand_mesh_predictor.h"
 #include "network/poem_config.h"
-#include "core/capsule_hand.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_record.h"
 #include "tests/apps/run_command.h"

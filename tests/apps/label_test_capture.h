@@ -7,8 +7,8 @@
 #include <fstream>
 #include <string>
 
-#include "core/capsule_hand.h"
 #include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
 
 namespace handlabel::testing {
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "capture/synth_capture.h"
 #include "core/image_file.h"
 #include "core/npz.h"
-#include "capture/synth_capture.h"
 
 namespace handlabel::testing {
 

@@ -11,11 +11,11 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
-#include "core/errors.h"
-#include "core/image_file.h"
-#include "core/capsule_hand.h"
 #include "capture/ho3d_frame_source.h"
 #include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
+#include "core/errors.h"
+#include "core/image_file.h"
 #include "tests/core/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/test_util.h"
 
@@ -65,7 +65,7 @@ inline void WriteMeta(const std::string& path, const Points3d& snap_in_camera) {
 }
 
 inline Ho3dFixture WriteHo3dFixture(const std::string& root, int num_frames = 2,
-                             int num_cameras = 3) {
+                                    int num_cameras = 3) {
   SynthCaptureOptions synth;
   synth.rig.preset = "dexycb";
   synth.rig.width = 640;  // HO3D's calibration files imply 640x480

@@ -10,12 +10,12 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
+#include "capture/oakink_frame_source.h"
+#include "capture/synth_capture.h"
+#include "core/capsule_hand.h"
 #include "core/errors.h"
 #include "core/image.h"
 #include "core/image_file.h"
-#include "core/capsule_hand.h"
-#include "capture/oakink_frame_source.h"
-#include "capture/synth_capture.h"
 #include "tests/core/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/test_util.h"
 

@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/errors.h"
 #include "core/atomic_file.h"
+#include "core/errors.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
