@@ -2,10 +2,10 @@
 
 #include <cmath>
 #include <iomanip>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "calib/cv_image_file.h"
 #include "core/errors.h"
 
 namespace handlabel {
@@ -104,13 +104,7 @@ void PlotBoardResiduals(const BoardCalibResult& result, const std::string& png_p
   legend << "grey circle = 1 px; axes span +-" << std::setprecision(2) << range << " px";
   cv::putText(canvas, legend.str(), cv::Point(6, rows * panel - 6),
               cv::FONT_HERSHEY_SIMPLEX, 0.35, cv::Scalar(80, 80, 80), 1, cv::LINE_AA);
-  bool ok = false;
-  try {
-    ok = cv::imwrite(png_path, canvas);
-  } catch (const cv::Exception& e) {
-    throw InputError(png_path, "(file)", "a writable .png path", e.what());
-  }
-  if (!ok) throw InputError(png_path, "(file)", "a writable .png path", "write failed");
+  WriteCvImage(canvas, png_path);
 }
 
 }  // namespace handlabel

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
 
+#include "calib/cv_image_file.h"
 #include "core/errors.h"
 
 namespace handlabel {
@@ -25,15 +26,7 @@ GrayImage ReadGrayImage(const std::string& path) {
 void WriteGrayImage(const GrayImage& image, const std::string& path) {
   const cv::Mat mat(image.height, image.width, CV_8UC1,
                     const_cast<uint8_t*>(image.pixels.data()));
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, mat);
-  } catch (const cv::Exception& e) {
-    throw InputError(path, "(file)", "a writable image path (.png, .jpg)", e.what());
-  }
-  if (!ok)
-    throw InputError(path, "(file)", "a writable image path (.png, .jpg)",
-                     "write failed");
+  WriteCvImage(mat, path);
 }
 
 }  // namespace handlabel

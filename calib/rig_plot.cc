@@ -6,10 +6,10 @@
 #include <functional>
 #include <iomanip>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "calib/cv_image_file.h"
 #include "core/errors.h"
 
 namespace handlabel {
@@ -220,13 +220,7 @@ void PlotRig(const Rig& rig, const std::string& png_path, const RigPlotOptions& 
     cv::putText(canvas, options.title, cv::Point(10, 21), cv::FONT_HERSHEY_SIMPLEX, 0.6,
                 cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   }
-  bool ok = false;
-  try {
-    ok = cv::imwrite(png_path, canvas);
-  } catch (const cv::Exception& e) {
-    throw InputError(png_path, "(file)", "a writable .png path", e.what());
-  }
-  if (!ok) throw InputError(png_path, "(file)", "a writable .png path", "write failed");
+  WriteCvImage(canvas, png_path);
 }
 
 std::string RigTable(const Rig& rig) {
