@@ -29,6 +29,8 @@ void SetIfGiven(const CLI::App& app, const char* flag, const T& value,
 }
 
 void PrintSummary(const FitCaptureSummary& s) {
+  if (!s.hand_model_note.empty())
+    std::cerr << "handlabel fit: note: " << s.hand_model_note << "\n";
   std::cout << "fitted " << s.frames << " frames (" << s.converged << " converged, "
             << s.job.failed << " failed), " << s.mean_seconds << " s per frame";
   if (s.has_ground_truth) {

@@ -51,6 +51,8 @@ int RunLabel(int argc, char** argv) {
     options.interactive = Progress::IsTerminal(STDERR_FILENO);
     options.log = quiet ? nullptr : &std::cerr;
     const BuiltLabelStages stages = BuildLabelStages(job);
+    if (!stages.hand_model_note.empty() && !quiet)
+      std::cerr << "handlabel label: note: " << stages.hand_model_note << "\n";
     const LabelSummary summary = RunLabelJob(job, stages.Set(), options);
     return summary.failed > 0 && summary.ok == 0 ? 1 : 0;
   });

@@ -109,6 +109,7 @@ FitCaptureSummary FitCapture(const FitCaptureOptions& options, std::ostream* log
   s.pa_mpvpe = Mean(s.job, "pa_mpvpe_mm") / 1000;
   s.auc_joints = Mean(s.job, "auc");
   s.summary_path = SummaryJsonPath(job.output_dir);
+  s.hand_model_note = stages.hand_model_note;
   ReadFitReports(job.output_dir, JobFrames(job, *stages.source), stages.hand_model, &s);
   return s;
 }

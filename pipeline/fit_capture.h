@@ -59,6 +59,7 @@ struct FitCaptureSummary {
   double auc_joints = 0.0;               // PCK AUC 0-20 mm over keypoints
   double max_limit_violation_deg = 0.0;  // largest over the labels
   std::string summary_path;
+  std::string hand_model_note;  // ResolveHandModel's note, "" if nothing to say
 };
 
 // Runs FitJob(options) (every chosen frame is fitted again) and reads the numbers of

@@ -75,7 +75,9 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   BuiltLabelStages built;
   built.source = BuildFrameSource(job);
   const HandSide side = built.source->side().value_or(HandSide::kRight);
-  built.hand_model = ResolveHandModel(job.hand_model, side).model;
+  ResolvedHandModel hand = ResolveHandModel(job.hand_model, side);
+  built.hand_model = std::move(hand.model);
+  built.hand_model_note = std::move(hand.note);
   if (!job.network_weights.empty()) {
     built.predictor = LoadNetworkStage(job.network_weights, job.batch_size, job.threads);
   }

@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "core/hand_model.h"
 #include "pipeline/job_config.h"
@@ -18,6 +19,8 @@ struct BuiltLabelStages {
   std::unique_ptr<LabelFitter> fitter;
   std::unique_ptr<OverlayWriter> overlays;
   HandModel hand_model;
+  // Why the hand model is not the one asked for (ResolveHandModel's note), "" if nothing.
+  std::string hand_model_note;
   // Views of the above for RunLabelJob.
   LabelStageSet Set() const;
 };
