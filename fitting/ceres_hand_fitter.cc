@@ -24,6 +24,22 @@
 namespace handlabel {
 namespace {
 
+// The occluder mask of view v, or nullptr when there is none; it must match the hand
+// mask's size.
+const MaskImage* Occluder(const HandFitInput& input, size_t v) {
+  if (v >= input.occluder_masks.size() || input.occluder_masks[v].size() == 0)
+    return nullptr;
+  const MaskImage& occluder = input.occluder_masks[v];
+  if (v < input.masks.size() && (occluder.rows() != input.masks[v].rows() ||
+                                 occluder.cols() != input.masks[v].cols())) {
+    throw InputError(
+        "HandFitInput", "occluder_masks[" + std::to_string(v) + "]",
+        "the hand mask's size",
+        std::to_string(occluder.cols()) + "x" + std::to_string(occluder.rows()));
+  }
+  return &occluder;
+}
+
 constexpr int kBetas = 10;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Palm keypoints (SNAP): wrist and the four finger MCPs; rigid in the hand's frame.
@@ -308,6 +324,13 @@ class FitRun {
           std::to_string(input.views.size()) + " masks (one per view) or none",
           std::to_string(input.masks.size()));
     }
+    if (!input.occluder_masks.empty() &&
+        input.occluder_masks.size() != input.views.size()) {
+      throw InputError(
+          "HandFitInput", "occluder_masks",
+          std::to_string(input.views.size()) + " masks (one per view) or none",
+          std::to_string(input.occluder_masks.size()));
+    }
     bool use_sil = false;
     for (const MaskImage& m : input.masks) use_sil |= m.size() > 0;
     use_sil &= config_.use_silhouettes && options_.silhouette_rounds > 0;
@@ -385,10 +408,12 @@ class FitRun {
                            std::to_string(input.masks[v].cols()) + "x" +
                                std::to_string(input.masks[v].rows()));
         }
-        view.distance_to_mask = DistanceToMask(input.masks[v]);
+        const MaskImage* occluder = Occluder(input, v);
+        view.distance_to_mask = DistanceToMask(
+            occluder ? HandOrOccluder(input.masks[v], *occluder) : input.masks[v]);
         if (!std::isfinite(view.distance_to_mask(0, 0))) continue;  // empty mask
-        outlines.push_back(
-            SampleMaskOutline(input.masks[v], options_.silhouette_outline_samples));
+        outlines.push_back(SampleMaskOutline(
+            input.masks[v], options_.silhouette_outline_samples, occluder));
         sil_views.push_back(std::move(view));
       }
     }
@@ -449,7 +474,7 @@ class FitRun {
                                                       camera, (*input.pixel_rays)[v])
                                      : RenderHandMask(result.vertices, model_.faces,
                                                       camera, PixelRays(camera.camera));
-      result.view_iou[v] = MaskIoU(rendered, input.masks[v]);
+      result.view_iou[v] = MaskIoU(rendered, input.masks[v], Occluder(input, v));
     }
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

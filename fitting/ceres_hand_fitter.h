@@ -105,6 +105,11 @@ struct HandFitInput {
   // Per view: silhouette mask (rows = image height), or empty = none for that view.
   // Empty vector = no silhouettes. Cameras come from `views`.
   std::vector<MaskImage> masks;
+  // Per view: pixels where something in front of the hand may hide it (255 = an
+  // object), or empty = nothing known; empty vector = none. Where given, the hand may
+  // project onto these pixels unpenalised and the hand mask's outline next to them is
+  // not a hand boundary (docs/fitting.md, "Occlusion").
+  std::vector<MaskImage> occluder_masks;
   std::optional<Points3dTargets> targets3d;
   std::optional<HandParams> previous;
   // Optional per-view pixel rays of the cameras (core/rasterizer.h), for the IoU of

@@ -6,9 +6,30 @@
 namespace handlabel {
 namespace {
 constexpr int kNormalReach = 3;
+
+bool NearOccluder(const MaskImage& occluder, int x, int y) {
+  const int h = static_cast<int>(occluder.rows()), w = static_cast<int>(occluder.cols());
+  for (int dy = -kOccluderReachPx; dy <= kOccluderReachPx; ++dy) {
+    for (int dx = -kOccluderReachPx; dx <= kOccluderReachPx; ++dx) {
+      const int u = x + dx, v = y + dy;
+      if (u >= 0 && v >= 0 && u < w && v < h && occluder(v, u) != 0) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
-MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples) {
+MaskImage HandOrOccluder(const MaskImage& hand, const MaskImage& occluder) {
+  MaskImage joined = hand;
+  for (Eigen::Index i = 0; i < joined.size(); ++i) {
+    if (occluder.data()[i] != 0) joined.data()[i] = 255;
+  }
+  return joined;
+}
+
+MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples,
+                              const MaskImage* occluder) {
   const int h = static_cast<int>(mask.rows()), w = static_cast<int>(mask.cols());
   std::vector<Eigen::Vector2i> boundary;
   for (int y = 1; y + 1 < h; ++y) {
@@ -16,6 +37,7 @@ MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples) {
       if (mask(y, x) == 0) continue;
       if (mask(y - 1, x) == 0 || mask(y + 1, x) == 0 || mask(y, x - 1) == 0 ||
           mask(y, x + 1) == 0) {
+        if (occluder != nullptr && NearOccluder(*occluder, x, y)) continue;
         boundary.emplace_back(x, y);
       }
     }

@@ -21,10 +21,12 @@ MaskImage RenderHandMask(const Points3d& vertices, const MeshFaces& faces,
   return mask;
 }
 
-double MaskIoU(const MaskImage& a, const MaskImage& b) {
+double MaskIoU(const MaskImage& a, const MaskImage& b, const MaskImage* ignore) {
   HL_CHECK(a.rows() == b.rows() && a.cols() == b.cols(), "masks differ in size");
+  HL_CHECK(!ignore || ignore->size() == a.size(), "ignore mask differs in size");
   long both = 0, either = 0;
   for (Eigen::Index i = 0; i < a.size(); ++i) {
+    if (ignore && ignore->data()[i] != 0) continue;
     const bool x = a.data()[i] != 0, y = b.data()[i] != 0;
     both += x && y;
     either += x || y;

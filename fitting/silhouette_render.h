@@ -15,6 +15,8 @@ MaskImage RenderHandMask(const Points3d& vertices, const MeshFaces& faces,
                          const RigCamera& camera, const PixelRays& rays);
 
 // |A and B| / |A or B| over nonzero pixels; 1 when both are empty.
-double MaskIoU(const MaskImage& a, const MaskImage& b);
+// Pixels where `ignore` is set (occluded: neither mask can be judged there) do not
+// count.
+double MaskIoU(const MaskImage& a, const MaskImage& b, const MaskImage* ignore = nullptr);
 
 }  // namespace handlabel

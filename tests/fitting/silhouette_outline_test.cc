@@ -39,5 +39,29 @@ TEST(SilhouetteOutlineTest, MatchesNearestValidPoint) {
   EXPECT_EQ(MatchOutlineToPoints(outline, projected, {0, 0, 0})[0], -1);
 }
 
+// A square hand mask whose right side touches an object: the outline keeps the other
+// three sides and drops the pixels within kOccluderReachPx of the object.
+TEST(SilhouetteOutlineTest, NoOutlineNextToAnOccluder) {
+  MaskImage hand = MaskImage::Zero(40, 40);
+  hand.block(10, 10, 20, 20).setConstant(255);  // columns 10..29
+  MaskImage object = MaskImage::Zero(40, 40);
+  object.block(5, 30, 30, 6).setConstant(255);  // columns 30..35, right of the hand
+  const MaskOutline all = SampleMaskOutline(hand, 1000);
+  const MaskOutline visible = SampleMaskOutline(hand, 1000, &object);
+  // Kept boundary pixels reach column 29 - kOccluderReachPx; points sit at most half a
+  // pixel further out.
+  const double last_kept = 29 - kOccluderReachPx + 0.5;
+  int right_all = 0, right_visible = 0;
+  for (const Eigen::Vector2d& p : all.points) right_all += p.x() > last_kept;
+  for (const Eigen::Vector2d& p : visible.points) right_visible += p.x() > last_kept;
+  EXPECT_GT(right_all, 20);
+  EXPECT_EQ(right_visible, 0);
+  EXPECT_GE(visible.points.size(), 50u);  // the three free sides stay
+  const MaskImage joined = HandOrOccluder(hand, object);
+  EXPECT_EQ(joined(20, 33), 255);
+  EXPECT_EQ(joined(20, 20), 255);
+  EXPECT_EQ(joined(2, 2), 0);
+}
+
 }  // namespace
 }  // namespace handlabel
