@@ -71,6 +71,10 @@ void AddEvidenceFlags(CLI::App& app, FitFlags* f) {
   app.add_option("--evidence", o.evidence,
                  "2D keypoints: auto | detections | keypoints (exact projections)")
       ->capture_default_str();
+  app.add_option("--object-masks", o.object_masks,
+                 "object masks as occluders (pixels behind objects do not count against "
+                 "the silhouettes): files | none")
+      ->capture_default_str();
   app.add_option("--masks", o.masks, "masks: auto | detections | truth | none")
       ->capture_default_str();
   app.add_flag("--no-silhouettes", f->no_silhouettes, "ignore masks (as --masks none)");

@@ -30,6 +30,9 @@ struct FrameInput {
   Rig rig;
   std::vector<std::string> image_paths;  // one per rig camera
   std::vector<std::string> mask_paths;   // one per rig camera, or empty
+  // Object label maps (0 = none, k = object k), one per rig camera, or empty when the
+  // capture has none: pixels where an object may hide the hand.
+  std::vector<std::string> object_mask_paths;
   // 2D keypoints from files, one entry per rig camera (nullopt: none for that view);
   // empty when the capture has no keypoint files. Unknown keypoints: confidence 0 and
   // position 0.

@@ -76,6 +76,8 @@ FrameInput NativeFrameSource::Load(const std::string& id) const {
   for (int c = 0; c < reader_.num_cameras(); ++c) {
     frame.image_paths.push_back(reader_.Path(kFileImage, f, c));
     if (!mask_kind_.empty()) frame.mask_paths.push_back(reader_.Path(mask_kind_, f, c));
+    if (reader_.Has(kFileObjectMask))
+      frame.object_mask_paths.push_back(reader_.Path(kFileObjectMask, f, c));
   }
   if (!keypoint_kind_.empty()) {
     const std::vector<ViewKeypoints> views = keypoint_kind_ == kFileDetections

@@ -23,5 +23,8 @@ MaskImage MaskFromImage(const ImageU8& image);
 // Reads a mask PNG and applies the mask rule. Throws InputError naming the path when
 // the file is missing or not an 8-bit PNG.
 MaskImage ReadMaskPng(const std::string& path);
+// An object label map (0 = no object, k = object k; capture/capture_format.h
+// object_masks) as a mask: any non-zero pixel is an object (255).
+MaskImage ReadObjectMaskPng(const std::string& path);
 
 }  // namespace handlabel

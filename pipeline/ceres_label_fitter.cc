@@ -132,6 +132,15 @@ HandFitInput CeresLabelFitter::Evidence(const LabelFitRequest& request,
       input.masks.push_back(
           frame.mask_paths[v].empty() ? MaskImage() : ReadMaskPng(frame.mask_paths[v]));
     }
+    if (options_.use_object_masks && !frame.object_mask_paths.empty()) {
+      *silhouettes = "files+object_masks";
+      for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
+        if (!request.keypoints_2d[v]) continue;
+        const std::string& path = frame.object_mask_paths[v];
+        input.occluder_masks.push_back(path.empty() ? MaskImage()
+                                                    : ReadObjectMaskPng(path));
+      }
+    }
   }
   return input;
 }

@@ -31,6 +31,8 @@ namespace handlabel {
 struct CeresLabelFitterOptions {
   // Fit to the frame's mask files (evidence.masks: files).
   bool use_masks = false;
+  // With mask files: the frame's object masks are occluders (evidence.object_masks).
+  bool use_object_masks = true;
   HandFitConfig config;
   HandFitOptions fit;
   // > 0: silhouettes that come with the request (the network's) are fitted with this

@@ -57,6 +57,8 @@ void FitCaptureOptions::Check() const {
     throw InputError("command line", "--evidence", "auto, detections or keypoints",
                      evidence);
   }
+  if (object_masks != "files" && object_masks != "none")
+    throw InputError("command line", "--object-masks", "files or none", object_masks);
   if (masks != "auto" && masks != "detections" && masks != "truth" && masks != "none") {
     throw InputError("command line", "--masks", "auto, detections, truth or none", masks);
   }
@@ -84,6 +86,7 @@ JobConfig FitJob(const FitCaptureOptions& o) {
   job.keypoint_files = o.evidence;
   job.masks = o.masks == "none" ? MaskSource::kNone : MaskSource::kFiles;
   job.mask_files = o.masks == "none" ? "auto" : o.masks;
+  job.object_masks = o.object_masks == "files";
   job.ignore_views = o.ignore_views;
   job.fit = o.fit;
   job.output_dir = o.out_dir;

@@ -34,6 +34,9 @@ struct FitCaptureOptions {
   // Masks: "detections" (noisy masks), "truth", "none", or "auto" (detections, else
   // truth, else none): evidence.mask_files, or evidence.masks none.
   std::string masks = "auto";
+  // Object masks as occluders: "files" (where the capture has them) or "none"
+  // (evidence.object_masks).
+  std::string object_masks = "files";
   // Camera names whose keypoints and masks are ignored (evidence.ignore_views).
   std::vector<std::string> ignore_views;
   // Model file or "capsule"; empty = $HANDLABEL_HAND_MODEL, then the shipped open hand.

@@ -143,6 +143,13 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
   evidence.Read("network_mask_sigma_px", &job->network_mask_sigma_px);
   evidence.Read("keypoint_files", &job->keypoint_files);
   evidence.Read("mask_files", &job->mask_files);
+  std::string object_masks = "files";
+  evidence.Read("object_masks", &object_masks);
+  if (object_masks != "files" && object_masks != "none") {
+    throw InputError(path, evidence.Name("object_masks"), "files | none",
+                     "'" + object_masks + "'");
+  }
+  job->object_masks = object_masks == "files";
   evidence.Read("ignore_views", &job->ignore_views);
   if (!(job->network_mask_sigma_px >= 0)) {
     throw InputError(path, evidence.Name("network_mask_sigma_px"),

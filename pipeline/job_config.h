@@ -90,6 +90,9 @@ struct JobConfig {
   // "detections" or "truth". Other input formats take "auto" only.
   std::string keypoint_files = "auto";
   std::string mask_files = "auto";
+  // evidence.object_masks: files (default: where the capture has object masks, pixels
+  // behind objects do not count against the silhouette fit) | none.
+  bool object_masks = true;
   // Camera names whose 2D keypoints and masks are not fitted to (a broken camera).
   std::vector<std::string> ignore_views;
   // Silhouette residual scale (pixels per unit) for the network's masks. In the file

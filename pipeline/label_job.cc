@@ -119,6 +119,7 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
     extra["evidence_files"] = {job.keypoint_files, job.mask_files, job.ignore_views};
   }
   if (!job.fit.IsDefault()) extra["fit"] = FitSettingsJson(job.fit);
+  if (!job.object_masks) extra["object_masks"] = "none";
   if (!extra.empty()) j["added"] = extra;
   return Sha256Hex(j.dump());
 }

@@ -19,6 +19,7 @@ CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
   const FitSettings& s = job.fit;
   CeresLabelFitterOptions o;
   o.use_masks = job.masks == MaskSource::kFiles;
+  o.use_object_masks = job.object_masks;
   o.network_mask_sigma_px = job.network_mask_sigma_px;
   o.init = s.init;
   o.fit.num_threads = 1;  // frames run in parallel

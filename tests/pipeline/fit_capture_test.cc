@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -15,10 +17,12 @@
 namespace handlabel {
 namespace {
 
-// A small synthetic capture (capsule hand, DexYCB-like rig at 160x120, no objects).
-std::string SmallCapture(const std::string& scratch, int frames) {
+// A small synthetic capture (capsule hand, DexYCB-like rig at 160x120, objects when
+// asked).
+std::string SmallCapture(const std::string& scratch, int frames, bool objects = false) {
   const std::string dir = scratch + "/capture";
   SynthCaptureOptions o;
+  o.scene.objects = objects;
   o.rig.preset = "dexycb";
   o.rig.width = 160;
   o.rig.height = 120;
@@ -58,6 +62,33 @@ TEST(FitCaptureTest, ExactKeypointsRecoverGroundTruth) {
 }
 
 // --init previous: frames run in order, each fit starting from the previous label.
+// Hands holding objects, exact keypoints and the true (visible) hand masks: with the
+// capture's object masks as occluders the silhouettes agree with the keypoints; without
+// them they pull the hand out of the object's pixels.
+TEST(FitCaptureTest, ObjectMasksKeepTheSilhouettesFromPullingTheHandOut) {
+  const std::string scratch = testing::ScratchDir();
+  FitCaptureOptions o;
+  o.capture_dir = SmallCapture(scratch, 4, /*objects=*/true);
+  o.evidence = "keypoints";
+  o.masks = "truth";
+  o.hand_model = "capsule";
+  o.num_threads = 2;
+  o.out_dir = scratch + "/aware";
+  const FitCaptureSummary aware = FitCapture(o);
+  o.out_dir = scratch + "/unaware";
+  o.object_masks = "none";
+  const FitCaptureSummary unaware = FitCapture(o);
+  RecordProperty("aware_um", int(1e6 * aware.mpjpe));
+  RecordProperty("unaware_um", int(1e6 * unaware.mpjpe));
+  std::cout << "object masks: MPJPE " << 1e3 * aware.mpjpe << " mm, without "
+            << 1e3 * unaware.mpjpe << " mm\n";
+  EXPECT_EQ(aware.job.ok, 4);
+  EXPECT_LT(aware.mpjpe, 0.002);
+  EXPECT_GT(unaware.mpjpe, 1.5 * aware.mpjpe);
+  const LabelRecord label = ReadLabelFile(LabelFilePath(scratch + "/aware", "000000"));
+  EXPECT_EQ(label.fit.value("silhouettes", ""), "files+object_masks");
+}
+
 TEST(FitCaptureTest, PreviousStartsFromThePreviousLabel) {
   const std::string scratch = testing::ScratchDir();
   FitCaptureOptions o;
