@@ -113,23 +113,43 @@ std::vector<MaskImage> RenderMasks(const HandModel& model,
   return masks;
 }
 
-// The tube hand, not the capsule hand: with the capsule hand the same fit reaches
-// only 1.6-2.0 mm vertex error and IoU 0.87-0.90 (below this test's bounds).
-TEST(CeresHandFitterSilhouetteTest, NoiseFreeKeypointsAndMasks) {
-  const HandModel model = testing::MakeTubeHand();
-  HandFitOptions options;
-  options.silhouette_vertex_stride = 4;  // keeps the test fast
-  options.silhouette_rounds = 2;
-  const CeresHandFitter fitter(model, {}, options);
-  std::vector<PixelRays> rays;
-  for (const RigCamera& cam : testing::DexYcbLikeRig(0.5)) rays.emplace_back(cam.camera);
-  for (int trial = 0; trial < 2; ++trial) {
-    const testing::SceneFrame frame =
-        testing::RandomSceneFrame(model, testing::TestRng());
+// The tube hand, its fitter with silhouettes and the half-size DexYCB-like rig's pixel
+// rays; Input() gives a frame's exact keypoints and rendered masks.
+struct SilhouetteScene {
+  HandModel model = testing::MakeTubeHand();
+  CeresHandFitter fitter{model, {}, Options()};
+  std::vector<PixelRays> rays = Rays();
+
+  static HandFitOptions Options() {
+    HandFitOptions options;
+    options.silhouette_vertex_stride = 4;  // keeps the tests fast
+    options.silhouette_rounds = 2;
+    return options;
+  }
+  static std::vector<PixelRays> Rays() {
+    std::vector<PixelRays> rays;
+    for (const RigCamera& cam : testing::DexYcbLikeRig(0.5))
+      rays.emplace_back(cam.camera);
+    return rays;
+  }
+  HandFitInput Input(const testing::SceneFrame& frame) const {
     HandFitInput input;
     input.views = frame.views;
     input.masks = RenderMasks(model, frame, rays);
     input.pixel_rays = &rays;
+    return input;
+  }
+};
+
+// The tube hand, not the capsule hand: with the capsule hand the same fit reaches
+// only 1.6-2.0 mm vertex error and IoU 0.87-0.90 (below this test's bounds).
+TEST(CeresHandFitterSilhouetteTest, NoiseFreeKeypointsAndMasks) {
+  const SilhouetteScene scene;
+  for (int trial = 0; trial < 2; ++trial) {
+    const testing::SceneFrame frame =
+        testing::RandomSceneFrame(scene.model, testing::TestRng());
+    HandFitInput input = scene.Input(frame);
+    const CeresHandFitter& fitter = scene.fitter;
     const HandFitResult result = fitter.Fit(input, fitter.InitFromViews(input.views));
     EXPECT_LT(MeanPointError(result.keypoints, frame.mesh.keypoints), 0.001) << trial;
     EXPECT_LT(MeanPointError(result.vertices, frame.mesh.vertices), 0.0015) << trial;
@@ -180,20 +200,12 @@ double FingerError(const Points3d& a, const Points3d& b) {
 // Without the occluder masks the silhouette term pulls the hidden fingers out of the
 // object's pixels; with them the fit stays at the truth.
 TEST(CeresHandFitterSilhouetteTest, OccluderMasksKeepFingersBehindAnObject) {
-  const HandModel model = testing::MakeTubeHand();
-  HandFitOptions options;
-  options.silhouette_vertex_stride = 4;
-  options.silhouette_rounds = 2;
-  const CeresHandFitter fitter(model, {}, options);
-  std::vector<PixelRays> rays;
-  for (const RigCamera& cam : testing::DexYcbLikeRig(0.5)) rays.emplace_back(cam.camera);
+  const SilhouetteScene scene;
   for (int trial = 0; trial < 2; ++trial) {
     const testing::SceneFrame frame =
-        testing::RandomSceneFrame(model, testing::TestRng());
-    HandFitInput input;
-    input.views = frame.views;
-    input.masks = RenderMasks(model, frame, rays);
-    input.pixel_rays = &rays;
+        testing::RandomSceneFrame(scene.model, testing::TestRng());
+    HandFitInput input = scene.Input(frame);
+    const CeresHandFitter& fitter = scene.fitter;
     const std::vector<MaskImage> occluders = OccludeTwoFingers(frame, &input.masks);
     const HandParams init = fitter.InitFromViews(input.views);
     const HandFitResult unaware = fitter.Fit(input, init);
