@@ -80,7 +80,7 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   built.hand_model = std::move(hand.model);
   built.hand_model_note = std::move(hand.note);
   if (!job.network_weights.empty()) {
-    built.predictor = LoadNetworkStage(job.network_weights, job.batch_size, job.threads);
+    built.predictor = LoadNetworkStage(job);
   }
   if (job.masks == MaskSource::kNetwork &&
       !(built.predictor && built.predictor->predicts_masks)) {

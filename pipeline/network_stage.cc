@@ -114,12 +114,12 @@ std::vector<MeshPrediction> PredictFramesInRig(
   return predictions;
 }
 
-NetworkStage LoadNetworkStage(const std::string& weights, int batch_size,
-                              int num_threads) {
+NetworkStage LoadNetworkStage(const JobConfig& job) {
+  const std::string& weights = job.network_weights;
   HandMeshPredictorOptions options;
   options.weights = weights;
-  options.batch_size = batch_size;
-  options.num_threads = num_threads;
+  options.batch_size = job.batch_size;
+  options.num_threads = job.threads;
   // Shared: std::function needs a copyable callable.
   std::shared_ptr<HandMeshPredictor> network = CreateHandMeshPredictor(options);
   NetworkStage stage;

@@ -12,6 +12,7 @@
 
 #include "network/hand_crop.h"
 #include "network/hand_mesh_predictor.h"
+#include "pipeline/job_config.h"
 #include "pipeline/label_stages.h"
 
 namespace handlabel {
@@ -32,9 +33,9 @@ MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& 
 std::vector<MeshPrediction> PredictFramesInRig(
     HandMeshPredictor& network, const std::vector<const FrameInput*>& frames);
 
-// The job's network stage on POEM weights: loads and validates them (InputError naming
-// the file) and hashes them.
-NetworkStage LoadNetworkStage(const std::string& weights, int batch_size,
-                              int num_threads);
+// The job's network stage from its `network` section (weights, batch_size, threads):
+// loads and validates the weights (InputError naming the file) and hashes them. This is
+// where capture/'s frames meet network/'s predictor, so it lives in pipeline/.
+NetworkStage LoadNetworkStage(const JobConfig& job);
 
 }  // namespace handlabel

@@ -30,12 +30,20 @@ class NetworkStageTest : public ::testing::Test {
     const NativeFrameSource source(dir + "/capture");
     frame_ = source.Load(source.FrameIds().at(0));
   }
+  // A job with these weights, one frame per batch, one thread.
+  JobConfig Job() const {
+    JobConfig job;
+    job.network_weights = weights_;
+    job.batch_size = 1;
+    job.threads = 1;
+    return job;
+  }
   std::string weights_;
   FrameInput frame_;
 };
 
 TEST_F(NetworkStageTest, AnswersAreTheNetworksInTheRigsFrames) {
-  const NetworkStage stage = LoadNetworkStage(weights_, 1, 1);
+  const NetworkStage stage = LoadNetworkStage(Job());
   const MeshPrediction p = stage.predict({&frame_}).at(0);
 
   // The wrapped network on the same crops.
@@ -87,7 +95,7 @@ TEST_F(NetworkStageTest, AnswersAreTheNetworksInTheRigsFrames) {
 }
 
 TEST_F(NetworkStageTest, MovingTheRigMovesTheAnswerWithIt) {
-  const NetworkStage stage = LoadNetworkStage(weights_, 1, 1);
+  const NetworkStage stage = LoadNetworkStage(Job());
   const MeshPrediction a = stage.predict({&frame_}).at(0);
   // new_world = T * world: every camera sees the same, the world frame moved.
   const Rigid3 T(

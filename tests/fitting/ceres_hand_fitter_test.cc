@@ -114,7 +114,7 @@ std::vector<MaskImage> RenderMasks(const HandModel& model,
 }
 
 // The tube hand, its fitter with silhouettes and the half-size DexYCB-like rig's pixel
-// rays; Input() gives a frame's exact keypoints and rendered masks.
+// rays.
 struct SilhouetteScene {
   HandModel model = testing::MakeTubeHand();
   CeresHandFitter fitter{model, {}, Options()};
@@ -132,12 +132,15 @@ struct SilhouetteScene {
       rays.emplace_back(cam.camera);
     return rays;
   }
-  HandFitInput Input(const testing::SceneFrame& frame) const {
+  // A random frame (testing::TestRng) with its exact keypoints and rendered masks.
+  std::pair<testing::SceneFrame, HandFitInput> NextTrial() const {
+    const testing::SceneFrame frame =
+        testing::RandomSceneFrame(model, testing::TestRng());
     HandFitInput input;
     input.views = frame.views;
     input.masks = RenderMasks(model, frame, rays);
     input.pixel_rays = &rays;
-    return input;
+    return {frame, input};
   }
 };
 
@@ -146,9 +149,7 @@ struct SilhouetteScene {
 TEST(CeresHandFitterSilhouetteTest, NoiseFreeKeypointsAndMasks) {
   const SilhouetteScene scene;
   for (int trial = 0; trial < 2; ++trial) {
-    const testing::SceneFrame frame =
-        testing::RandomSceneFrame(scene.model, testing::TestRng());
-    HandFitInput input = scene.Input(frame);
+    auto [frame, input] = scene.NextTrial();
     const CeresHandFitter& fitter = scene.fitter;
     const HandFitResult result = fitter.Fit(input, fitter.InitFromViews(input.views));
     EXPECT_LT(MeanPointError(result.keypoints, frame.mesh.keypoints), 0.001) << trial;
@@ -202,9 +203,7 @@ double FingerError(const Points3d& a, const Points3d& b) {
 TEST(CeresHandFitterSilhouetteTest, OccluderMasksKeepFingersBehindAnObject) {
   const SilhouetteScene scene;
   for (int trial = 0; trial < 2; ++trial) {
-    const testing::SceneFrame frame =
-        testing::RandomSceneFrame(scene.model, testing::TestRng());
-    HandFitInput input = scene.Input(frame);
+    auto [frame, input] = scene.NextTrial();
     const CeresHandFitter& fitter = scene.fitter;
     const std::vector<MaskImage> occluders = OccludeTwoFingers(frame, &input.masks);
     const HandParams init = fitter.InitFromViews(input.views);
