@@ -175,6 +175,9 @@ void SynthSceneOptions::Check() const {
   if (!(betas_sigma >= 0 && betas_sigma <= 5)) {
     throw InputError(src, "betas_sigma", "0..5", std::to_string(betas_sigma));
   }
+  if (!(object_probability >= 0 && object_probability <= 1)) {
+    throw InputError(src, "object_probability", "0..1", std::to_string(object_probability));
+  }
   if (max_objects < 1 || max_objects > 8) {
     throw InputError(src, "max_objects", "1..8", std::to_string(max_objects));
   }
@@ -324,7 +327,9 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
   scene.cameras_seeing_hand = PlaceHand(model, rig, o, rng, &scene.params);
   scene.hand = PoseHand(model, scene.params);
   SampleAppearance(model, rng, &scene);
-  if (o.objects) AddObjects(o, rng, &scene);
+  const bool with_objects =
+      o.objects && (o.object_probability >= 1.0 || Uniform(rng, 0, 1) < o.object_probability);
+  if (with_objects) AddObjects(o, rng, &scene);
   return scene;
 }
 

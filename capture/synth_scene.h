@@ -42,6 +42,9 @@ struct SynthSceneOptions {
   // Add 1..max_objects objects (sphere, box, cylinder) held near or in the hand.
   bool objects = false;
   int max_objects = 2;
+  // With objects: the share of frames that get them (the rest show the empty hand), so
+  // that one training run sees both; 1 = every frame (no random draw is spent).
+  double object_probability = 1.0;
   // The hand centre is drawn uniformly in a ball of this radius (m) around the
   // workspace centre (the world origin of the presets).
   Eigen::Vector3d workspace_center = Eigen::Vector3d::Zero();

@@ -64,6 +64,7 @@ void ReadData(Section data, TrainConfig* c) {
   data.Read("validation_seed", &c->validation_seed);
   data.Read("objects", &objects);
   data.Read("max_objects", &c->synth.scene.max_objects);
+  data.Read("object_probability", &c->synth.scene.object_probability);
   data.Read("clutter", &clutter);
   data.Read("frame_reuse", &c->samples.frame_reuse);
   data.Read("box_scale", &c->samples.box_scale);

@@ -9,6 +9,7 @@
 #include "capture/synth_detections.h"
 #include "capture/synth_view.h"
 #include "core/capsule_hand.h"
+#include "core/errors.h"
 #include "tests/pin_digest.h"
 #include "tests/test_util.h"
 
@@ -80,6 +81,24 @@ TEST(SynthScene, ObjectsAreHeldNearTheHand) {
       EXPECT_LT((obj.world_from_object.translation - palm).norm(), 0.25) << obj.kind;
     }
   }
+}
+
+TEST(SynthScene, ObjectProbabilityMixesEmptyAndObjectFrames) {
+  SceneFixture s;
+  SynthSceneOptions o;
+  o.objects = true;
+  o.object_probability = 0.6;
+  int with_objects = 0;
+  const int n = 100;
+  for (int i = 0; i < n; ++i) {
+    with_objects +=
+        !SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, TestRng()).objects.empty();
+  }
+  // Binomial(100, 0.6): mean 60, sd 4.9; 4 sd either side.
+  EXPECT_GT(with_objects, 40);
+  EXPECT_LT(with_objects, 80);
+  o.object_probability = 1.5;
+  EXPECT_THROW(o.Check(), InputError);
 }
 
 void AddMesh(const RenderMesh& m, testing::PinDigest* d) {
