@@ -155,8 +155,10 @@ JobResult RunFitJob(const std::string& dir, const std::string& name,
 // Labels of the same frames read in place and in the native layout, with the same
 // evidence: in place must be within 1.5x the native MPJPE (the acceptance).
 void ExpectInPlaceLikeNative(const JobResult& in_place, const JobResult& native) {
-  RecordProperty("in_place_mpjpe_um", static_cast<int>(1000 * in_place.mpjpe_mm));
-  RecordProperty("native_mpjpe_um", static_cast<int>(1000 * native.mpjpe_mm));
+  ::testing::Test::RecordProperty("in_place_mpjpe_um",
+                                  static_cast<int>(1000 * in_place.mpjpe_mm));
+  ::testing::Test::RecordProperty("native_mpjpe_um",
+                                  static_cast<int>(1000 * native.mpjpe_mm));
   EXPECT_EQ(in_place.summary.ok, native.summary.ok);
   EXPECT_GT(in_place.summary.ok, 0);
   EXPECT_LE(in_place.mpjpe_mm, 1.5 * native.mpjpe_mm)
