@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -52,32 +53,64 @@ Rigid3 CamFromCommon(const std::vector<double>& v, const std::string& path,
 
 // ---------------------------------------------------------------------------- DexYCB
 
+constexpr char kDexYcbTagKey[] = "apriltag";
+
+struct SizedIntrinsicsFile {
+  fs::path file;
+  int width = 0;
+  int height = 0;
+};
+
+// <serial>_<W>x<H>.yml; the size comes from the name. DexYCB's toolkit always reads
+// <serial>_640x480.yml (its images are 640x480), so that file wins when several sizes
+// sit side by side; a single other size is taken as it is; several without 640x480
+// are ambiguous and an error.
 Camera DexYcbIntrinsics(const fs::path& folder, const std::string& serial) {
-  // <serial>_<W>x<H>.yml; the size comes from the name.
   static const std::regex size_suffix("_([0-9]+)x([0-9]+)\\.yml");
+  std::vector<SizedIntrinsicsFile> found;
   if (fs::is_directory(folder)) {
-    std::vector<fs::path> files;
-    for (const auto& e : fs::directory_iterator(folder)) files.push_back(e.path());
-    std::sort(files.begin(), files.end());
-    for (const fs::path& file : files) {
-      std::smatch m;
-      const std::string filename = file.filename().string();
+    for (const auto& e : fs::directory_iterator(folder)) {
+      const std::string filename = e.path().filename().string();
       if (filename.rfind(serial, 0) != 0) continue;
       const std::string rest = filename.substr(serial.size());
+      std::smatch m;
       if (!std::regex_match(rest, m, size_suffix)) continue;
-      const YAML::Node color = LoadYaml(file)["color"];
-      const std::string p = file.string();
-      if (!color) throw InputError(p, "color", "a map with fx, fy, ppx, ppy", "missing");
-      return Camera(
-          CameraModelId::kPinhole, std::stoi(m[1]), std::stoi(m[2]),
-          {YamlNumber(color["fx"], p, "color.fx"), YamlNumber(color["fy"], p, "color.fy"),
-           YamlNumber(color["ppx"], p, "color.ppx"),
-           YamlNumber(color["ppy"], p, "color.ppy")},
-          p);
+      found.push_back({e.path(), std::stoi(m[1]), std::stoi(m[2])});
     }
   }
-  throw InputError(folder.string(), serial + "_<W>x<H>.yml",
-                   "an intrinsics file for camera " + serial, "not found");
+  std::sort(found.begin(), found.end(),
+            [](const auto& a, const auto& b) { return a.file < b.file; });
+  if (found.empty()) {
+    throw InputError(folder.string(), serial + "_<W>x<H>.yml",
+                     "an intrinsics file for camera " + serial, "not found");
+  }
+  size_t pick = 0;
+  if (found.size() > 1) {
+    std::string sizes;
+    pick = found.size();
+    for (size_t i = 0; i < found.size(); ++i) {
+      sizes += (i ? ", " : "") + found[i].file.filename().string();
+      if (found[i].width == 640 && found[i].height == 480) pick = i;
+    }
+    if (pick == found.size()) {
+      throw InputError(folder.string(), serial + "_<W>x<H>.yml",
+                       "one intrinsics size, or " + serial +
+                           "_640x480.yml (the size DexYCB's toolkit reads)",
+                       sizes);
+    }
+  }
+  const fs::path& file = found[pick].file;
+  const int width = found[pick].width;
+  const int height = found[pick].height;
+  const YAML::Node color = LoadYaml(file)["color"];
+  const std::string p = file.string();
+  if (!color) throw InputError(p, "color", "a map with fx, fy, ppx, ppy", "missing");
+  return Camera(
+      CameraModelId::kPinhole, width, height,
+      {YamlNumber(color["fx"], p, "color.fx"), YamlNumber(color["fy"], p, "color.fy"),
+       YamlNumber(color["ppx"], p, "color.ppx"),
+       YamlNumber(color["ppy"], p, "color.ppy")},
+      p);
 }
 
 Rig ReadDexYcb(const fs::path& path, RigFileInfo* info) {
@@ -107,7 +140,12 @@ Rig ReadDexYcb(const fs::path& path, RigFileInfo* info) {
   std::string master;
   if (extr["master"]) master = extr["master"].as<std::string>();
   if (serials.empty()) {
-    for (const auto& kv : map) serials.push_back(kv.first.as<std::string>());
+    // Every entry is a camera serial except `apriltag`: the calibration tag's pose in
+    // the common frame (world_from_tag, 3x4), which is no camera.
+    for (const auto& kv : map) {
+      const std::string key = kv.first.as<std::string>();
+      if (key != kDexYcbTagKey) serials.push_back(key);
+    }
   }
   const fs::path intrinsics_folder =
       fs::absolute(extrinsics_file).parent_path().parent_path() / "intrinsics";
@@ -130,14 +168,13 @@ Rig ReadDexYcb(const fs::path& path, RigFileInfo* info) {
 
 // ---------------------------------------------------------------------------- HO3D
 
-std::vector<double> ReadNumbers(const fs::path& path, char separator_to_space = ' ') {
+// Whitespace-separated numbers (np.savetxt's output).
+std::vector<double> ReadNumbers(const fs::path& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path.string(), "(file)", "a readable text file", "not found");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  std::string text = buffer.str();
-  std::replace(text.begin(), text.end(), separator_to_space, ' ');
-  std::istringstream parse(text);
+  std::istringstream parse(buffer.str());
   std::vector<double> out;
   std::string token;
   while (parse >> token) {
@@ -174,6 +211,46 @@ Camera Ho3dIntrinsics(const fs::path& path) {
                 {values[0], values[1], values[2], values[3]}, path.string());
 }
 
+// cam_orders.txt as np.loadtxt reads it: whitespace-separated numbers, '#' comments;
+// each a camera folder index, no index twice.
+std::vector<int> Ho3dCameraOrder(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string(), "(file)", "a readable text file", "not found");
+  std::vector<int> order;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream tokens(line.substr(0, line.find('#')));
+    std::string token;
+    while (tokens >> token) {
+      double value = 0;
+      size_t used = 0;
+      try {
+        value = std::stod(token, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != token.size() || value < 0 || value > 1000 ||
+          value != std::floor(value)) {
+        throw InputError(file.string(), "(camera order)",
+                         "whitespace-separated camera indices (as np.loadtxt reads them)",
+                         "'" + token + "'");
+      }
+      const int index = static_cast<int>(value);
+      if (std::find(order.begin(), order.end(), index) != order.end()) {
+        throw InputError(file.string(), "(camera order)", "each camera index once",
+                         std::to_string(index) + " twice");
+      }
+      order.push_back(index);
+    }
+  }
+  return order;
+}
+
+// Pairing, as HO3D's multi-camera viewer reads it: the files with index i
+// (trans_<i>.txt, cam_<i>_intrinsics.txt) belong to the camera folder
+// <SEQ><cams_order[i]>, where cams_order[i] is the i-th entry of cam_orders.txt. The
+// rig lists the cameras in that file order. Without cam_orders.txt the order is the
+// identity.
 Rig ReadHo3d(const fs::path& folder, RigFileInfo* info) {
   if (!fs::is_directory(folder)) {
     throw InputError(folder.string(), "(folder)", "calibration/<SEQ>/calibration",
@@ -185,8 +262,7 @@ Rig ReadHo3d(const fs::path& folder, RigFileInfo* info) {
   const std::string seq = dir.parent_path().filename().string();
   std::vector<int> order;
   if (fs::exists(dir / "cam_orders.txt")) {
-    for (double v : ReadNumbers(dir / "cam_orders.txt", ','))
-      order.push_back(static_cast<int>(v));
+    order = Ho3dCameraOrder(dir / "cam_orders.txt");
   } else {
     for (int i = 0; fs::exists(dir / ("trans_" + std::to_string(i) + ".txt")); ++i)
       order.push_back(i);
@@ -196,15 +272,16 @@ Rig ReadHo3d(const fs::path& folder, RigFileInfo* info) {
                      "none");
   }
   Rig rig;
-  for (int i : order) {
-    const fs::path trans = dir / ("trans_" + std::to_string(i) + ".txt");
+  for (size_t i = 0; i < order.size(); ++i) {
+    const std::string index = std::to_string(i);
+    const fs::path trans = dir / ("trans_" + index + ".txt");
     const std::vector<double> v = ReadNumbers(trans);
     if (v.size() != 16) {
       throw InputError(trans.string(), "(matrix)", "16 numbers (4x4 camera -> common)",
                        std::to_string(v.size()));
     }
-    rig.Add({seq + std::to_string(i),
-             Ho3dIntrinsics(dir / ("cam_" + std::to_string(i) + "_intrinsics.txt")),
+    rig.Add({seq + std::to_string(order[i]),
+             Ho3dIntrinsics(dir / ("cam_" + index + "_intrinsics.txt")),
              CamFromCommon(std::vector<double>(v.begin(), v.begin() + 12), trans.string(),
                            "(matrix)")});
   }

@@ -58,6 +58,41 @@ bool HasHand(const std::vector<double>& values) {
   return std::any_of(values.begin(), values.end(), [](double v) { return v != -1.0; });
 }
 
+// The labels' seg (H x W, uint8: 0 background, 255 hand, 1..254 the YCB id of the
+// object at that pixel) as the view's hand mask and object mask; both empty when the
+// file has no seg.
+void AddSegmentation(const NamedArrays& arrays, const std::string& file,
+                     const Camera& camera, FrameInput* frame) {
+  const NdArray* seg = nullptr;
+  for (const auto& [key, array] : arrays) {
+    if (key == "seg") seg = &array;
+  }
+  MaskImage hand, objects;
+  if (seg) {
+    if (seg->ndim() != 2 || seg->dtype != DType::kUInt8) {
+      throw InputError(file, "seg",
+                       "an H x W uint8 array (0 background, 255 hand, "
+                       "1..254 object ids)",
+                       seg->ShapeString() + " " + DTypeName(seg->dtype));
+    }
+    if (seg->shape[0] != camera.height() || seg->shape[1] != camera.width()) {
+      throw InputError(file, "seg",
+                       "the camera's size " + std::to_string(camera.height()) + " x " +
+                           std::to_string(camera.width()),
+                       seg->ShapeString());
+    }
+    hand.resize(seg->shape[0], seg->shape[1]);
+    objects.resize(seg->shape[0], seg->shape[1]);
+    const uint8_t* v = seg->data.data();
+    for (Eigen::Index i = 0; i < hand.size(); ++i) {
+      hand.data()[i] = v[i] == 255 ? 255 : 0;
+      objects.data()[i] = v[i] != 0 && v[i] != 255 ? 255 : 0;
+    }
+  }
+  frame->masks.push_back(std::move(hand));
+  frame->object_masks.push_back(std::move(objects));
+}
+
 }  // namespace
 
 DexYcbSequence ReadDexYcbSequence(const std::string& dir) {
@@ -189,7 +224,15 @@ std::string DexYcbFrameSource::Describe() const {
          std::to_string(frames) + " frames, " +
          (side() == HandSide::kLeft ? "left" : "right") +
          " hand, 2D keypoints and ground truth keypoints: " +
-         (labels ? "labels_*.npz" : "none") + ", masks: none)";
+         (labels ? "labels_*.npz" : "none") +
+         ", hand and object masks: " + (labels ? "labels_*.npz seg" : "none") + ")";
+}
+
+std::string DexYcbFrameSource::KeypointsSource() const {
+  for (const DexYcbSequence& seq : sequences_) {
+    if (!seq.has_labels) return "";
+  }
+  return "DexYCB labels_*.npz joint_2d";
 }
 
 FrameInput DexYcbFrameSource::Load(const std::string& id) const {
@@ -224,7 +267,7 @@ FrameInput DexYcbFrameSource::Load(const std::string& id) const {
     }
     frame.image_paths.push_back(image);
   }
-  if (!seq.has_labels) return frame;
+  if (!seq.has_labels) return frame;  // no 2D, no masks, no ground truth
   for (size_t v = 0; v < seq.rig.size(); ++v) {
     const std::string file = ViewFile(seq, v, "labels", f);
     if (!fs::is_regular_file(file)) {
@@ -242,12 +285,15 @@ FrameInput DexYcbFrameSource::Load(const std::string& id) const {
     if (HasHand(uv)) {
       view.emplace();
       for (int k = 0; k < kNumHandKeypoints; ++k) {
-        const bool known = std::isfinite(uv[2 * k]) && std::isfinite(uv[2 * k + 1]);
+        // (-1, -1): the toolkit's "unlabelled" keypoint, not an observation.
+        const bool known = std::isfinite(uv[2 * k]) && std::isfinite(uv[2 * k + 1]) &&
+                           !(uv[2 * k] == -1.0 && uv[2 * k + 1] == -1.0);
         if (known) view->uv_px.row(k) << uv[2 * k], uv[2 * k + 1];
         view->confidence(k) = known ? 1.0 : 0.0;
       }
     }
     frame.keypoints_2d.push_back(view);
+    AddSegmentation(arrays, file, seq.rig[v].camera, &frame);
     if (!frame.ground_truth && HasHand(xyz)) {
       const Rigid3 world_from_cam = seq.rig[v].cam_from_world.Inverse();
       FrameGroundTruth truth;
@@ -259,6 +305,11 @@ FrameInput DexYcbFrameSource::Load(const std::string& id) const {
       }
       frame.ground_truth = truth;
     }
+  }
+  const auto empty = [](const MaskImage& m) { return m.size() == 0; };
+  if (std::all_of(frame.masks.begin(), frame.masks.end(), empty)) {
+    frame.masks.clear();  // no seg in any view: no mask evidence at all
+    frame.object_masks.clear();
   }
   return frame;
 }

@@ -10,13 +10,16 @@
 //   cameras     <root>/calibration (calib/dataset_calib.h: intrinsics per serial,
 //               extrinsics_<id>; world = DexYCB's common frame), or cameras.file
 //               matched by serial
-//   2D keypoints  <serial>/labels_%06d.npz joint_2d [1,21,2] (SNAP order, pixels; -1 =
-//               no hand in that view) when the sequence has labels files
+//   2D keypoints  <serial>/labels_%06d.npz joint_2d [1,21,2] (SNAP order, pixels; all
+//               -1 = no hand in that view, one (-1, -1) keypoint = unlabelled:
+//               confidence 0) when the sequence has labels files
+//   masks       the labels' seg (0 background, 255 hand, 1..254 YCB object id): the
+//               hand pixels are the view's hand mask (evidence.masks: files), the
+//               object pixels its object mask (evidence.object_masks: files), in memory
 //   ground truth  joint_3d [1,21,3] (metres, camera frame) of the first view with a hand,
 //               moved into the rig's world: keypoints only. Vertices and MANO
 //               parameters (pose_m with the subject's betas) need the user's MANO model
 //               and are not read.
-// Masks are not read (labels' seg is not converted): evidence.masks finds none.
 
 #include <map>
 #include <optional>
@@ -50,6 +53,7 @@ class DexYcbFrameSource : public FrameSource {
   std::vector<std::string> FrameIds() const override;
   FrameInput Load(const std::string& id) const override;
   std::string Describe() const override;
+  std::string KeypointsSource() const override;
   std::optional<HandSide> side() const override;
   const std::vector<DexYcbSequence>& sequences() const { return sequences_; }
 

@@ -13,6 +13,7 @@
 
 #include "core/hand_lbs.h"
 #include "core/keypoints2d.h"
+#include "core/mask_image.h"
 #include "core/rig.h"
 
 namespace handlabel {
@@ -33,6 +34,12 @@ struct FrameInput {
   // Object label maps (0 = none, k = object k), one per rig camera, or empty when the
   // capture has none: pixels where an object may hide the hand.
   std::vector<std::string> object_mask_paths;
+  // Masks a reader decoded itself (a dataset's segmentation inside its label files),
+  // one per rig camera (an empty image: none for that view), or empty. When set they
+  // take the place of mask_paths / object_mask_paths: 255 = hand (masks) or object
+  // (object_masks).
+  std::vector<MaskImage> masks;
+  std::vector<MaskImage> object_masks;
   // 2D keypoints from files, one entry per rig camera (nullopt: none for that view);
   // empty when the capture has no keypoint files. Unknown keypoints: confidence 0 and
   // position 0.
@@ -50,6 +57,10 @@ class FrameSource {
   virtual FrameInput Load(const std::string& id) const = 0;
   // One line for logs ("native capture /data/cap1, 8 cameras, 1200 frames").
   virtual std::string Describe() const = 0;
+  // Where the frames' 2D keypoints (FrameInput::keypoints_2d) come from, for logs and
+  // the job summary ("labels_*.npz joint_2d", "detections folder /d"); "" when the
+  // capture has none (the default).
+  virtual std::string KeypointsSource() const { return ""; }
   // Which hand the capture shows, when it says (the hand model is built for it);
   // nullopt: the right hand.
   virtual std::optional<HandSide> side() const { return std::nullopt; }

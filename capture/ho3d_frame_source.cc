@@ -7,6 +7,7 @@
 #include "calib/dataset_calib.h"
 #include "core/errors.h"
 #include "core/hand_model.h"
+#include "core/image_file.h"
 #include "core/pickle_reader.h"
 
 namespace handlabel {
@@ -57,6 +58,41 @@ std::optional<Points3d> JointsInCamera(const fs::path& meta) {
     out.row(k) << v[3 * n], -v[3 * n + 1], -v[3 * n + 2];
   }
   return out;
+}
+
+// <camera>/seg/<fid>.png (or .jpg, HO3D v2); "" if neither exists.
+std::string SegmentationFile(const std::string& camera_dir, const std::string& fid) {
+  for (const char* extension : {".png", ".jpg"}) {
+    const fs::path file = fs::path(camera_dir) / "seg" / (fid + extension);
+    if (fs::is_regular_file(file)) return file.string();
+  }
+  return "";
+}
+
+// HO3D's segmentation picture, as its scripts read it with OpenCV (BGR): channel 0
+// (blue) is the hand, channel 1 (green) the object; a pixel counts above 127 (the
+// mask rule of core/mask_image.h; JPEG-compressed segmentations are not exactly 0/255).
+// Resampled (nearest pixel) to the camera's size when it differs.
+void ReadHo3dSegmentation(const std::string& file, const Camera& camera, MaskImage* hand,
+                          MaskImage* object) {
+  const ImageU8 seg = ReadImageFile(file);
+  if (seg.channels < 3) {
+    throw InputError(file, "(channels)", "an RGB segmentation (blue hand, green object)",
+                     std::to_string(seg.channels) + " channel(s)");
+  }
+  hand->setZero(camera.height(), camera.width());
+  object->setZero(camera.height(), camera.width());
+  for (int y = 0; y < camera.height(); ++y) {
+    const int sy =
+        static_cast<int>(static_cast<int64_t>(y) * seg.height / camera.height());
+    for (int x = 0; x < camera.width(); ++x) {
+      const int sx =
+          static_cast<int>(static_cast<int64_t>(x) * seg.width / camera.width());
+      const size_t at = seg.index(sx, sy, 0);
+      (*hand)(y, x) = seg.data[at + 2] > 127 ? 255 : 0;  // RGB order: blue is last
+      (*object)(y, x) = seg.data[at + 1] > 127 ? 255 : 0;
+    }
+  }
 }
 
 }  // namespace
@@ -156,8 +192,8 @@ std::string Ho3dFrameSource::Describe() const {
          (sequences_.size() == 1 ? "" : "s") + ", " +
          std::to_string(sequences_.front().rig.size()) + " cameras, " +
          std::to_string(frames) +
-         " frames, right hand, 2D keypoints: none, masks: none, ground truth: meta "
-         "handJoints3D where present)";
+         " frames, right hand, 2D keypoints: none, hand and object masks: seg/<fid>.png "
+         "where present, ground truth: meta handJoints3D where present)";
 }
 
 FrameInput Ho3dFrameSource::Load(const std::string& id) const {
@@ -187,6 +223,18 @@ FrameInput Ho3dFrameSource::Load(const std::string& id) const {
                        "missing");
     }
     frame.image_paths.push_back(image);
+    const std::string seg = SegmentationFile(seq.camera_dirs[v], fid);
+    frame.masks.emplace_back();
+    frame.object_masks.emplace_back();
+    if (!seg.empty()) {
+      ReadHo3dSegmentation(seg, seq.rig[v].camera, &frame.masks.back(),
+                           &frame.object_masks.back());
+    }
+  }
+  const auto empty = [](const MaskImage& m) { return m.size() == 0; };
+  if (std::all_of(frame.masks.begin(), frame.masks.end(), empty)) {
+    frame.masks.clear();  // no segmentation in any view
+    frame.object_masks.clear();
   }
   for (size_t v = 0; v < seq.rig.size() && !frame.ground_truth; ++v) {
     const std::optional<Points3d> in_camera =

@@ -15,8 +15,10 @@
 //               order + tips) of the first camera that has it, turned into OpenCV axes,
 //               SNAP order and the rig's world: keypoints only (vertices and MANO
 //               parameters need the user's MANO model and are not read)
-// No 2D keypoint files and no masks: HO3D has none (its seg/ is not read). HO3D shows
-// right hands only.
+//   masks       <SEQ><i>/seg/<fid>.png (or .jpg) where present: blue = hand (the
+//               view's hand mask), green = object (its object mask), in memory
+// No 2D keypoint files: HO3D has none (a label job takes them from
+// evidence.detections). HO3D shows right hands only.
 
 #include <map>
 #include <optional>

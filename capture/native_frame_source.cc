@@ -62,6 +62,11 @@ std::string NativeFrameSource::Describe() const {
          ", ground truth: " + (reader_.Has(kFileGroundTruth) ? "yes" : "no") + ")";
 }
 
+std::string NativeFrameSource::KeypointsSource() const {
+  return keypoint_kind_.empty() ? ""
+                                : keypoint_kind_ + "/{frame}.json of " + reader_.dir();
+}
+
 std::optional<HandSide> NativeFrameSource::side() const {
   return reader_.manifest().hand_side == "left" ? HandSide::kLeft : HandSide::kRight;
 }

@@ -30,6 +30,7 @@ class NativeFrameSource : public FrameSource {
   std::vector<std::string> FrameIds() const override;
   FrameInput Load(const std::string& id) const override;
   std::string Describe() const override;
+  std::string KeypointsSource() const override;
   std::optional<HandSide> side() const override;
   const CaptureReader& reader() const { return reader_; }
 

@@ -43,6 +43,7 @@ constexpr KnownGlobal kKnownGlobals[] = {
     {"scipy.sparse", "csr_matrix", Global::kCsrMatrix, DType::kUInt8},
     {"torch._utils", "_rebuild_tensor_v2", Global::kRebuildTensorV2, DType::kUInt8},
     {"torch._utils", "_rebuild_parameter", Global::kRebuildParameter, DType::kUInt8},
+    {"torch.storage", "_load_from_bytes", Global::kLoadFromBytes, DType::kUInt8},
     {"torch", "FloatStorage", Global::kStorage, DType::kFloat32},
     {"torch", "DoubleStorage", Global::kStorage, DType::kFloat64},
     {"torch", "HalfStorage", Global::kStorage, DType::kFloat16},

@@ -32,6 +32,7 @@ enum class Global {
   kRebuildTensorV2,
   kRebuildParameter,
   kStorage,
+  kLoadFromBytes,  // torch.storage._load_from_bytes: a storage saved inside the pickle
 };
 
 // Finds module.name (numpy.core and numpy._core, __builtin__ and builtins alike).

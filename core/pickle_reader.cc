@@ -11,6 +11,7 @@
 #include "core/pickle_globals.h"
 #include "core/pickle_graph.h"
 #include "core/utf8.h"
+#include "core/zip_reader.h"
 
 namespace handlabel {
 namespace {
@@ -26,13 +27,20 @@ using pickle::PickleOpcodeName;
 
 class Reader {
  public:
-  Reader(const std::string& bytes, const std::string& source, const PickleLimits& limits)
-      : in_(bytes), source_(source), limits_(limits) {}
+  // Reads the pickle that starts at byte `start` of `bytes` (torch's legacy format
+  // holds several pickles one after another).
+  Reader(const std::string& bytes, const std::string& source, const PickleLimits& limits,
+         size_t start = 0)
+      : in_(bytes), source_(source), limits_(limits), pos_(start) {}
 
   PickleValue Run() {
     const int root = Execute();
     return ConvertPickleGraph(nodes_, root, source_, limits_);
   }
+  // Runs the opcodes up to STOP and returns the root node unconverted (a torch
+  // storage stays a storage); end() is then the offset after STOP.
+  Node RunToNode() { return nodes_[Execute()]; }
+  size_t end() const { return pos_; }
 
  private:
   // ---- errors --------------------------------------------------------------------
@@ -433,12 +441,25 @@ class Reader {
         if (t->shape.size() != t->stride.size()) {
           Fail("as many strides as dimensions", "a mismatch");
         }
+        const std::shared_ptr<NdArray> storage = N(args[0]).array;
+        if (storage) {  // the storage came with the pickle: the tensor is plain data
+          const int id = NewNode(NodeKind::kArray);
+          N(id).array = TensorFromStorage(*t, *storage);
+          N(id).global_name = "torch.Tensor";
+          return id;
+        }
         const int id = NewNode(NodeKind::kTensor);
         N(id).tensor = t;
         return id;
       }
+      case Global::kLoadFromBytes: {
+        if (args.size() != 1) Fail("_load_from_bytes(bytes)", "other arguments");
+        const std::string saved = BytesOf(args[0], "saved storage");  // a copy
+        return LoadStorageFromBytes(saved);
+      }
       case Global::kRebuildParameter: {
-        if (args.empty() || N(args[0]).kind != NodeKind::kTensor) {
+        if (args.empty() || (N(args[0]).kind != NodeKind::kTensor &&
+                             N(args[0]).kind != NodeKind::kArray)) {
           Fail("_rebuild_parameter(tensor, ...)", "other arguments");
         }
         return args[0];
@@ -488,14 +509,16 @@ class Reader {
   }
 
   int PersistentLoad(int pid) {
-    // torch.save: ('storage', <Type>Storage, key, location, numel)
+    // torch.save: ('storage', <Type>Storage, key, location, numel); the legacy
+    // (pre-zip) format adds view_metadata, None for a whole storage.
     const std::vector<int>& t = TupleOf(pid, "persistent id");
-    if (t.size() != 5 || !IsText(t[0]) ||
+    const bool legacy = t.size() == 6 && N(t[5]).kind == NodeKind::kNone;
+    if ((t.size() != 5 && !legacy) || !IsText(t[0]) ||
         TextOf(t[0], "persistent id tag") != "storage" ||
         N(t[1]).kind != NodeKind::kGlobal || N(t[1]).global != Global::kStorage) {
       Fail(
           "a torch storage persistent id ('storage', torch.<Type>Storage, key, "
-          "location, numel)",
+          "location, numel[, None])",
           "another persistent id");
     }
     auto ref = std::make_shared<TensorRef>();
@@ -507,6 +530,157 @@ class Reader {
     const int id = NewNode(NodeKind::kStorage);
     N(id).tensor = ref;
     return id;
+  }
+
+  // ---- torch storages saved inside the pickle (torch.storage._load_from_bytes) ----
+  // Pickling a tensor with plain pickle (not torch.save) stores its storage as
+  // _load_from_bytes(torch.save(storage)): the legacy torch.save format (magic number,
+  // protocol 1001, sys_info, the storage's persistent id, its key list, then per key an
+  // int64 element count and the raw little-endian elements) or the zip form
+  // (<name>/data.pkl + <name>/data/<key>). Only a single whole storage is accepted;
+  // every count is checked against the bytes present before anything is allocated.
+  int LoadStorageFromBytes(const std::string& saved) {
+    const std::string what = source_ + " (saved torch storage)";
+    Node storage;
+    std::string data;
+    if (LooksLikeZip(saved)) {
+      const ZipReader zip = ZipReader::FromBytes(saved, what);
+      const ZipEntry* pkl = nullptr;
+      for (const ZipEntry& e : zip.entries()) {
+        const size_t n = e.name.size();
+        if (n >= 8 && e.name.compare(n - 8, 8, "data.pkl") == 0 &&
+            (n == 8 || e.name[n - 9] == '/'))
+          pkl = &e;
+      }
+      if (!pkl) Fail("a torch.save archive with data.pkl", "none in the saved storage");
+      const std::string pickled = zip.Read(*pkl);
+      storage = Reader(pickled, what, limits_).RunToNode();
+      RequireSavedStorage(storage);
+      const std::string prefix = pkl->name.substr(0, pkl->name.size() - 8);
+      const std::string entry = prefix + "data/" + storage.tensor->storage_key;
+      if (!zip.Find(entry)) Fail("the storage entry " + entry, "none");
+      data = zip.Read(entry);
+    } else {
+      size_t pos = SkipTorchMagic(saved);
+      Reader version(saved, what, limits_, pos);
+      const PickleValue protocol = version.Run();
+      if (protocol.kind != PickleValue::Kind::kInt || protocol.integer != 1001) {
+        Fail("torch legacy protocol version 1001", protocol.Describe());
+      }
+      Reader sys_info(saved, what, limits_, version.end());
+      const PickleValue info = sys_info.Run();
+      const PickleValue* little = info.Find("little_endian");
+      if (little && little->kind == PickleValue::Kind::kBool && !little->boolean) {
+        Fail("a storage saved on a little-endian machine", "big-endian");
+      }
+      Reader main(saved, what, limits_, sys_info.end());
+      storage = main.RunToNode();
+      RequireSavedStorage(storage);
+      Reader keys(saved, what, limits_, main.end());
+      const PickleValue key_list = keys.Run();
+      if (key_list.kind != PickleValue::Kind::kList || key_list.items.size() != 1 ||
+          key_list.items[0].kind != PickleValue::Kind::kText ||
+          key_list.items[0].text != storage.tensor->storage_key) {
+        Fail("the key list ['" + storage.tensor->storage_key + "']", key_list.Describe());
+      }
+      pos = keys.end();
+      if (saved.size() - pos < 8) Fail("the storage's element count", "end of data");
+      int64_t count = 0;
+      for (int k = 7; k >= 0; --k)
+        count = (count << 8) | static_cast<uint8_t>(saved[pos + k]);
+      pos += 8;
+      if (count != storage.tensor->storage_numel) {
+        Fail(std::to_string(storage.tensor->storage_numel) + " stored elements",
+             std::to_string(count));
+      }
+      data = saved.substr(pos);
+    }
+    const int64_t itemsize = FixedDTypeSize(storage.tensor->dtype);
+    const int64_t numel = storage.tensor->storage_numel;
+    if (numel > limits_.max_total_bytes / itemsize ||
+        static_cast<int64_t>(data.size()) != numel * itemsize) {
+      Fail(std::to_string(numel) + " elements of " + std::to_string(itemsize) +
+               " bytes in the saved storage",
+           std::to_string(data.size()) + " bytes");
+    }
+    ChargeBytes(data.size());
+    auto array = std::make_shared<NdArray>();
+    array->dtype = storage.tensor->dtype;
+    array->itemsize = itemsize;
+    array->shape = {numel};
+    array->data.assign(data.begin(), data.end());
+    const int id = NewNode(NodeKind::kStorage);
+    N(id).tensor = storage.tensor;
+    N(id).array = array;
+    return id;
+  }
+
+  // The legacy format's first pickle: the magic number 0x1950a86a20f9469cfc6c (a
+  // 10-byte LONG1). Returns the offset after it.
+  size_t SkipTorchMagic(const std::string& saved) {
+    static const unsigned char kMagic[] = {0x8a, 0x0a, 0x6c, 0xfc, 0x9c, 0x46, 0xf9,
+                                           0x20, 0x6a, 0xa8, 0x50, 0x19, '.'};
+    size_t pos = 0;
+    if (saved.size() >= 2 && static_cast<uint8_t>(saved[0]) == 0x80) pos = 2;  // PROTO
+    if (saved.size() < pos + sizeof(kMagic) ||
+        std::memcmp(saved.data() + pos, kMagic, sizeof(kMagic)) != 0) {
+      Fail("torch.save bytes (zip, or the legacy magic number)", "other bytes");
+    }
+    return pos + sizeof(kMagic);
+  }
+
+  void RequireSavedStorage(const Node& storage) {
+    if (storage.kind != NodeKind::kStorage || !storage.tensor) {
+      Fail("a saved torch storage", DescribeNode(storage));
+    }
+  }
+
+  // The elements of a tensor view of an in-memory storage, in C order. Offsets and
+  // strides are checked against the storage before anything is read.
+  std::shared_ptr<NdArray> TensorFromStorage(const TensorRef& t, const NdArray& storage) {
+    const int64_t stored = storage.shape[0];
+    int64_t numel = 1, last = t.storage_offset;
+    for (size_t d = 0; d < t.shape.size(); ++d) {
+      if (t.shape[d] < 0 || t.stride[d] < 0) {
+        Fail("non-negative tensor sizes and strides", "a negative one");
+      }
+      if (t.shape[d] == 0) {
+        numel = 0;
+        continue;
+      }
+      if (t.stride[d] > 0 && t.shape[d] - 1 > stored / t.stride[d]) {
+        Fail("a tensor view inside its storage", "strides beyond it");
+      }
+      last += (t.shape[d] - 1) * t.stride[d];  // each term <= stored: no overflow
+      if (numel > 0 && t.shape[d] > limits_.max_total_bytes / numel) {
+        Fail("a tensor within the size limit", "a larger one");
+      }
+      numel *= t.shape[d];
+    }
+    if (numel > 0 &&
+        (t.storage_offset < 0 || t.storage_offset > stored || last >= stored)) {
+      Fail("a tensor view inside its storage of " + std::to_string(stored) + " elements",
+           "element " + std::to_string(last));
+    }
+    auto a = std::make_shared<NdArray>();
+    a->dtype = storage.dtype;
+    a->itemsize = storage.itemsize;
+    a->shape = t.shape;
+    ChargeBytes(static_cast<uint64_t>(numel * a->itemsize));
+    a->data.resize(static_cast<size_t>(numel * a->itemsize));
+    std::vector<int64_t> index(t.shape.size(), 0);
+    for (int64_t i = 0; i < numel; ++i) {
+      int64_t at = t.storage_offset;
+      for (size_t d = 0; d < index.size(); ++d) at += index[d] * t.stride[d];
+      std::memcpy(a->data.data() + i * a->itemsize,
+                  storage.data.data() + at * a->itemsize,
+                  static_cast<size_t>(a->itemsize));
+      for (size_t d = index.size(); d-- > 0;) {  // next index in C order
+        if (++index[d] < t.shape[d]) break;
+        index[d] = 0;
+      }
+    }
+    return a;
   }
 
   // ---- protocol 0 text arguments -------------------------------------------------

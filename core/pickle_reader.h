@@ -12,7 +12,14 @@
 //   builtins.set / frozenset / bytes / bytearray / object, _codecs.encode,
 //   copy_reg._reconstructor, collections.OrderedDict, chumpy.ch.Ch,
 //   chumpy.reordering.Select, scipy.sparse.{csc,_csc,csr,_csr}.{csc,csr}_matrix,
-//   torch._utils._rebuild_tensor_v2 / _rebuild_parameter, torch.<Type>Storage.
+//   torch._utils._rebuild_tensor_v2 / _rebuild_parameter, torch.<Type>Storage,
+//   torch.storage._load_from_bytes.
+// Tensors: inside a torch.save archive they stay references (kTensor, read through
+// torch_archive.h); a tensor pickled with plain pickle carries its storage as
+// _load_from_bytes(<torch.save bytes>) (legacy or zip form), which is decoded here:
+// such a tensor becomes a plain array (kArray, C order), after checking the stored
+// element count against the bytes present and the view's offset and strides against
+// the storage. Nothing else of torch.save is accepted.
 // Limits: every length is checked against the bytes left before anything is
 // allocated; the number of values, the container nesting depth and the total bytes
 // of decoded arrays are capped (PickleLimits).

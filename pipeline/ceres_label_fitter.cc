@@ -125,17 +125,25 @@ HandFitInput CeresLabelFitter::Evidence(const LabelFitRequest& request,
     for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
       if (request.keypoints_2d[v]) input.masks.push_back(request.masks[v]);
     }
-  } else if (options_.use_masks && !frame.mask_paths.empty()) {
+  } else if (options_.use_masks && (!frame.mask_paths.empty() || !frame.masks.empty())) {
+    // Masks the reader decoded (frame.masks) or mask files.
     *silhouettes = "files";
     for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
       if (!request.keypoints_2d[v]) continue;
-      input.masks.push_back(
-          frame.mask_paths[v].empty() ? MaskImage() : ReadMaskPng(frame.mask_paths[v]));
+      input.masks.push_back(!frame.masks.empty() ? frame.masks[v]
+                            : frame.mask_paths[v].empty()
+                                ? MaskImage()
+                                : ReadMaskPng(frame.mask_paths[v]));
     }
-    if (options_.use_object_masks && !frame.object_mask_paths.empty()) {
+    if (options_.use_object_masks &&
+        (!frame.object_mask_paths.empty() || !frame.object_masks.empty())) {
       *silhouettes = "files+object_masks";
       for (size_t v = 0; v < request.keypoints_2d.size(); ++v) {
         if (!request.keypoints_2d[v]) continue;
+        if (!frame.object_masks.empty()) {
+          input.occluder_masks.push_back(frame.object_masks[v]);
+          continue;
+        }
         const std::string& path = frame.object_mask_paths[v];
         input.occluder_masks.push_back(path.empty() ? MaskImage()
                                                     : ReadObjectMaskPng(path));

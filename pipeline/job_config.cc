@@ -151,6 +151,7 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
   }
   job->object_masks = object_masks == "files";
   evidence.Read("ignore_views", &job->ignore_views);
+  evidence.Read("detections", &job->detections);
   if (!(job->network_mask_sigma_px >= 0)) {
     throw InputError(path, evidence.Name("network_mask_sigma_px"),
                      "> 0 pixels, or 0 for the default",
@@ -296,6 +297,7 @@ JobConfig LoadJobConfig(const std::string& path) {
 
   job.input_path = Resolve(job.input_path, base);
   job.cameras_file = Resolve(job.cameras_file, base);
+  job.detections = Resolve(job.detections, base);
   if (job.hand_model != "capsule")
     job.hand_model = Resolve(job.hand_model, base);  // built-in
   job.network_weights = Resolve(job.network_weights, base);

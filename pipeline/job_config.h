@@ -93,6 +93,12 @@ struct JobConfig {
   // evidence.object_masks: files (default: where the capture has object masks, pixels
   // behind objects do not count against the silhouette fit) | none.
   bool object_masks = true;
+  // evidence.detections: a folder of 2D detections in the native format, <frame
+  // id>.json per frame (capture/detections_frame_source.h; `handlabel detect` writes
+  // them): the job's 2D keypoints, replacing the capture's. Required for input
+  // formats without 2D keypoints (ho3d, oakink, dexycb without labels files): a job
+  // never runs from no 2D. Empty = the capture's own 2D.
+  std::string detections;
   // Camera names whose 2D keypoints and masks are not fitted to (a broken camera).
   std::vector<std::string> ignore_views;
   // Silhouette residual scale (pixels per unit) for the network's masks. In the file

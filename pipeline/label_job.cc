@@ -120,6 +120,7 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   }
   if (!job.fit.IsDefault()) extra["fit"] = FitSettingsJson(job.fit);
   if (!job.object_masks) extra["object_masks"] = "none";
+  if (!job.detections.empty()) extra["detections"] = job.detections;
   if (!extra.empty()) j["added"] = extra;
   return Sha256Hex(j.dump());
 }
@@ -448,15 +449,29 @@ class LabelJobRun {
     }
   }
 
+  // What the job's 2D keypoints are: the capture's (or evidence.detections'), the
+  // network's, or both (evidence.keypoints_2d).
+  std::string KeypointsSourceText() const {
+    const std::string files = stages_.source->KeypointsSource();
+    const std::string own = stages_.predictor ? "the network's own 2D" : "";
+    if (job_.keypoints == KeypointSource::kNetwork) return own;
+    if (job_.keypoints == KeypointSource::kFiles) return files.empty() ? "none" : files;
+    return files.empty() ? own : files + ", else " + own;
+  }
+
   // The shard's summary file, the merge of a whole-job run, the closing lines.
   LabelSummary Finish(double wall_seconds) const {
     LabelSummary summary = Summarize(mine_, ReadShardLogs(out_));
+    summary.keypoints_2d_source = KeypointsSourceText();
     summary.skipped = done_before_;
     summary.wall_seconds = wall_seconds;
     WriteFileAtomically(ShardSummaryPath(out_, options_.shard),
                         summary.ToJson().dump(1) + "\n");
     const bool whole_job = options_.shard.count == 1;
-    if (whole_job) MergeLabelOutputs(out_, job_.name, job_hash_, all_frames_);
+    if (whole_job) {
+      MergeLabelOutputs(out_, job_.name, job_hash_, all_frames_,
+                        summary.keypoints_2d_source);
+    }
     if (!options_.log) return summary;
     *options_.log << summary.ToText();
     if (whole_job) {

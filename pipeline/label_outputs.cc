@@ -72,7 +72,8 @@ std::map<std::string, FrameRecord> ReadShardLogs(const std::string& output_dir) 
 
 LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string& job_name,
                                const std::string& job_hash,
-                               const std::vector<std::string>& frames) {
+                               const std::vector<std::string>& frames,
+                               const std::string& keypoints_2d_source) {
   std::map<std::string, FrameRecord> records = ReadShardLogs(output_dir);
   nlohmann::json entries = nlohmann::json::array();
   for (const std::string& frame : frames) {
@@ -97,6 +98,7 @@ LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string&
     entries.push_back(entry);
   }
   LabelSummary summary = Summarize(frames, records);
+  summary.keypoints_2d_source = keypoints_2d_source;
   const nlohmann::json manifest = {{"format", "handlabel-manifest"},
                                    {"format_version", 1},
                                    {"job", job_name},

@@ -36,9 +36,11 @@ std::map<std::string, FrameRecord> ReadShardLogs(const std::string& output_dir);
 // label file is missing counts as missing. Writes manifest.json (frames, status, path,
 // label file, reason: nothing run-dependent, so it is identical however the job was
 // sharded), summary.json and summary.md, each atomically, and returns the summary.
+// `keypoints_2d_source` (FrameSource::KeypointsSource) is stated in the summary.
 LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string& job_name,
                                const std::string& job_hash,
-                               const std::vector<std::string>& frames);
+                               const std::vector<std::string>& frames,
+                               const std::string& keypoints_2d_source = "");
 
 // Removes leftovers of interrupted atomic writes that belong to `frames` (never other
 // shards' files, which may be in flight). Returns how many were removed.

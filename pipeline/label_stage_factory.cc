@@ -1,5 +1,6 @@
 #include "pipeline/label_stage_factory.h"
 
+#include "capture/detections_frame_source.h"
 #include "capture/dexycb_frame_source.h"
 #include "capture/ho3d_frame_source.h"
 #include "capture/native_frame_source.h"
@@ -51,10 +52,10 @@ LabelStageSet BuiltLabelStages::Set() const {
   return set;
 }
 
-std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
-  std::optional<Rig> cameras;
-  if (job.cameras_source == "file")
-    cameras = ReadCamerasFile(job.cameras_file, job.source_file);
+namespace {
+
+std::unique_ptr<FrameSource> BuildCaptureSource(const JobConfig& job,
+                                                const std::optional<Rig>& cameras) {
   if (job.input_format == "native") {
     return std::make_unique<NativeFrameSource>(job.input_path, cameras,
                                                job.keypoint_files, job.mask_files);
@@ -70,6 +71,30 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
   }
   throw InputError(job.source_file, "input.format", "native | dexycb | ho3d | oakink",
                    "'" + job.input_format + "'");
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
+  std::optional<Rig> cameras;
+  if (job.cameras_source == "file")
+    cameras = ReadCamerasFile(job.cameras_file, job.source_file);
+  std::unique_ptr<FrameSource> source = BuildCaptureSource(job, cameras);
+  if (!job.detections.empty()) {
+    source = std::make_unique<DetectionsFrameSource>(
+        std::move(source), job.detections, job.source_file + ": evidence.detections");
+  }
+  // A dataset without 2D keypoints gives the network nothing to crop on and the fit
+  // nothing to fit: the job must name its 2D.
+  if (job.input_format != "native" && source->KeypointsSource().empty()) {
+    throw InputError(job.source_file, "evidence.detections",
+                     "a folder of 2D detections (<frame id>.json, the native detections "
+                     "format that `handlabel detect` writes): input " +
+                         job.input_format + " at " + job.input_path +
+                         " has no 2D keypoints, and a job never runs without 2D",
+                     "none");
+  }
+  return source;
 }
 
 BuiltLabelStages BuildLabelStages(const JobConfig& job) {

@@ -86,6 +86,7 @@ nlohmann::json LabelSummary::ToJson() const {
   for (const auto& [frame, reason] : failures)
     fails.push_back({{"frame", frame}, {"reason", reason}});
   j["failures"] = fails;
+  if (!keypoints_2d_source.empty()) j["keypoints_2d_source"] = keypoints_2d_source;
   nlohmann::json groups = nlohmann::json::object();
   for (const auto& [group, metrics] : this->metrics) {
     nlohmann::json g = {{"frames", GroupFrames(metrics)}};
@@ -104,6 +105,8 @@ std::string LabelSummary::ToText() const {
   if (missing > 0) out << ", " << missing << " not yet run";
   if (skipped > 0) out << ", " << skipped << " skipped (done before)";
   out << "\n";
+  if (!keypoints_2d_source.empty())
+    out << "2D keypoints: " << keypoints_2d_source << "\n";
   if (wall_seconds > 0) {
     out << "time: " << Number(wall_seconds, 1) << " s wall, " << Number(frame_seconds, 1)
         << " s summed over frames\n";
@@ -134,6 +137,8 @@ std::string LabelSummary::ToMarkdown() const {
          "|\n|---|---|---|---|---|\n"
       << "| " << frames << " | " << ok << " | " << failed << " | " << missing << " | "
       << Number(frame_seconds, 1) << " |\n\n";
+  if (!keypoints_2d_source.empty())
+    out << "2D keypoints: " << keypoints_2d_source << "\n\n";
   if (!by_path.empty()) {
     out << "| path | frames |\n|---|---|\n";
     for (const auto& [path, count] : by_path)

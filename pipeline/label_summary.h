@@ -37,6 +37,9 @@ struct LabelSummary {
   double wall_seconds = 0;             // wall time of this run (0 for a merge)
   int skipped = 0;                     // done in an earlier run and skipped (run only)
   std::vector<std::pair<std::string, std::string>> failures;  // frame, reason
+  // Where the job's 2D keypoints came from (FrameSource::KeypointsSource, or the
+  // network's own); empty when not known (a merge without the job's source).
+  std::string keypoints_2d_source;
   // group -> metric -> mean over frames
   std::map<std::string, std::map<std::string, MetricMean>> metrics;
 

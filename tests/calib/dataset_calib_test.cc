@@ -3,6 +3,7 @@
 // holds what numpy computed for each camera.
 #include "calib/dataset_calib.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -55,9 +56,63 @@ TEST(DatasetCalib, DexYcbFromExtrinsicsFileOrMeta) {
       Truth("dexycb"), 1e-12);
 }
 
-TEST(DatasetCalib, Ho3dCalibrationFolder) {
+// The fixture's cam_orders.txt is 1 3 2 4 0: camera ABF1<order[i]> takes trans_<i> and
+// cam_<i>_intrinsics (HO3D's viewer). Reading trans_<order[i]> instead (the pairing
+// this reader had) gives four wrong cameras and fails here.
+TEST(DatasetCalib, Ho3dCalibrationFolderPairsFilesByPositionInCamOrders) {
+  const nlohmann::json truth = Truth("ho3d");
+  ASSERT_EQ(truth[0]["name"], "ABF11");  // the fixture's order is not the identity
   ExpectMatchesTruth(ReadDatasetRig("ho3d", kData + "/ho3d/calibration/ABF1/calibration"),
-                     Truth("ho3d"), 1e-12);
+                     truth, 1e-12);
+}
+
+// cam_orders.txt as np.loadtxt reads it: whitespace (one line or one per line, np.savetxt
+// style), not commas; every index once.
+TEST(DatasetCalib, Ho3dCamOrdersAsNumpyReadsThem) {
+  const std::string dir = testing::ScratchDir();
+  fs::copy(kData + "/ho3d", dir + "/ho3d", fs::copy_options::recursive);
+  const std::string ho3d = dir + "/ho3d/calibration/ABF1/calibration";
+  std::ofstream(ho3d + "/cam_orders.txt") << "1.000000000000000000e+00\n3\n2\n4\n0\n";
+  ExpectMatchesTruth(ReadDatasetRig("ho3d", ho3d), Truth("ho3d"), 1e-12);
+  const auto error_of = [&](const std::string& text) {
+    std::ofstream(ho3d + "/cam_orders.txt") << text;
+    try {
+      ReadDatasetRig("ho3d", ho3d);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(error_of("1,3,2,4,0\n"),
+              ::testing::AllOf(::testing::HasSubstr("cam_orders.txt"),
+                               ::testing::HasSubstr("np.loadtxt")));
+  EXPECT_THAT(error_of("1 3 1 4 0\n"), ::testing::HasSubstr("1 twice"));
+  EXPECT_THAT(error_of("1 3 2 4 0 5\n"), ::testing::HasSubstr("trans_5.txt"));
+}
+
+// DexYCB: the extrinsics file alone lists the apriltag entry (not a camera), and a
+// second intrinsics size beside 640x480 is not taken; two sizes without 640x480 are an
+// error, one other size is taken as it is.
+TEST(DatasetCalib, DexYcbSkipsTheTagAndTakes640x480) {
+  const std::string dir = testing::ScratchDir();
+  fs::copy(kData + "/dexycb", dir + "/dexycb", fs::copy_options::recursive);
+  const std::string extr =
+      dir + "/dexycb/calibration/extrinsics_20200709-subject-01/extrinsics.yml";
+  const std::string intrinsics = dir + "/dexycb/calibration/intrinsics/836212060125";
+  const Rig rig = ReadDatasetRig("dexycb", extr);
+  ASSERT_EQ(rig.size(), 3u);
+  EXPECT_LT(rig.IndexOf("apriltag"), 0);
+  EXPECT_EQ(rig[0].camera.width(), 640);
+  fs::rename(intrinsics + "_640x480.yml", intrinsics + "_320x240.yml");
+  try {
+    ReadDatasetRig("dexycb", extr);
+    FAIL() << "two sizes without 640x480";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("836212060125_1280x720.yml, "
+                                               "836212060125_320x240.yml"));
+  }
+  fs::remove(intrinsics + "_1280x720.yml");
+  EXPECT_EQ(ReadDatasetRig("dexycb", extr)[0].camera.width(), 320);
 }
 
 TEST(DatasetCalib, OakInkPicklesThroughTheRestrictedReader) {
@@ -75,6 +130,7 @@ TEST(DatasetCalib, BrokenFilesNameFileAndField) {
   const std::string extr =
       dir + "/dexycb/calibration/extrinsics_20200709-subject-01/extrinsics.yml";
   fs::remove(dir + "/dexycb/calibration/intrinsics/839512060362_640x480.yml");
+  fs::remove(dir + "/dexycb/calibration/intrinsics/839512060362_1280x720.yml");
   try {
     ReadDatasetRig("dexycb", extr);
     FAIL();

@@ -78,17 +78,20 @@ inline Ho3dFixture WriteHo3dFixture(const std::string& root, int num_frames = 2,
   fx.split = root + "/train";
   const std::string calib = root + "/calibration/ABF1/calibration";
   fs::create_directories(calib);
+  // As in HO3D: the files with index i belong to camera folder ABF1<order[i]>, and the
+  // order is not the identity; whitespace-separated (np.loadtxt).
   std::ofstream orders(calib + "/cam_orders.txt");
-  for (int c = 0; c < num_cameras; ++c) {
+  for (int i = 0; i < num_cameras; ++i) {
+    const int c = (i + 1) % num_cameras;
     const RigCamera& camera = preset[c];
     fx.rig.Add({"ABF1" + std::to_string(c), camera.camera, camera.cam_from_world});
-    orders << (c ? "," : "") << c;
+    orders << (i ? " " : "") << c;
     const std::vector<double>& k = camera.camera.params();
-    std::ofstream intr(calib + "/cam_" + std::to_string(c) + "_intrinsics.txt");
+    std::ofstream intr(calib + "/cam_" + std::to_string(i) + "_intrinsics.txt");
     intr.precision(17);
     intr << "fx:" << k[0] << ", fy:" << k[1] << ", ppx:" << k[2] << ", ppy:" << k[3]
          << "\n";
-    std::ofstream trans(calib + "/trans_" + std::to_string(c) + ".txt");
+    std::ofstream trans(calib + "/trans_" + std::to_string(i) + ".txt");
     trans.precision(17);
     const Matrix3x4d m = camera.cam_from_world.Inverse().ToMatrix();  // cam -> common
     for (int r = 0; r < 3; ++r)

@@ -73,7 +73,8 @@ TEST(Ho3dFrameSource, TruthFromTheFirstCameraWithFullJoints) {
   w.Str("handJoints3D");
   w.Array({3}, "f4", root_joint, 12);
   w.EndDict();
-  std::ofstream(fx.split + "/ABF10/meta/0000.pkl", std::ios::binary) << w.Finish();
+  std::ofstream(fx.split + "/" + fx.rig[0].name + "/meta/0000.pkl", std::ios::binary)
+      << w.Finish();
   FrameInput frame = Ho3dFrameSource(fx.split + "/ABF1").Load("0000");
   ASSERT_TRUE(frame.ground_truth.has_value());
   EXPECT_THAT(frame.ground_truth->keypoints,
@@ -89,8 +90,9 @@ TEST(Ho3dFrameSource, NumpyWrittenMetaGivesOpenCvAxesAndSnapOrder) {
   const Ho3dFixture fx = WriteHo3dFixture(testing::ScratchDir(), 1);
   for (const RigCamera& camera : fx.rig.cameras())
     fs::remove_all(fx.split + "/" + camera.name + "/meta");
-  fs::create_directories(fx.split + "/ABF11/meta");
-  fs::copy_file(kData + "/meta_0000.pkl", fx.split + "/ABF11/meta/0000.pkl");
+  const std::string meta = fx.split + "/" + fx.rig[1].name + "/meta";
+  fs::create_directories(meta);
+  fs::copy_file(kData + "/meta_0000.pkl", meta + "/0000.pkl");
   const FrameInput frame = Ho3dFrameSource(fx.split + "/ABF1").Load("0000");
   ASSERT_TRUE(frame.ground_truth.has_value());
   std::ifstream in(kData + "/expected.json");
@@ -113,7 +115,7 @@ TEST(Ho3dFrameSource, SplitFolderListsCalibratedSequences) {
   const Ho3dFrameSource source(fx.split);
   EXPECT_EQ(source.FrameIds(), (std::vector<std::string>{"ABF1/0000", "ABF1/0001"}));
   const FrameInput frame = source.Load("ABF1/0001");
-  EXPECT_EQ(frame.image_paths[2], fx.split + "/ABF12/rgb/0001.jpg");
+  EXPECT_EQ(frame.image_paths[2], fx.split + "/" + fx.rig[2].name + "/rgb/0001.jpg");
   EXPECT_THAT(testing::InputErrorOf([&] { source.Load("0001"); }), HasSubstr("frame id"));
   EXPECT_THAT(testing::InputErrorOf([&] { source.Load("ABF1/0002"); }),
               HasSubstr("frame id"));
@@ -130,9 +132,9 @@ TEST(Ho3dFrameSource, BrokenLayoutsNameTheFileAndField) {
   EXPECT_THAT(error, HasSubstr(fx.split + "/ABF12/rgb/0001.jpg"));
   EXPECT_THAT(error, HasSubstr("ABF12"));
   // A broken meta pickle fails its frame, naming it.
-  std::ofstream(fx.split + "/ABF10/meta/0000.pkl") << "garbage";
+  std::ofstream(fx.split + "/" + fx.rig[0].name + "/meta/0000.pkl") << "garbage";
   EXPECT_THAT(testing::InputErrorOf([&] { source.Load("0000"); }),
-              HasSubstr("ABF10/meta/0000.pkl"));
+              HasSubstr(fx.rig[0].name + "/meta/0000.pkl"));
   // A camera folder listed by the calibration is missing.
   fs::rename(fx.split + "/ABF11", fx.split + "/moved");
   error = testing::InputErrorOf([&] { Ho3dFrameSource{fx.split + "/ABF1"}; });

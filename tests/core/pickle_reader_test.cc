@@ -340,3 +340,81 @@ TEST(PickleReader, ReadsPython2TextProtocol) {
 
 }  // namespace
 }  // namespace handlabel
+
+namespace handlabel {
+namespace {
+
+// ---- tensors pickled with plain pickle (torch.storage._load_from_bytes) ------------
+
+// The dict of tests/data/datasets/make_tensor_pickles.py, whichever form it was
+// written in: every tensor becomes a plain array with torch's values.
+void ExpectTensorValues(const PickleValue& v) {
+  ASSERT_EQ(v.kind, K::kDict) << v.Describe();
+  const PickleValue* f32 = v.Find("f32");
+  ASSERT_EQ(f32->kind, K::kArray) << f32->Describe();
+  EXPECT_EQ(f32->array->dtype, DType::kFloat32);
+  EXPECT_EQ(f32->array->shape, (std::vector<int64_t>{3, 3}));
+  for (int i = 0; i < 9; ++i) EXPECT_EQ(f32->array->ToDoubles()[i], i / 8.0);
+  // base = arange(24).reshape(4, 6) * 0.25 - 2; its transpose (strides 1, 6) and
+  // base[1:, 2:4] (offset 8): C order as numpy would give them.
+  const auto base = [](int r, int c) { return (r * 6 + c) * 0.25 - 2; };
+  const NdArray& t = *v.Find("f64_transposed")->array;
+  EXPECT_EQ(t.shape, (std::vector<int64_t>{6, 4}));
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 4; ++c) EXPECT_EQ(t.ToDoubles()[r * 4 + c], base(c, r));
+  }
+  const NdArray& o = *v.Find("f64_offset")->array;
+  EXPECT_EQ(o.shape, (std::vector<int64_t>{3, 2}));
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 2; ++c) EXPECT_EQ(o.ToDoubles()[r * 2 + c], base(r + 1, c + 2));
+  }
+  EXPECT_EQ(v.Find("i64")->array->ToInt64s(),
+            (std::vector<int64_t>{-3, 0, 7, int64_t{1} << 40}));
+  EXPECT_EQ(v.Find("f16")->array->dtype, DType::kFloat16);
+  EXPECT_EQ(v.Find("f16")->array->ToDoubles(), (std::vector<double>{0.5, -1.25, 3.0}));
+  EXPECT_EQ(v.Find("u8")->array->ToInt64s(), (std::vector<int64_t>{0, 255, 7, 9}));
+  EXPECT_EQ(v.Find("scalar")->array->shape, std::vector<int64_t>{});
+  EXPECT_EQ(v.Find("scalar")->array->ToDoubles(), std::vector<double>{2.5});
+  const PickleValue* list = v.Find("nested")->Find("list");
+  ASSERT_EQ(list->items.size(), 1u);
+  EXPECT_EQ(list->items[0].array->ToDoubles(), (std::vector<double>{1, 1}));
+}
+
+TEST(PickleReader, DecodesTensorsPickledWithPlainPickle) {
+  for (const char* name :
+       {"tensors_legacy_p2.pkl", "tensors_legacy_p4.pkl", "tensors_zip.pkl"}) {
+    SCOPED_TRACE(name);
+    ExpectTensorValues(ReadPickleFile(DataPath(std::string("datasets/") + name)));
+  }
+}
+
+TEST(PickleReader, RefusesHostileSavedStorages) {
+  const auto error_of = [](const std::string& name) {
+    return PickleError(testing::ReadFileBytes(DataPath("datasets/" + name)));
+  };
+  std::string error = error_of("tensor_view_beyond_storage.pkl");
+  EXPECT_NE(error.find("inside its storage of 4 elements"), std::string::npos) << error;
+  error = error_of("tensor_count_beyond_bytes.pkl");
+  EXPECT_NE(error.find("4 stored elements"), std::string::npos) << error;
+  error = error_of("tensor_evil_inner_global.pkl");
+  EXPECT_NE(error.find("os.system"), std::string::npos) << error;
+  EXPECT_NE(error.find("saved torch storage"), std::string::npos) << error;
+  // Anything but torch.save bytes, and a truncated storage, fail by name.
+  std::string bytes = testing::ReadFileBytes(DataPath("datasets/tensors_legacy_p4.pkl"));
+  const size_t magic = bytes.find("\x8a\x0a\x6c\xfc"s);
+  ASSERT_NE(magic, std::string::npos);
+  std::string garbled = bytes;
+  garbled[magic + 3] = 'x';
+  error = PickleError(garbled);
+  EXPECT_NE(error.find("legacy magic number"), std::string::npos) << error;
+  // Every truncation of a tensor pickle fails cleanly (or decodes a shorter prefix).
+  for (size_t n = 0; n < bytes.size(); n += 7) PickleError(bytes.substr(0, n));
+  // The element count is checked against the byte budget before allocating.
+  PickleLimits tight;
+  tight.max_total_bytes = 64;
+  error = PickleError(bytes, tight);
+  EXPECT_FALSE(error.empty());
+}
+
+}  // namespace
+}  // namespace handlabel

@@ -44,6 +44,12 @@ for s in serials:
         for key in ("fx", "fy", "ppx", "ppy"):
             f.write(f"  {key}: {k[key]!r}\n")
         f.write("depth:\n  fx: 380.0\n  fy: 380.0\n  ppx: 320.0\n  ppy: 240.0\n")
+    # A second colour size, first in name order, with other values: readers must take
+    # 640x480, as the toolkit does.
+    with open(f"dexycb/calibration/intrinsics/{s}_1280x720.yml", "w") as f:
+        f.write("color:\n")
+        for key in ("fx", "fy", "ppx", "ppy"):
+            f.write(f"  {key}: {2 * k[key]!r}\n")
     common_from_cam = random_pose()
     if s == serials[0]:
         common_from_cam = np.eye(4)  # the master camera defines the common frame
@@ -53,6 +59,9 @@ for s in serials:
     cams.append(dict(name=s, params=[k["fx"], k["fy"], k["ppx"], k["ppy"]],
                      width=640, height=480,
                      cam_from_world=cam_from_world.reshape(-1).tolist()))
+tag = random_pose()  # the AprilTag's pose in the common frame: not a camera
+extr_lines.append("  apriltag: [" + ", ".join(repr(float(v)) for v in tag[:3].reshape(-1)) +
+                  "]\n")
 with open(f"dexycb/calibration/extrinsics_{calib_id}/extrinsics.yml", "w") as f:
     f.write("extrinsics:\n" + "".join(extr_lines) + f"master: '{serials[0]}'\n")
 with open("dexycb/20200709-subject-01/20200709_141754/meta.yml", "w") as f:
@@ -62,21 +71,22 @@ with open("dexycb/20200709-subject-01/20200709_141754/meta.yml", "w") as f:
 truth["dexycb"] = cams
 
 # HO3D v3: calibration/<SEQ>/calibration/ with cam_orders.txt, trans_<i>.txt (4x4
-# camera -> common), cam_<i>_intrinsics.txt.
+# camera -> common), cam_<i>_intrinsics.txt. The files with index i belong to camera
+# folder <SEQ><order[i]> (HO3D's multi-camera viewer); real orders are permutations.
 seq = "ABF1"
 folder = f"ho3d/calibration/{seq}/calibration"
 os.makedirs(folder, exist_ok=True)
-order = [0, 1, 2, 3, 4]
+order = [1, 3, 2, 4, 0]
 with open(f"{folder}/cam_orders.txt", "w") as f:
     f.write(" ".join(str(i) for i in order) + "\n")
 cams = []
-for i in order:
+for i, cam in enumerate(order):
     k = intrinsics()
     with open(f"{folder}/cam_{i}_intrinsics.txt", "w") as f:
         f.write(f"fx:{k['fx']!r}, fy:{k['fy']!r}, ppx:{k['ppx']!r}, ppy:{k['ppy']!r}\n")
     common_from_cam = random_pose()
     np.savetxt(f"{folder}/trans_{i}.txt", common_from_cam, fmt="%.17g")
-    cams.append(dict(name=f"{seq}{i}", params=[k["fx"], k["fy"], k["ppx"], k["ppy"]],
+    cams.append(dict(name=f"{seq}{cam}", params=[k["fx"], k["fy"], k["ppx"], k["ppy"]],
                      width=640, height=480,
                      cam_from_world=np.linalg.inv(common_from_cam)[:3].reshape(-1).tolist()))
 truth["ho3d"] = cams

@@ -1,0 +1,41 @@
+#pragma once
+// 2D detections in the native format beside a capture read in place (a label job's
+// evidence.detections; docs/labeling-jobs.md): for datasets that ship no 2D keypoints
+// (HO3D, OakInk) they are the job's 2D. One file per frame, <folder>/<frame id>.json
+// (ids with '/' are subfolders), in the shape of a native capture's
+// detections/{frame}.json (docs/capture-format.md), which `handlabel detect` writes.
+// Views are matched to the rig's cameras by name; a keypoint with confidence 0 or a
+// null position is unknown; a camera without a view in the file has no 2D.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "capture/frame_source.h"
+
+namespace handlabel {
+
+class DetectionsFrameSource : public FrameSource {
+ public:
+  // Reads frames from `inner` and their 2D keypoints from `folder` (which must exist;
+  // InputError naming `field` otherwise), replacing any the capture has.
+  DetectionsFrameSource(std::unique_ptr<FrameSource> inner, const std::string& folder,
+                        const std::string& field = "evidence.detections");
+  std::vector<std::string> FrameIds() const override { return inner_->FrameIds(); }
+  // Throws InputError naming the detection file when it is missing or malformed.
+  FrameInput Load(const std::string& id) const override;
+  std::string Describe() const override;
+  std::string KeypointsSource() const override;
+  std::optional<HandSide> side() const override { return inner_->side(); }
+
+ private:
+  std::unique_ptr<FrameSource> inner_;
+  std::string folder_;
+};
+
+// One frame's detections file in rig order (nullopt: no view for that camera).
+std::vector<std::optional<Keypoints2d>> ReadDetectionsFile(const std::string& path,
+                                                           const Rig& rig);
+
+}  // namespace handlabel
