@@ -6,14 +6,18 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <set>
+#include <sstream>
 
 #include "core/data_dir.h"
 #include "core/hand_model.h"
 #include "core/hand_model_io.h"
 #include "core/image.h"
+#include "core/image_file.h"
 #include "core/mesh_render.h"
 #include "network/tflite_model.h"
 
@@ -190,6 +194,53 @@ TEST(TfliteMediapipeModels, PalmDetectorFindsTheRenderedPalm) {
     const float grey_logit =
         BestPalm(model->Run({ResizedInput(ImageU8(224, 224, 3, 128), 192)}), &centre);
     EXPECT_LT(grey_logit, 0.0f) << name << " on a grey image";
+  }
+}
+
+// Not a test: writes inputs and our outputs for the peer check against TFLite's own
+// runtime (tests/network/tflite_peer_parity.mjs; docs/model-card-mediapipe-hands.md):
+//   HANDLABEL_TFLITE_PARITY_DIR=/tmp/parity [HANDLABEL_TFLITE_PARITY_IMAGES=a.jpg:b.png]
+//   build/tests/network_tests --gtest_also_run_disabled_tests \
+//       --gtest_filter='*WritePeerParityFiles'
+// Inputs: the rendered hand, seeded noise, grey, and the listed images, each resized
+// (nearest) to the model's input; files in_<size>_<name>.bin (float32 NHWC) and
+// ours_<model>_<name>.bin (all outputs concatenated, float32).
+TEST(TfliteMediapipeModels, DISABLED_WritePeerParityFiles) {
+  REQUIRE_MEDIAPIPE_MODELS();
+  const char* dir = std::getenv("HANDLABEL_TFLITE_PARITY_DIR");
+  ASSERT_NE(dir, nullptr) << "set HANDLABEL_TFLITE_PARITY_DIR";
+  std::filesystem::create_directories(dir);
+  std::vector<std::pair<std::string, ImageU8>> images{
+      {"rendered_hand", RenderHandCrop().image}, {"grey", ImageU8(224, 224, 3, 128)}};
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> byte(0, 255);
+  ImageU8 noise(224, 224, 3);
+  for (auto& v : noise.data) v = static_cast<uint8_t>(byte(rng));
+  images.push_back({"noise", noise});
+  if (const char* list = std::getenv("HANDLABEL_TFLITE_PARITY_IMAGES")) {
+    std::stringstream paths(list);
+    for (std::string path; std::getline(paths, path, ':');) {
+      images.push_back(
+          {std::filesystem::path(path).filename().string(), ReadImageFile(path)});
+      ASSERT_GE(images.back().second.channels, 3) << path << ": expected an RGB image";
+    }
+  }
+  auto write = [&](const std::string& name, const std::vector<float>& values) {
+    std::ofstream f(std::string(dir) + "/" + name, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(float));
+  };
+  for (const char* name : {"hand_landmark_full", "hand_landmark_lite",
+                           "palm_detection_full", "palm_detection_lite"}) {
+    auto model = TfliteModel::Load(MediapipeModel(std::string(name) + ".tflite"));
+    const int size = model->inputs()[0].shape[1];
+    for (const auto& [image_name, image] : images) {
+      const std::vector<float> x = ResizedInput(image, size);
+      std::vector<float> all;
+      for (const auto& out : model->Run({x}))
+        all.insert(all.end(), out.begin(), out.end());
+      write("in_" + std::to_string(size) + "_" + image_name + ".bin", x);
+      write("ours_" + std::string(name) + "_" + image_name + ".bin", all);
+    }
   }
 }
 
