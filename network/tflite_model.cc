@@ -667,7 +667,13 @@ Interpreter::Interpreter(std::unique_ptr<TfliteGraph> graph, const std::string& 
   // One run on zeros: every result must have the shape the file declares.
   std::vector<std::vector<float>> zeros;
   for (const auto& info : inputs_) zeros.emplace_back(info.num_elements(), 0.0f);
-  Execute(zeros, /*check_shapes=*/true);
+  const std::vector<Value> values = Execute(zeros, /*check_shapes=*/true);
+  for (int id : g.outputs) {
+    if (!values[id].t.defined()) {
+      throw InputError(source_, "subgraph output " + g.tensors[id].name,
+                       "a tensor computed by an operator or constant", "never written");
+    }
+  }
 }
 
 void Interpreter::CheckInputs(const std::vector<std::vector<float>>& inputs) const {

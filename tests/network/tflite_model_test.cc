@@ -5,8 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include "core/errors.h"
@@ -18,13 +16,6 @@ namespace handlabel {
 namespace {
 
 using namespace testing_tflite;
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 std::string CorpusFile(const std::string& name) {
   return std::string(HANDLABEL_SOURCE_DIR) + "/fuzz/corpus/tflite_reader/" + name;
@@ -206,6 +197,14 @@ TEST(TfliteModel, RejectsBadIndicesSizesAndShapes) {
       TfliteModel::FromBytes(b.Finish({in, w}, {out}), "m");
     });
     EXPECT_NE(m.find("constant data"), std::string::npos) << m;
+  }
+  {  // an output that no operator writes
+    TfliteBuilder b;
+    const int in = b.Tensor({1, 2});
+    const int out = b.Tensor({1, 2}, "orphan");
+    const std::string m =
+        InputErrorOf([&] { TfliteModel::FromBytes(b.Finish({in}, {out}), "m"); });
+    EXPECT_NE(m.find("orphan"), std::string::npos) << m;
   }
   {  // int8 activations (quantized models)
     TfliteBuilder b;
