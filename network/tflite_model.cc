@@ -393,6 +393,22 @@ Step Builder::Logistic() {
 Step Builder::Prelu() {
   ExpectArity(2, 2);
   const int x = In(0), alpha = In(1), out = Out();
+  // Fast path: a constant per-channel alpha ([C], [1, C], [1, 1, C] or [1, 1, 1, C]) on
+  // a rank-4 input is LibTorch's prelu on NCHW with one weight per channel.
+  std::optional<Tensor> per_channel;
+  const auto& in = InShape(0);
+  if (in.size() == 4 && m_.constants_[alpha]) {
+    const Tensor& a = *m_.constants_[alpha];
+    if (a.dim() >= 1 && a.dim() <= 4 && a.size(-1) == in[3] && a.numel() == in[3]) {
+      per_channel = a.flatten().contiguous();
+    }
+  }
+  if (per_channel) {
+    const Tensor weight = *per_channel;
+    return [=](std::vector<Value>& v) {
+      v[out] = {torch::prelu(InNchw(v[x]), weight), true};
+    };
+  }
   return [=](std::vector<Value>& v) {
     const bool nchw = v[x].nchw || v[alpha].nchw;
     Tensor tx = nchw ? BroadcastToNchw(v[x]) : v[x].t;

@@ -335,6 +335,24 @@ TEST(TfliteOps, LogisticAndPrelu) {
   ExpectNear(RunOne(b.Finish({in}, {out}), x), want, 1e-6f);
 }
 
+TEST(TfliteOps, PreluWithComputedAlphaAndOnRank3) {
+  // The general path: alpha is a graph input (not a constant), x of rank 3.
+  std::mt19937 rng(17);
+  const int h = 3, c = 4;
+  const std::vector<float> x = RandomFloats(h * c, rng, -2, 2);
+  const std::vector<float> alpha = RandomFloats(c, rng, 0, 0.5);
+  TfliteBuilder b;
+  const int in = b.Tensor({1, h, c});
+  const int alpha_in = b.Tensor({c});
+  const int out = b.Tensor({1, h, c});
+  b.Op(kPrelu, {in, alpha_in}, {out});
+  auto model = TfliteModel::FromBytes(b.Finish({in, alpha_in}, {out}), "fixture");
+  std::vector<float> want;
+  for (size_t i = 0; i < x.size(); ++i)
+    want.push_back(x[i] >= 0 ? x[i] : alpha[i % c] * x[i]);
+  ExpectNear(model->Run({x, alpha})[0], want, 1e-6f);
+}
+
 TEST(TfliteOps, PadSpatialAndChannels) {
   std::mt19937 rng(13);
   const int h = 2, w = 3, c = 2;
