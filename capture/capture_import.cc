@@ -738,6 +738,7 @@ CaptureImportReport ImportCapture(const std::string& capture_dir,
 
   tbb::task_arena arena(o.num_threads > 0 ? o.num_threads : tbb::task_arena::automatic);
   int since_checkpoint = 0;
+  if (callbacks.progress) callbacks.progress(report.frames_kept, report.frames_total);
   try {
     for (int k = report.frames_kept; k < report.frames_total; ++k) {
       const PlannedFrame& frame = plan[k];

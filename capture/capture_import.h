@@ -96,7 +96,8 @@ struct CaptureImportReport {
 struct CaptureImportCallbacks {
   // A note for the user (frame counts that differ, ignored folders, ...), as it arises.
   std::function<void(const std::string&)> note;
-  // (frames done including kept ones, frames planned) after every frame.
+  // (frames done including kept ones, frames planned): once before the first frame is
+  // read (done = the frames a resumed import keeps), then after every frame.
   std::function<void(int, int)> progress;
 };
 

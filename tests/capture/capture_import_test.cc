@@ -242,6 +242,8 @@ TEST(CaptureImport, VideosWithOffsetsAndDifferentLengthsDecodeExactly) {
   ASSERT_EQ(report.notes.size(), 1u);
   EXPECT_THAT(report.notes[0], HasSubstr("cam0 5, cam1 7 (offset 2), cam2 6"));
   EXPECT_THAT(report.notes[0], HasSubstr("Timeline frames 0 to 4"));
+  ASSERT_EQ(progress.size(), 6u);
+  EXPECT_EQ(progress.front(), std::make_pair(0, 5));
   EXPECT_EQ(progress.back(), std::make_pair(5, 5));
   const std::vector<int> offset = {0, 2, 0};
   ExpectFrames(capture, recording, {"000000", "000001", "000002", "000003", "000004"},
@@ -364,7 +366,7 @@ TEST(CaptureImport, AnInterruptedImportIsReadableAndResumesToTheSameCapture) {
     if (done == 3) throw Stop{};
   };
   EXPECT_THROW(ImportCapture(capture, o, {{}, check_then_stop}), Stop);
-  EXPECT_EQ(checked, 3);
+  EXPECT_EQ(checked, 4);  // before frame 1, then after frames 1 to 3
   EXPECT_EQ(CaptureReader(capture).num_frames(), 3);
 
   o.resume = true;
