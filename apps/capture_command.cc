@@ -151,23 +151,28 @@ int RunCaptureImport(int argc, char** argv) {
   return RunReportingErrors("capture import", [&] {
     o.source_to_camera = ParseMap(maps);
     o.offsets = ParseOffsets(offsets);
+    // Made once the plan is known (the first call, before any frame is read); counts
+    // only the frames of this run, so a resumed import's rate and ETA are its own.
     std::unique_ptr<Progress> progress;
+    int kept = 0;
     CaptureImportCallbacks callbacks;
     callbacks.note = [](const std::string& text) {
       std::cerr << "handlabel capture import: note: " << text << "\n";
     };
     callbacks.progress = [&](int done, int total) {
       if (!progress) {
+        kept = done;
         progress = std::make_unique<Progress>(
-            total, std::cerr, Progress::IsTerminal(STDERR_FILENO), "import");
+            total - kept, std::cerr, Progress::IsTerminal(STDERR_FILENO), "import");
+        return;
       }
-      progress->Update(done);
+      progress->Update(done - kept);
     };
     const CaptureImportReport report = ImportCapture(capture, o, callbacks);
     if (progress) progress->Finish();
     std::cout << "imported " << report.frames_written << " frames";
     if (report.frames_kept > 0) {
-      std::cout << " (" << report.frames_kept << " kept from the interrupted import)";
+      std::cout << " (" << report.frames_kept << " were already in the capture)";
     }
     std::cout << " into " << capture << ": " << report.frames_kept + report.frames_written
               << " of " << report.frames_total << " planned frames";
