@@ -31,6 +31,8 @@ const std::vector<Command>& AllCommands() {
       {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",
        RunCameras},
       {"calib", "calibrate a camera rig from board images or with COLMAP", RunCalib},
+      {"capture", "make a capture from a rig and import image folders or videos",
+       RunCapture},
       {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
       {"fit", "fit the hand model to a capture's 2D keypoints and masks (Ceres)", RunFit},
       {"train", "train the POEM network on synthetic captures (resumable)", RunTrain},

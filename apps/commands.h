@@ -29,6 +29,7 @@ int RunLabel(int argc, char** argv);
 int RunMerge(int argc, char** argv);
 int RunCameras(int argc, char** argv);
 int RunCalib(int argc, char** argv);
+int RunCapture(int argc, char** argv);
 int RunSynth(int argc, char** argv);
 int RunFit(int argc, char** argv);
 int RunTrain(int argc, char** argv);
