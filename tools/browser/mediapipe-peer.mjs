@@ -2,7 +2,12 @@
 // Chromium) as the parity peer of handlabel's detector (network/mediapipe_hands.h).
 //
 //   node tools/browser/mediapipe-peer.mjs --out DIR [--model full|lite] [--max-hands N]
-//        IMAGE...
+//        [--inference gpu|cpu] IMAGE...
+//
+// --inference: where the solution runs the TFLite models: `gpu` (its default on desktop:
+// WebGL, here SwiftShader, reduced float precision) or `cpu` (its wasm TFLite runtime,
+// float32; the solution's own useCpuInference option). Image preprocessing (crops) is
+// WebGL either way.
 //
 // Writes DIR/<index>.json per image (index = position on the command line, 0-based) and
 // DIR/summary.json. Per image: the image size, the wall time of `send` (ms), and per hand
@@ -41,22 +46,26 @@ const roiStream = 'handlandmarktrackinggpu__hand_rects_from_palm_detections';
 function usage(message) {
   if (message) console.error(`mediapipe-peer: ${message}`);
   console.error('usage: node mediapipe-peer.mjs --out DIR [--model full|lite] ' +
-                '[--max-hands N] IMAGE...');
+                '[--max-hands N] [--inference gpu|cpu] IMAGE...');
   process.exit(2);
 }
 
 function parseArgs(argv) {
-  const args = { out: null, model: 'full', maxHands: 2, images: [] };
+  const args = { out: null, model: 'full', maxHands: 2, inference: 'gpu', images: [] };
   for (let i = 0; i < argv.length; ++i) {
     const a = argv[i];
     if (a === '--out') args.out = argv[++i];
     else if (a === '--model') args.model = argv[++i];
     else if (a === '--max-hands') args.maxHands = Number(argv[++i]);
+    else if (a === '--inference') args.inference = argv[++i];
     else if (a.startsWith('--')) usage(`unknown option ${a}`);
     else args.images.push(a);
   }
   if (!args.out) usage('--out is required');
   if (args.model !== 'full' && args.model !== 'lite') usage('--model: expected full or lite');
+  if (args.inference !== 'gpu' && args.inference !== 'cpu') {
+    usage('--inference: expected gpu or cpu');
+  }
   if (!Number.isInteger(args.maxHands) || args.maxHands < 1) {
     usage('--max-hands: expected an integer >= 1');
   }
@@ -129,7 +138,7 @@ function startServer(images) {
 
 // Runs in the page: a protobuf wire-format reader for the ROIs (mediapipe NormalizedRect,
 // delivered serialised), then MediaPipe on every image.
-async function pageMain({ count, model, maxHands }) {
+async function pageMain({ count, model, maxHands, inference }) {
   function readFields(bytes) {
     const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
     const fields = [];
@@ -182,6 +191,7 @@ async function pageMain({ count, model, maxHands }) {
   hands.setOptions({
     maxNumHands: maxHands, modelComplexity: model === 'full' ? 1 : 0,
     minDetectionConfidence: 0.5, minTrackingConfidence: 0.5, selfieMode: false,
+    useCpuInference: inference === 'cpu',
   });
   await hands.initialize();
   const outputs = [];
@@ -229,6 +239,7 @@ async function main() {
     const t0 = Date.now();
     const results = await page.evaluate(pageMain, {
       count: args.images.length, model: args.model, maxHands: args.maxHands,
+      inference: args.inference,
     });
     const wall = (Date.now() - t0) / 1000;
     results.forEach((r, i) => {
@@ -240,6 +251,7 @@ async function main() {
       tool: 'MediaPipe Hands JS (@mediapipe/hands) in headless Chromium',
       package_version: JSON.parse(fs.readFileSync(path.join(packageDir, 'package.json'))).version,
       chromium: browser.version(), model: args.model, max_hands: args.maxHands,
+      inference: args.inference,
       images: results.map((r) => r.image), hands_found: results.map((r) => r.hands.length),
       time_ms_per_image: times, total_s_including_init: wall,
     };
