@@ -94,6 +94,61 @@ PalmHypothesis BestPalmHypothesis(const Rig& rig, const std::vector<ImageU8>& im
   return best;
 }
 
+// The 3D palm (7 keypoints and the box centre, triangulated from the agreeing views) and
+// the box size per unit of wrist-to-middle-MCP distance, as those views saw it.
+struct Palm3d {
+  Points3 keypoints;
+  Eigen::Vector3d box_centre = Eigen::Vector3d::Zero();
+  double box_per_span = 0;
+};
+
+std::optional<Palm3d> TriangulatePalmWithBox(
+    const Rig& rig, const std::vector<ImageU8>& images,
+    const std::vector<std::vector<PalmDetection>>& palms, const PalmHypothesis& h) {
+  const auto keypoints = TriangulatePalm(rig, images, palms, h.members);
+  if (!keypoints) return std::nullopt;
+  Palm3d out;
+  out.keypoints = *keypoints;
+  std::vector<ViewObservation> centres;
+  for (const auto& [v, index] : h.members) {
+    const PalmDetection& p = palms[v][index];
+    const int w = images[v].width, ht = images[v].height;
+    centres.push_back(
+        {v, NormToPixel({p.xmin + p.width / 2, p.ymin + p.height / 2}, w, ht), 1.0});
+    const double span =
+        (PalmKeypointPx(p, 2, w, ht) - PalmKeypointPx(p, 0, w, ht)).norm();
+    out.box_per_span += PalmSizePx(p, w, ht) / std::max(span, 1.0) / h.members.size();
+  }
+  const auto centre = TriangulateWeighted(rig, centres);
+  if (!centre) return std::nullopt;
+  out.box_centre = *centre;
+  return out;
+}
+
+// The 3D palm seen from camera `camera` as a palm detection (normalised), a square box of
+// the agreeing views' size per span; nothing when it projects behind the camera or
+// its centre falls outside the image.
+std::optional<PalmDetection> ProjectPalm(const RigCamera& camera, const Palm3d& palm,
+                                         int w, int h) {
+  PalmDetection out;
+  out.score = 0;
+  std::array<Eigen::Vector2d, kPalmKeypoints> px;
+  for (int k = 0; k < kPalmKeypoints; ++k) {
+    if (!camera.ProjectWorld(palm.keypoints[k], &px[k])) return std::nullopt;
+    out.keypoints[k] = Eigen::Vector2d((px[k].x() + 0.5) / w, (px[k].y() + 0.5) / h);
+  }
+  Eigen::Vector2d centre;
+  if (!camera.ProjectWorld(palm.box_centre, &centre) || !camera.camera.InImage(centre)) {
+    return std::nullopt;
+  }
+  const double size = palm.box_per_span * (px[2] - px[0]).norm();
+  out.xmin = (centre.x() + 0.5 - size / 2) / w;
+  out.ymin = (centre.y() + 0.5 - size / 2) / h;
+  out.width = size / w;
+  out.height = size / h;
+  return out;
+}
+
 double MedianReprojectionPx(const RigCamera& camera, const Keypoints2d& kp,
                             const FrameHandResult& frame) {
   std::vector<double> errors;
@@ -227,6 +282,19 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
         HandRoiFromPalm(palms[v][index], images[v].width, images[v].height);
     RunLandmarks(detector, images[v], roi, "palm", &frame.views[v]);
   }
+  // Step 4a: views whose palm detection missed, from the projected 3D palm.
+  const auto palm3d = TriangulatePalmWithBox(rig, images, palms, best);
+  for (int v = 0; v < n && palm3d; ++v) {
+    if (frame.views[v].detected || frame.views[v].reason == "low_presence") continue;
+    const auto palm = ProjectPalm(rig[v], *palm3d, images[v].width, images[v].height);
+    if (!palm) {
+      frame.views[v].reason = "hand_outside_view";
+      continue;
+    }
+    RunLandmarks(detector, images[v],
+                 HandRoiFromPalm(*palm, images[v].width, images[v].height), "3d_palm",
+                 &frame.views[v]);
+  }
   TriangulateKeypoints(rig, images, options, &frame);
   frame.found = frame.keypoint3d_valid[0];
   if (!frame.found) {
@@ -234,7 +302,8 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
     return frame;
   }
 
-  // Step 4: the other views from the projected hand (all views in a second pass).
+  // Step 4b: views still without a hand from the projected 3D keypoints (all views in
+  // a second pass).
   const auto redo_from_3d = [&](int v, const std::string& source) {
     KeypointPixels uv = KeypointPixels::Zero();
     if (!ProjectHand(rig[v], frame, options, &uv)) {
@@ -247,7 +316,9 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
                  &frame.views[v]);
   };
   for (int v = 0; v < n; ++v) {
-    if (!frame.views[v].detected) redo_from_3d(v, "3d_hand");
+    if (!frame.views[v].detected && frame.views[v].reason != "hand_outside_view") {
+      redo_from_3d(v, "3d_hand");
+    }
   }
   TriangulateKeypoints(rig, images, options, &frame);
   if (options.second_pass) {

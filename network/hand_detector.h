@@ -10,10 +10,12 @@
 //     does, so ties go to more views, then to the higher summed palm score.
 //  3. Landmarks in the confirming views (ROI from their palm); handedness is voted:
 //     presence-weighted mean of the per-view probabilities.
-//  4. The 21 keypoints are triangulated (robustly, per keypoint) from those views and
-//     projected into every other view: where palm detection missed the hand, the
-//     landmark model runs on the ROI around the projection. Optionally (`second_pass`)
-//     every view is redone from the projection of the keypoints triangulated from all.
+//  4. Where palm detection missed the hand, the 3D palm (its keypoints and box centre,
+//     triangulated from those views; box size from their box-to-palm-span ratio) is
+//     projected and its ROI cropped for the landmark model. Then the 21 keypoints are
+//     triangulated (robustly, per keypoint) from every view with landmarks, and views
+//     still without a hand get the ROI around the projected keypoints. Optionally
+//     (`second_pass`) every view is redone from the keypoints triangulated from all.
 //  5. A view's detection that disagrees with the triangulated hand (median reprojection
 //     error above `max_reprojection` ROI sizes) is dropped.
 // Each view without a detection records why (ViewHandResult::reason).
@@ -56,8 +58,8 @@ struct MultiViewDetectorOptions {
 // One view's outcome.
 struct ViewHandResult {
   bool detected = false;
-  // "palm" (ROI from this view's palm), "3d_hand" (ROI from the projected 3D hand) or
-  // "second_pass"; empty without a detection.
+  // "palm" (ROI from this view's palm), "3d_palm" (from the projected 3D palm),
+  // "3d_hand" (from the projected 3D keypoints) or "second_pass"; empty without one.
   std::string source;
   // Why there is no detection: "no_hand_in_frame" (no palms agreed in enough views),
   // "hand_outside_view" (the 3D hand projects mostly outside the image or behind the
