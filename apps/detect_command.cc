@@ -35,6 +35,9 @@ int RunDetect(int argc, char** argv) {
                "with --capture: replace the detections the capture already has");
   app.add_flag("--second-pass", dc.multiview.second_pass,
                "with --capture: redo every view from the triangulated keypoints");
+  app.add_option("--min-presence-from-3d", dc.multiview.min_presence_from_3d,
+                 "with --capture: presence needed in ROIs placed from the other views")
+      ->capture_default_str();
   app.add_option("--min-palm-views", dc.multiview.min_palm_views,
                  "with --capture: views whose palms must agree")
       ->capture_default_str();

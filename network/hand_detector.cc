@@ -211,11 +211,13 @@ bool ProjectHand(const RigCamera& camera, const FrameHandResult& frame,
   return inside >= options.min_keypoints_in_view * kNumHandKeypoints;
 }
 
+// `min_presence`: the detector's own threshold for ROIs from the view's palm, the lower
+// `min_presence_from_3d` for ROIs the other views put there.
 void RunLandmarks(const MediapipeHands& detector, const ImageU8& image,
                   const NormalizedRect& roi, const std::string& source,
-                  ViewHandResult* r) {
+                  double min_presence, ViewHandResult* r) {
   r->hand = detector.LandmarksInRoi(image, roi);
-  r->detected = r->hand.presence >= detector.options().min_presence;
+  r->detected = r->hand.presence >= min_presence;
   if (r->detected) {
     r->source = source;
     r->reason.clear();
@@ -252,6 +254,10 @@ void MultiViewDetectorOptions::Check(const std::string& source) const {
   positive(palm_agreement, "palm_agreement");
   positive(keypoint_inlier, "keypoint_inlier");
   positive(max_reprojection, "max_reprojection");
+  if (!(min_presence_from_3d >= 0 && min_presence_from_3d <= 1)) {
+    throw InputError(source, "min_presence_from_3d", "a value in [0, 1]",
+                     std::to_string(min_presence_from_3d));
+  }
   if (!(min_keypoints_in_view >= 0 && min_keypoints_in_view <= 1)) {
     throw InputError(source, "min_keypoints_in_view", "a value in [0, 1]",
                      std::to_string(min_keypoints_in_view));
@@ -280,7 +286,8 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
   for (const auto& [v, index] : best.members) {
     const NormalizedRect roi =
         HandRoiFromPalm(palms[v][index], images[v].width, images[v].height);
-    RunLandmarks(detector, images[v], roi, "palm", &frame.views[v]);
+    RunLandmarks(detector, images[v], roi, "palm", detector.options().min_presence,
+                 &frame.views[v]);
   }
   // Step 4a: views whose palm detection missed, from the projected 3D palm.
   const auto palm3d = TriangulatePalmWithBox(rig, images, palms, best);
@@ -293,7 +300,7 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
     }
     RunLandmarks(detector, images[v],
                  HandRoiFromPalm(*palm, images[v].width, images[v].height), "3d_palm",
-                 &frame.views[v]);
+                 options.min_presence_from_3d, &frame.views[v]);
   }
   TriangulateKeypoints(rig, images, options, &frame);
   frame.found = frame.keypoint3d_valid[0];
@@ -313,7 +320,7 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
     }
     RunLandmarks(detector, images[v],
                  RoiFromKeypoints(uv, images[v].width, images[v].height), source,
-                 &frame.views[v]);
+                 options.min_presence_from_3d, &frame.views[v]);
   };
   for (int v = 0; v < n; ++v) {
     if (!frame.views[v].detected && frame.views[v].reason != "hand_outside_view") {

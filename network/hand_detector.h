@@ -49,6 +49,11 @@ struct MultiViewDetectorOptions {
   // A projected hand is looked for in a view only when at least this share of its 21
   // keypoints projects inside the image.
   double min_keypoints_in_view = 0.5;
+  // Presence a hand needs in a ROI placed from the other views (3D palm or keypoints):
+  // there the rig already says where the hand is, and held objects hide much of it, so
+  // this is below the single-image threshold (MediapipeHandsOptions::min_presence); the
+  // reprojection check (max_reprojection) still drops crops that disagree.
+  double min_presence_from_3d = 0.2;
   // Redo every view from the ROI of the keypoints triangulated from all views.
   bool second_pass = false;
   // Throws InputError naming `source` when a field is out of range.

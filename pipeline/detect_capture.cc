@@ -63,6 +63,7 @@ nlohmann::json FrameDetectionsJson(const std::string& frame,
       jv["median_reprojection_px"] = JsonNumberOrNull(r.median_reprojection_px);
     } else {
       jv["reason"] = r.reason;
+      if (r.reason == "low_presence") jv["presence"] = r.hand.presence;
     }
   }
   out["detector"] = "mediapipe_hands";
