@@ -38,6 +38,8 @@ const std::vector<Command>& AllCommands() {
       {"train", "train the POEM network on synthetic captures (resumable)", RunTrain},
       {"eval-network", "MPJPE / MPVPE / AUC of POEM weights on held-out synthetic frames",
        RunEvalNetwork},
+      {"detect", "MediaPipe Hands 2D keypoints: a capture's views (multi-view) or images",
+       RunDetect},
   };
   return commands;
 }

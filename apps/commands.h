@@ -34,5 +34,6 @@ int RunSynth(int argc, char** argv);
 int RunFit(int argc, char** argv);
 int RunTrain(int argc, char** argv);
 int RunEvalNetwork(int argc, char** argv);
+int RunDetect(int argc, char** argv);
 
 }  // namespace handlabel

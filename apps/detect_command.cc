@@ -1,0 +1,96 @@
+// `handlabel detect`: MediaPipe Hands' 2D hand keypoints (network/mediapipe_hands.h) for
+// a capture's views, found consistently across the rig (pipeline/detect_capture.h), or
+// for single images (pipeline/detect_images.h). docs/detector.md.
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "apps/cli_util.h"
+#include "apps/commands.h"
+#include "core/errors.h"
+#include "core/progress.h"
+#include "pipeline/detect_capture.h"
+#include "pipeline/detect_images.h"
+
+namespace handlabel {
+
+int RunDetect(int argc, char** argv) {
+  CLI::App app(
+      "Detect hands with MediaPipe Hands' models (palm detection + 21 landmarks).\n"
+      "Capture: handlabel detect --capture C [--model full|lite]   "
+      "(C/detections/{frame}.json,\n"
+      "         the hand found consistently across the rig's views)\n"
+      "Images:  handlabel detect --images a.jpg b.png --out dets/   (one JSON per "
+      "image)\n"
+      "docs/detector.md",
+      "detect");
+  DetectCaptureOptions dc;
+  MediapipeHandsOptions& o = dc.hands;
+  std::vector<std::string> images;
+  std::string out_dir, capture_dir;
+  app.add_option("--capture", capture_dir, "native capture folder (multi-view)");
+  app.add_flag("--overwrite", dc.overwrite,
+               "with --capture: replace the detections the capture already has");
+  app.add_flag("--second-pass", dc.multiview.second_pass,
+               "with --capture: redo every view from the triangulated keypoints");
+  app.add_option("--min-presence-from-3d", dc.multiview.min_presence_from_3d,
+                 "with --capture: presence needed in ROIs placed from the other views")
+      ->capture_default_str();
+  app.add_option("--min-palm-views", dc.multiview.min_palm_views,
+                 "with --capture: views whose palms must agree")
+      ->capture_default_str();
+  app.add_option("--images", images, "single images (PNG or JPEG), each on its own");
+  app.add_option("--out", out_dir, "with --images: output folder (created)");
+  app.add_option("--model", o.model, "full or lite")->capture_default_str();
+  app.add_option(
+      "--model-dir", o.model_dir,
+      "folder with the .tflite files (default: <data folder>/models/mediapipe)");
+  app.add_option("--max-hands", o.max_hands, "hands per image at most")
+      ->capture_default_str();
+  app.add_option("--min-palm-score", o.min_palm_score, "palm detection threshold")
+      ->capture_default_str();
+  app.add_option("--min-presence", o.min_presence, "hand presence threshold")
+      ->capture_default_str();
+  app.add_option("--threads", o.num_threads, "LibTorch threads, 0 = default")
+      ->capture_default_str();
+  if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
+  if (images.empty() == capture_dir.empty()) {
+    std::cerr << "detect: give either --capture or --images (with --out)\n";
+    return 2;
+  }
+  if (!images.empty() && out_dir.empty()) {
+    std::cerr << "detect: --images needs --out\n";
+    return 2;
+  }
+  if (!capture_dir.empty()) {
+    return RunReportingErrors("detect", [&] {
+      Progress progress(CountCaptureFrames(capture_dir), std::cerr,
+                        Progress::IsTerminal(STDERR_FILENO), "detect");
+      const DetectCaptureSummary s =
+          DetectCapture(capture_dir, dc, [&](int done, int) { progress.Update(done); });
+      progress.Finish();
+      std::printf(
+          "frames %d, hand found in %d; views with a detection %d of %d (%d from "
+          "their own palm); %.1f s\n",
+          s.frames, s.frames_with_hand, s.views_detected, s.views, s.views_from_palm,
+          s.seconds);
+      std::cout << "detections: " << capture_dir << "/detections\n";
+      return 0;
+    });
+  }
+  return RunReportingErrors("detect", [&] {
+    o.Check("detect");
+    const MediapipeHands detector(o);
+    Progress progress(static_cast<int>(images.size()), std::cerr,
+                      Progress::IsTerminal(STDERR_FILENO), "detect");
+    DetectImages(detector, images, out_dir,
+                 [&](int done, int) { progress.Update(done); });
+    progress.Finish();
+    std::cout << "detections: " << out_dir << "\n";
+    return 0;
+  });
+}
+
+}  // namespace handlabel

@@ -1,0 +1,120 @@
+#include "pipeline/detect_capture.h"
+
+#include <chrono>
+#include <filesystem>
+#include <limits>
+
+#include "capture/capture_format.h"
+#include "capture/capture_reader.h"
+#include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/json_util.h"
+
+namespace handlabel {
+namespace {
+
+constexpr char kDetectionsPattern[] = "detections/{frame}.json";
+
+std::string SideName(HandSide side) {
+  return side == HandSide::kRight ? "right" : "left";
+}
+
+// The capture's manifest with the detections kind listed (written atomically, last).
+void ListDetections(const CaptureReader& capture) {
+  CaptureManifest manifest = capture.manifest();
+  manifest.files[kFileDetections] = kDetectionsPattern;
+  WriteFileAtomically(capture.dir() + "/capture.json",
+                      ManifestToJson(manifest).dump(2) + "\n");
+}
+
+}  // namespace
+
+void DetectCaptureOptions::Check(const std::string& source) const {
+  hands.Check(source);
+  multiview.Check(source);
+}
+
+nlohmann::json FrameDetectionsJson(const std::string& frame,
+                                   const std::vector<std::string>& cameras,
+                                   const FrameHandResult& result) {
+  std::vector<ViewKeypoints> views(cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    views[c].camera = cameras[c];
+    views[c].keypoints = result.views[c].keypoints;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (views[c].keypoints.confidence(k) <= 0) {
+        views[c].keypoints.uv_px.row(k).setConstant(
+            std::numeric_limits<double>::quiet_NaN());
+      }
+    }
+    views[c].visibility.fill(-1);
+  }
+  nlohmann::json out = ViewKeypointsToJson(frame, views, /*ground_truth=*/false);
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    const ViewHandResult& r = result.views[c];
+    nlohmann::json& jv = out["views"][c];
+    jv["detected"] = r.detected;
+    jv["palm_candidates"] = r.palm_candidates;
+    if (r.detected) {
+      jv["source"] = r.source;
+      jv["presence"] = r.hand.presence;
+      jv["handedness"] = {{"side", SideName(r.hand.side())},
+                          {"score", r.hand.side_score()}};
+      jv["median_reprojection_px"] = JsonNumberOrNull(r.median_reprojection_px);
+    } else {
+      jv["reason"] = r.reason;
+      if (r.reason == "low_presence") jv["presence"] = r.hand.presence;
+    }
+  }
+  out["detector"] = "mediapipe_hands";
+  out["hand"] = {{"found", result.found},
+                 {"side", SideName(result.side)},
+                 {"side_score", result.side_score},
+                 {"palm_views", result.palm_views}};
+  return out;
+}
+
+int CountCaptureFrames(const std::string& capture_dir) {
+  return CaptureReader(capture_dir).num_frames();
+}
+
+DetectCaptureSummary DetectCapture(const std::string& capture_dir,
+                                   const DetectCaptureOptions& options,
+                                   const std::function<void(int, int)>& on_frame) {
+  options.Check("detect");
+  const CaptureReader capture(capture_dir);
+  if (capture.Has(kFileDetections) && !options.overwrite) {
+    throw InputError(capture_dir + "/capture.json", "files.detections",
+                     "no detections yet (pass --overwrite to replace them)",
+                     capture.manifest().files.at(kFileDetections));
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const MediapipeHands detector(options.hands);
+  DetectCaptureSummary summary;
+  const int n = capture.num_cameras();
+  std::filesystem::create_directories(capture_dir + "/detections");
+  for (int f = 0; f < capture.num_frames(); ++f) {
+    std::vector<ImageU8> images;
+    for (int c = 0; c < n; ++c) images.push_back(capture.ReadImage(f, c));
+    const FrameHandResult result =
+        DetectHandMultiView(detector, capture.rig(), images, options.multiview);
+    const std::string id = capture.frame_id(f);
+    WriteFileAtomically(
+        capture_dir + "/" + ExpandPattern(kDetectionsPattern, "", id),
+        FrameDetectionsJson(id, capture.manifest().cameras, result).dump(1) + "\n");
+    ++summary.frames;
+    summary.views += n;
+    summary.frames_with_hand += result.found ? 1 : 0;
+    for (const ViewHandResult& r : result.views) {
+      summary.views_detected += r.detected ? 1 : 0;
+      summary.views_from_palm += (r.detected && r.source == "palm") ? 1 : 0;
+    }
+    if (on_frame) on_frame(f + 1, capture.num_frames());
+  }
+  ListDetections(capture);
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return summary;
+}
+
+}  // namespace handlabel

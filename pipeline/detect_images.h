@@ -1,0 +1,36 @@
+#pragma once
+// `handlabel detect --images`: MediaPipe Hands (network/mediapipe_hands.h) on single
+// images, one JSON file per image with everything the pipeline computes (palms, ROIs,
+// landmarks in image, crop and world coordinates, presence, handedness) and the time of
+// each step; the parity check against MediaPipe's own runtime
+// (scripts/mediapipe-parity) and the real-photo benchmark read these files.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "network/mediapipe_hands.h"
+
+namespace handlabel {
+
+// The JSON record of one image: {"image", "width", "height", "palms": [...],
+// "hands": [...], "time_ms": {...}} (docs/detector.md, "Single images").
+// Times in milliseconds: reading the file (`read_ms`) and the trace's steps.
+nlohmann::json DetectionRecordJson(const std::string& image_path, const ImageU8& rgb,
+                                   const MediapipeTrace& trace,
+                                   const std::vector<HandDetection>& hands,
+                                   double read_ms);
+
+// Runs the detector on each image and writes <out_dir>/<index>.json (index = position in
+// `images`) and <out_dir>/summary.json (per-image times and hand counts, means).
+// `on_image(done, total)` after each image. Throws InputError naming an unreadable image.
+void DetectImages(const MediapipeHands& detector, const std::vector<std::string>& images,
+                  const std::string& out_dir,
+                  const std::function<void(int, int)>& on_image = nullptr);
+
+// An image as 3-channel RGB (gray is repeated, alpha dropped).
+ImageU8 ToRgb(const ImageU8& image);
+
+}  // namespace handlabel
