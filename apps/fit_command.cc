@@ -5,6 +5,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "core/errors.h"
 #include "fitting/ceres_hand_fitter.h"
 #include "pipeline/fit_capture.h"
 
@@ -51,7 +52,9 @@ struct FitFlags {
   double silhouette_sigma = HandFitOptions().silhouette_sigma_px;
   int silhouette_rounds = HandFitOptions().silhouette_rounds;
   int pca = HandFitConfig().pose_pca_comps;
+  std::string unknown_occluders = "two_sided";
   bool no_silhouettes = false, no_limits = false, fixed_shape = false;
+  bool no_silhouette_check = false;
 };
 
 void AddEvidenceFlags(CLI::App& app, FitFlags* f) {
@@ -97,6 +100,14 @@ void AddFitterFlags(CLI::App& app, FitFlags* f) {
   app.add_option("--pca", f->pca,
                  "pose as PCA coefficients: 0 (45 axis-angle values), 12 or 45")
       ->capture_default_str();
+  app.add_option("--unknown-occluders", f->unknown_occluders,
+                 "silhouettes without object masks (--object-masks none): two_sided "
+                 "(guarded by the silhouette check) | one_sided (only observed hand "
+                 "pixels must be covered)")
+      ->capture_default_str();
+  app.add_flag(
+      "--no-silhouette-check", f->no_silhouette_check,
+      "keep a silhouette fit even when it disagrees with the keypoints-only fit");
   app.add_flag("--no-limits", f->no_limits, "no anatomical joint limits");
   app.add_flag("--fixed-shape", f->fixed_shape, "keep betas at their initial values");
 }
@@ -126,6 +137,12 @@ FitCaptureOptions ToOptions(const CLI::App& app, const FitFlags& f) {
   SetIfGiven(app, "--silhouette-sigma", f.silhouette_sigma, &o.fit.silhouette_sigma_px);
   SetIfGiven(app, "--silhouette-rounds", f.silhouette_rounds, &o.fit.silhouette_rounds);
   SetIfGiven(app, "--pca", f.pca, &o.fit.pose_pca_comps);
+  if (f.unknown_occluders != "one_sided" && f.unknown_occluders != "two_sided") {
+    throw InputError("command line", "--unknown-occluders", "one_sided | two_sided",
+                     f.unknown_occluders);
+  }
+  SetIfGiven(app, "--unknown-occluders", f.unknown_occluders, &o.fit.unknown_occluders);
+  if (f.no_silhouette_check) o.fit.silhouette_check = false;
   if (f.no_limits) o.fit.joint_limits = false;
   if (f.fixed_shape) o.fit.optimise_shape = false;
   if (f.no_silhouettes) o.masks = "none";

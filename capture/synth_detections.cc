@@ -4,7 +4,9 @@
 #include <cmath>
 #include <vector>
 
+#include "core/distance_transform.h"
 #include "core/errors.h"
+#include "core/mask_image.h"
 
 namespace handlabel {
 namespace {
@@ -59,14 +61,47 @@ void DetectionNoiseOptions::Check() const {
                        std::to_string(rate));
     }
   }
+  if (!(object_sigma_per_px >= 0)) {
+    throw InputError(src, "object_sigma_per_px", ">= 0",
+                     std::to_string(object_sigma_per_px));
+  }
+  if (!(object_confidence_px > 0)) {
+    throw InputError(src, "object_confidence_px", "> 0",
+                     std::to_string(object_confidence_px));
+  }
+  if (!(object_depth_cap_px >= 0)) {
+    throw InputError(src, "object_depth_cap_px", ">= 0",
+                     std::to_string(object_depth_cap_px));
+  }
   if (mask_morph_radius < 0 || mask_morph_radius > 50 || mask_blobs < 0) {
     throw InputError(src, "mask_morph_radius/mask_blobs", "0..50 and >= 0");
   }
 }
 
+std::array<double, kNumHandKeypoints> DepthBehindObjects(const SynthView& view,
+                                                         double cap_px) {
+  std::array<double, kNumHandKeypoints> depth{};
+  bool any = false;
+  for (int k = 0; k < kNumHandKeypoints; ++k) any |= view.behind_object[k];
+  if (!any) return depth;
+  const DistanceImage to_hand = DistanceToMask(MaskFromImage(view.hand_mask));
+  const int w = view.hand_mask.width, h = view.hand_mask.height;
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (!view.behind_object[k]) continue;
+    const int x =
+        std::clamp(static_cast<int>(std::lround(view.keypoints(k, 0))), 0, w - 1);
+    const int y =
+        std::clamp(static_cast<int>(std::lround(view.keypoints(k, 1))), 0, h - 1);
+    depth[k] = std::min(to_hand(y, x), cap_px);  // +inf without hand pixels
+  }
+  return depth;
+}
+
 ViewDetections SimulateDetections(const SynthView& view, const DetectionNoiseOptions& o,
                                   std::mt19937_64& rng) {
   ViewDetections det;
+  const std::array<double, kNumHandKeypoints> depth =
+      DepthBehindObjects(view, o.object_depth_cap_px);
   const double nan = std::nan("");
   det.keypoints.uv_px.setConstant(nan);
   // The hand's box from in-frame keypoints, for outliers.
@@ -97,11 +132,14 @@ ViewDetections SimulateDetections(const SynthView& view, const DetectionNoiseOpt
       det.keypoints.confidence[k] = 0.1 + 0.5 * u_conf;
       continue;
     }
-    const double sigma = o.keypoint_sigma_px * (vis == kVisible ? 1.0 : 2.0);
+    const double sigma = o.keypoint_sigma_px * (vis == kVisible ? 1.0 : 2.0) +
+                         o.object_sigma_per_px * depth[k];
     det.keypoints.uv_px(k, 0) = view.keypoints(k, 0) + sigma * nx;
     det.keypoints.uv_px(k, 1) = view.keypoints(k, 1) + sigma * ny;
     det.keypoints.confidence[k] =
-        vis == kVisible ? 0.6 + 0.4 * u_conf : 0.2 + 0.4 * u_conf;
+        vis == kVisible
+            ? 0.6 + 0.4 * u_conf
+            : (0.2 + 0.4 * u_conf) / (1.0 + depth[k] / o.object_confidence_px);
   }
 
   // Noisy mask.

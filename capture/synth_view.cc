@@ -74,6 +74,7 @@ SynthView RenderSynthView(const SynthScene& scene, const RigCamera& camera,
     const bool hand_in_front =
         m == 0 && buffer.depth[i] < p.z() - options.self_occlusion_tolerance;
     view.visibility[k] = object_in_front || hand_in_front ? kOccluded : kVisible;
+    view.behind_object[k] = object_in_front;
   }
   view.status = view.hand_pixels > 0                              ? "visible"
                 : in_frame > 0 || view.hand_pixels_unoccluded > 0 ? "occluded"

@@ -10,6 +10,9 @@
 //                  the keypoint (joints lie inside the finger, so a small margin is
 //                  normal)
 //   2 kVisible     otherwise
+// `behind_object` marks the occluded keypoints that an object hides (an object, not the
+// hand, is nearest at the keypoint's pixel): simulated detections treat them apart
+// (capture/synth_detections.h).
 // View status: "visible" (some hand pixel is visible), "occluded" (the hand projects
 // into the image but no hand pixel is visible), "out_of_frame" (no hand pixel and no
 // keypoint inside the image).
@@ -46,7 +49,8 @@ struct SynthView {
   ImageF depth;         // camera z in metres, 0 where nothing was drawn (if requested)
   Eigen::Matrix<double, kNumHandKeypoints, 2, Eigen::RowMajor> keypoints;  // pixels
   std::array<int, kNumHandKeypoints> visibility{};
-  int hand_pixels = 0;             // visible hand pixels
+  std::array<bool, kNumHandKeypoints> behind_object{};  // hidden by an object
+  int hand_pixels = 0;                                  // visible hand pixels
   int hand_pixels_unoccluded = 0;  // hand pixels if there were no objects
   std::string status;              // "visible", "occluded" or "out_of_frame"
 };

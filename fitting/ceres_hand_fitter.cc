@@ -25,13 +25,14 @@ namespace handlabel {
 namespace {
 
 // The occluder mask of view v, or nullptr when there is none; it must match the hand
-// mask's size.
+// mask's size (a view without a hand mask does not use it).
 const MaskImage* Occluder(const HandFitInput& input, size_t v) {
   if (v >= input.occluder_masks.size() || input.occluder_masks[v].size() == 0)
     return nullptr;
   const MaskImage& occluder = input.occluder_masks[v];
-  if (v < input.masks.size() && (occluder.rows() != input.masks[v].rows() ||
-                                 occluder.cols() != input.masks[v].cols())) {
+  if (v < input.masks.size() && input.masks[v].size() > 0 &&
+      (occluder.rows() != input.masks[v].rows() ||
+       occluder.cols() != input.masks[v].cols())) {
     throw InputError(
         "HandFitInput", "occluder_masks[" + std::to_string(v) + "]",
         "the hand mask's size",
@@ -176,6 +177,8 @@ void HandFitOptions::Check() const {
   RequireNonNegative(silhouette_outline_samples, "silhouette_outline_samples");
   RequireNonNegative(silhouette_rounds, "silhouette_rounds");
   RequirePositive(silhouette_contour_cosine, "silhouette_contour_cosine");
+  RequireNonNegative(occluder_reach_px, "occluder_reach_px");
+  RequirePositive(unknown_occluder_cap_px, "unknown_occluder_cap_px");
   RequireNonNegative(rigid_iterations, "rigid_iterations");
   RequireNonNegative(keypoint_iterations, "keypoint_iterations");
   RequireNonNegative(init_iterations, "init_iterations");
@@ -412,11 +415,15 @@ class FitRun {
         view.distance_to_mask = DistanceToMask(
             occluder ? HandOrOccluder(input.masks[v], *occluder) : input.masks[v]);
         if (!std::isfinite(view.distance_to_mask(0, 0))) continue;  // empty mask
-        outlines.push_back(SampleMaskOutline(
-            input.masks[v], options_.silhouette_outline_samples, occluder));
+        view.one_sided = occluder == nullptr && input.unknown_occluders;
+        view.cap_px = options_.unknown_occluder_cap_px;
+        outlines.push_back(SampleMaskOutline(input.masks[v],
+                                             options_.silhouette_outline_samples,
+                                             occluder, options_.occluder_reach_px));
         sil_views.push_back(std::move(view));
       }
     }
+    if (!sil_views.empty()) result.keypoints_only = Evaluate(input, FromBlocks(b));
     for (int round = 0; !sil_views.empty() && round < options_.silhouette_rounds;
          ++round) {
       // Outline samples are matched only to contour-generator vertices (normal nearly
@@ -449,10 +456,24 @@ class FitRun {
       run(&problem, options_.silhouette_iterations);
     }
 
-    result.params = FromBlocks(b);
-    const HandMesh mesh = PoseHand(model_, result.params);
-    result.vertices = mesh.vertices;
-    result.keypoints = mesh.keypoints;
+    const HandFitStageResult final_stage = Evaluate(input, FromBlocks(b));
+    result.params = final_stage.params;
+    result.vertices = final_stage.vertices;
+    result.keypoints = final_stage.keypoints;
+    result.view_rms_px = final_stage.view_rms_px;
+    result.view_iou = final_stage.view_iou;
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
+
+  // The posed hand of `params` and its agreement with the evidence per view.
+  HandFitStageResult Evaluate(const HandFitInput& input, const HandParams& params) const {
+    HandFitStageResult out;
+    out.params = params;
+    const HandMesh mesh = PoseHand(model_, params);
+    out.vertices = mesh.vertices;
+    out.keypoints = mesh.keypoints;
     for (const KeypointView& view : input.views) {
       double sum = 0.0;
       int n = 0;
@@ -463,22 +484,20 @@ class FitRun {
         sum += (uv - view.keypoints.uv_px.row(k).transpose()).squaredNorm();
         ++n;
       }
-      result.view_rms_px.push_back(n > 0 ? std::sqrt(sum / n) : kNaN);
+      out.view_rms_px.push_back(n > 0 ? std::sqrt(sum / n) : kNaN);
     }
-    result.view_iou.assign(input.views.size(), kNaN);
+    out.view_iou.assign(input.views.size(), kNaN);
     for (size_t v = 0; v < input.masks.size(); ++v) {
       if (input.masks[v].size() == 0) continue;
       const RigCamera& camera = input.views[v].camera;
-      const MaskImage rendered = input.pixel_rays != nullptr
-                                     ? RenderHandMask(result.vertices, model_.faces,
-                                                      camera, (*input.pixel_rays)[v])
-                                     : RenderHandMask(result.vertices, model_.faces,
-                                                      camera, PixelRays(camera.camera));
-      result.view_iou[v] = MaskIoU(rendered, input.masks[v], Occluder(input, v));
+      const MaskImage rendered =
+          input.pixel_rays != nullptr
+              ? RenderHandMask(out.vertices, model_.faces, camera, (*input.pixel_rays)[v])
+              : RenderHandMask(out.vertices, model_.faces, camera,
+                               PixelRays(camera.camera));
+      out.view_iou[v] = MaskIoU(rendered, input.masks[v], Occluder(input, v));
     }
-    result.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return result;
+    return out;
   }
 
   HandParams InitFromKeypoints3d(const Points3d& keypoints,

@@ -29,6 +29,7 @@
 #include "fitting/keypoint_view.h"
 #include "fitting/points3d_targets.h"
 #include "fitting/robust_loss.h"
+#include "fitting/silhouette_outline.h"
 
 namespace handlabel {
 
@@ -79,6 +80,14 @@ struct HandFitOptions {
   // Outline samples match only vertices whose normal makes |cos| below this with the
   // viewing ray (contour generators).
   double silhouette_contour_cosine = 0.6;
+  // Hand mask pixels within this many pixels (Chebyshev) of an occluder pixel are not
+  // outline samples: the hand may continue behind the occluder there. It must cover
+  // the hand mask's misalignment to the occluder mask (a detector's mask eroded by r
+  // pixels leaves a gap of r pixels next to the object); >= 0.
+  int occluder_reach_px = 2;
+  // Views whose occluders are unknown (HandFitInput::unknown_occluders): the mesh ->
+  // mask distance saturates at this many pixels (fitting/silhouette_cost.h), > 0.
+  double unknown_occluder_cap_px = 3.0;
   // Ceres iterations per stage (silhouette: per round).
   int rigid_iterations = 20;
   int keypoint_iterations = 60;
@@ -110,11 +119,27 @@ struct HandFitInput {
   // project onto these pixels unpenalised and the hand mask's outline next to them is
   // not a hand boundary (docs/fitting.md, "Occlusion").
   std::vector<MaskImage> occluder_masks;
+  // True when objects no occluder mask shows may carve the masks (object masks not
+  // known). Views without an occluder mask then get the one-sided silhouette term:
+  // observed hand pixels must be covered (outline samples pull only outwards), the
+  // projected hand may extend beyond the mask (the mesh -> mask half saturates at
+  // HandFitOptions::unknown_occluder_cap_px).
+  bool unknown_occluders = false;
   std::optional<Points3dTargets> targets3d;
   std::optional<HandParams> previous;
   // Optional per-view pixel rays of the cameras (core/rasterizer.h), for the IoU of
   // the result; computed per call when absent (costly: cache them per rig).
   const std::vector<PixelRays>* pixel_rays = nullptr;
+};
+
+// The result of the keypoint stage (before any silhouette round): what the same fit
+// without silhouettes gives, kept so that a silhouette fit can be checked against it.
+struct HandFitStageResult {
+  HandParams params;
+  Points3d vertices;                // V x 3, world frame
+  Points3d keypoints;               // 21 x 3, SNAP order
+  std::vector<double> view_rms_px;  // as HandFitResult::view_rms_px
+  std::vector<double> view_iou;     // as HandFitResult::view_iou
 };
 
 struct HandFitResult {
@@ -133,6 +158,8 @@ struct HandFitResult {
   double seconds = 0.0;
   bool converged = false;  // the last stage met a Ceres convergence tolerance
   std::string message;     // Ceres' message of the last stage
+  // Set when silhouette rounds ran: the keypoints-only result they started from.
+  std::optional<HandFitStageResult> keypoints_only;
 };
 
 class CeresHandFitter {

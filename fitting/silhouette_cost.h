@@ -16,6 +16,14 @@
 //                  each solve round, fixed during it, like ICP). Point-to-line, so
 //                  vertices may slide along the outline. Alone this term would inflate
 //                  the hand (a larger hand reaches every outline point).
+// Views whose mask may be carved by occluders nobody masked (SilhouetteView::one_sided):
+// observed hand pixels must be covered, the hand may reach beyond the mask. The outline
+// half pulls only outwards, r = min(0, n . (uv_c - p)) / sigma_px, and the mesh -> mask
+// half saturates, x = D - 0.5 becomes cap x / (cap + x) (cap_px; about x near the mask,
+// never above cap): it still holds the hand's size against small excursions, while a
+// finger far outside the mask (perhaps behind an object) is barely pulled (the slope
+// falls as (cap / (cap + x))^2). Without the cap the outward-only outline inflates the
+// hand.
 // Two implementations: MultiViewSilhouetteCost (templated functor, autodiff) and
 // MultiViewSilhouetteCostFunction (the vertices once in ceres::Jet, then every view's
 // projection in doubles with its 2x3 Jacobian chained in: several times faster for 8
@@ -48,6 +56,8 @@ struct SilhouetteView {
   std::vector<Eigen::Vector2d> outline_px;      // mask outline samples (pixel edge)
   std::vector<Eigen::Vector2d> outline_normal;  // unit, pointing out of the mask
   std::vector<int> outline_vertex;  // per outline sample: index into vertex_ids
+  bool one_sided = false;           // unknown occluders: see the header comment
+  double cap_px = 3.0;              // mesh -> mask saturation of one-sided views (> 0)
 };
 
 // Bilinear lookup with clamping at the border; T may be a Jet (the weights carry the
@@ -126,7 +136,10 @@ class MultiViewSilhouetteCost {
         T r = T(0.0);
         if (valid[i]) {
           const T d = BilinearLookup(view.distance_to_mask, uv[2 * i], uv[2 * i + 1]);
-          if (d > T(0.5)) r = (d - 0.5) * inv_sigma_;
+          if (d > T(0.5)) {
+            const T x = d - 0.5;
+            r = (view.one_sided ? view.cap_px * x / (view.cap_px + x) : x) * inv_sigma_;
+          }
         }
         residuals[row++] = r;
       }
@@ -137,6 +150,7 @@ class MultiViewSilhouetteCost {
           const Eigen::Vector2d& p = view.outline_px[s];
           const Eigen::Vector2d& n = view.outline_normal[s];
           r = (n[0] * (uv[2 * c] - p[0]) + n[1] * (uv[2 * c + 1] - p[1])) * inv_sigma_;
+          if (view.one_sided && r > T(0.0)) r = T(0.0);
         }
         residuals[row++] = r;
       }
@@ -234,9 +248,12 @@ class MultiViewSilhouetteCostFunction : public ceres::CostFunction {
           double f, dfdu, dfdv;
           BilinearWithGradient(view.distance_to_mask, uv[i], &f, &dfdu, &dfdv);
           if (f > 0.5) {
-            r = (f - 0.5) * inv_sigma_;
+            const double x = f - 0.5, cap = view.cap_px;
+            // d r / d x: 1, or (cap / (cap + x))^2 when saturated.
+            const double slope = view.one_sided ? std::pow(cap / (cap + x), 2) : 1.0;
+            r = (view.one_sided ? cap * x / (cap + x) : x) * inv_sigma_;
             jac.row(row) =
-                inv_sigma_ * (dfdu * uv_jac[i].row(0) + dfdv * uv_jac[i].row(1));
+                inv_sigma_ * slope * (dfdu * uv_jac[i].row(0) + dfdv * uv_jac[i].row(1));
           }
         }
         residuals[row++] = r;
@@ -247,8 +264,12 @@ class MultiViewSilhouetteCostFunction : public ceres::CostFunction {
         if (c >= 0 && valid[c]) {
           const Eigen::Vector2d& nrm = view.outline_normal[s];
           r = nrm.dot(uv[c] - view.outline_px[s]) * inv_sigma_;
-          jac.row(row) =
-              inv_sigma_ * (nrm[0] * uv_jac[c].row(0) + nrm[1] * uv_jac[c].row(1));
+          if (view.one_sided && r > 0.0) {
+            r = 0.0;
+          } else {
+            jac.row(row) =
+                inv_sigma_ * (nrm[0] * uv_jac[c].row(0) + nrm[1] * uv_jac[c].row(1));
+          }
         }
         residuals[row++] = r;
       }

@@ -7,10 +7,10 @@ namespace handlabel {
 namespace {
 constexpr int kNormalReach = 3;
 
-bool NearOccluder(const MaskImage& occluder, int x, int y) {
+bool NearOccluder(const MaskImage& occluder, int x, int y, int reach) {
   const int h = static_cast<int>(occluder.rows()), w = static_cast<int>(occluder.cols());
-  for (int dy = -kOccluderReachPx; dy <= kOccluderReachPx; ++dy) {
-    for (int dx = -kOccluderReachPx; dx <= kOccluderReachPx; ++dx) {
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
       const int u = x + dx, v = y + dy;
       if (u >= 0 && v >= 0 && u < w && v < h && occluder(v, u) != 0) return true;
     }
@@ -29,7 +29,7 @@ MaskImage HandOrOccluder(const MaskImage& hand, const MaskImage& occluder) {
 }
 
 MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples,
-                              const MaskImage* occluder) {
+                              const MaskImage* occluder, int occluder_reach_px) {
   const int h = static_cast<int>(mask.rows()), w = static_cast<int>(mask.cols());
   std::vector<Eigen::Vector2i> boundary;
   for (int y = 1; y + 1 < h; ++y) {
@@ -37,7 +37,8 @@ MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples,
       if (mask(y, x) == 0) continue;
       if (mask(y - 1, x) == 0 || mask(y + 1, x) == 0 || mask(y, x - 1) == 0 ||
           mask(y, x + 1) == 0) {
-        if (occluder != nullptr && NearOccluder(*occluder, x, y)) continue;
+        if (occluder != nullptr && NearOccluder(*occluder, x, y, occluder_reach_px))
+          continue;
         boundary.emplace_back(x, y);
       }
     }

@@ -18,15 +18,12 @@ struct MaskOutline {
 // outline: the hand continues beyond the image), evenly subsampled in scan order to at
 // most `max_samples`; each point is moved half a pixel along its outward normal (from
 // the centroid of the mask pixels in a 7x7 window towards the pixel). With an
-// `occluder` mask of the same size, mask pixels within kOccluderReachPx of an occluder
-// pixel are not outline either: there the hand may continue behind the occluder.
+// `occluder` mask of the same size, mask pixels within `occluder_reach_px` (Chebyshev)
+// of an occluder pixel are not outline either: there the hand may continue behind the
+// occluder.
 MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples,
-                              const MaskImage* occluder = nullptr);
-
-// How close (pixels, Chebyshev) an occluder pixel must be to a hand mask's boundary
-// pixel to make it an occlusion boundary: 2 px covers anti-aliased and slightly
-// misaligned masks.
-constexpr int kOccluderReachPx = 2;
+                              const MaskImage* occluder = nullptr,
+                              int occluder_reach_px = 2);
 
 // The hand mask joined with the occluder mask: what the hand may project onto.
 MaskImage HandOrOccluder(const MaskImage& hand, const MaskImage& occluder);

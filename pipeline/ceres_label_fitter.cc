@@ -97,6 +97,7 @@ CeresLabelFitter::CeresLabelFitter(const HandModel& model,
     : fitter_(model, options.config, options.fit),
       num_vertices_(model.num_vertices()),
       options_(options) {
+  options.silhouette_check.Check();
   if (options.network_mask_sigma_px > 0) {
     HandFitOptions coarse = options.fit;
     coarse.silhouette_sigma_px = options.network_mask_sigma_px;
@@ -134,6 +135,10 @@ HandFitInput CeresLabelFitter::Evidence(const LabelFitRequest& request,
                             : frame.mask_paths[v].empty()
                                 ? MaskImage()
                                 : ReadMaskPng(frame.mask_paths[v]));
+    }
+    if (!options_.use_object_masks && options_.one_sided_without_object_masks) {
+      *silhouettes = "files+one_sided";
+      input.unknown_occluders = true;
     }
     if (options_.use_object_masks &&
         (!frame.object_mask_paths.empty() || !frame.object_masks.empty())) {
@@ -185,6 +190,24 @@ HandParams CeresLabelFitter::Start(const LabelFitRequest& request,
   return fitter.InitFromViews(input->views);
 }
 
+std::optional<QualityReport> CeresLabelFitter::CheckSilhouettes(
+    HandFitResult* fit) const {
+  if (!fit->keypoints_only) return std::nullopt;
+  HandFitStageResult& kp = *fit->keypoints_only;
+  const HandFitStageResult silhouette_fit{fit->params, fit->vertices, fit->keypoints,
+                                          fit->view_rms_px, fit->view_iou};
+  QualityReport report =
+      CheckSilhouetteFit(silhouette_fit, kp, options_.silhouette_check);
+  if (!report.Passed() && options_.check_silhouettes) {
+    fit->params = kp.params;
+    fit->vertices = std::move(kp.vertices);
+    fit->keypoints = std::move(kp.keypoints);
+    fit->view_rms_px = std::move(kp.view_rms_px);
+    fit->view_iou = std::move(kp.view_iou);
+  }
+  return report;
+}
+
 std::shared_ptr<const std::vector<PixelRays>> CeresLabelFitter::Rays(
     const std::vector<KeypointView>& views) const {
   std::vector<double> key;
@@ -214,7 +237,8 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
   const CeresHandFitter& fitter =
       !request.masks.empty() && network_mask_fitter_ ? *network_mask_fitter_ : fitter_;
   const HandParams init = Start(request, fitter, &input, &start);
-  const HandFitResult fit = fitter.Fit(input, init);
+  HandFitResult fit = fitter.Fit(input, init);
+  const std::optional<QualityReport> check = CheckSilhouettes(&fit);
 
   LabelFit out;
   out.params = fit.params;
@@ -230,6 +254,18 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
                 {"view_rms_px", fit.view_rms_px},
                 {"view_iou", fit.view_iou},
                 {"silhouettes", silhouettes}};
+  if (check) {
+    nlohmann::json flags = nlohmann::json::array();
+    for (const QualityFlag& f : check->flags) flags.push_back(QualityFlagJson(f));
+    out.report["silhouette_check"] = flags;
+    const bool keep = check->Passed() || !options_.check_silhouettes;
+    out.report["used"] = keep ? "silhouettes" : "keypoints_only";
+    out.report["used_why"] =
+        check->Passed() ? "silhouette check passed"
+        : options_.check_silhouettes
+            ? "silhouette check failed: " + check->FailedNames()
+            : "silhouette check off (failed: " + check->FailedNames() + ")";
+  }
   if (silhouettes != "none") {
     out.report["silhouette_sigma_px"] = fitter.options().silhouette_sigma_px;
   }

@@ -13,7 +13,10 @@
 //                              2D keypoints + IK alignment), then fit
 // Silhouettes are used when the request carries them (the network's, evidence.masks:
 // network), or when use_masks is set and the frame has mask files (read with the one
-// mask rule of core/mask_image.h).
+// mask rule of core/mask_image.h). A fit with silhouettes is checked against the
+// keypoints-only fit it started from (CheckSilhouetteFit, pipeline/quality_checks.h);
+// when the check fails, the keypoints-only fit is the label. The report says which
+// (`used`: silhouettes | keypoints_only, `used_why`, `silhouette_check`).
 
 #include <map>
 #include <memory>
@@ -25,6 +28,7 @@
 #include "core/hand_model.h"
 #include "fitting/ceres_hand_fitter.h"
 #include "pipeline/label_stages.h"
+#include "pipeline/quality_checks.h"
 
 namespace handlabel {
 
@@ -33,6 +37,13 @@ struct CeresLabelFitterOptions {
   bool use_masks = false;
   // With mask files: the frame's object masks are occluders (evidence.object_masks).
   bool use_object_masks = true;
+  // Without object masks (use_object_masks false): true = one-sided silhouettes
+  // (HandFitInput::unknown_occluders); false = the two-sided term, guarded by the
+  // silhouette check (measured safer: docs/fitting.md "Occlusion").
+  bool one_sided_without_object_masks = false;
+  // Keep a silhouette fit only when it passes these; else the keypoints-only fit.
+  bool check_silhouettes = true;
+  SilhouetteCheckThresholds silhouette_check;
   HandFitConfig config;
   HandFitOptions fit;
   // > 0: silhouettes that come with the request (the network's) are fitted with this
@@ -58,6 +69,10 @@ class CeresLabelFitter : public LabelFitter {
   // names it for the report.
   HandParams Start(const LabelFitRequest& request, const CeresHandFitter& fitter,
                    HandFitInput* input, std::string* start) const;
+
+  // With silhouette rounds run: the check of the silhouette fit; when it fails and
+  // check_silhouettes is set, `fit` becomes its keypoints-only result.
+  std::optional<QualityReport> CheckSilhouettes(HandFitResult* fit) const;
 
   // Pixel rays of the views' cameras, for the IoU of fits with silhouettes; computed
   // once per set of cameras (a capture's rig) for up to kMaxRigs sets, then per fit.

@@ -69,6 +69,11 @@ void CheckFitSettings(const FitSettings& fit, const std::string& f) {
     throw InputError(f, "fit.silhouette_rounds", ">= 0",
                      std::to_string(*fit.silhouette_rounds));
   }
+  if (fit.unknown_occluders && *fit.unknown_occluders != "one_sided" &&
+      *fit.unknown_occluders != "two_sided") {
+    throw InputError(f, "fit.unknown_occluders", "one_sided | two_sided",
+                     "'" + *fit.unknown_occluders + "'");
+  }
   if (fit.pose_pca_comps && *fit.pose_pca_comps != 0 && *fit.pose_pca_comps != 12 &&
       *fit.pose_pca_comps != 45) {
     throw InputError(f, "fit.pose_pca_comps", "0, 12 or 45",
@@ -114,6 +119,8 @@ void ReadFitSection(Section& top, JobConfig* job) {
   ReadOptional(fit, "pose_pca_comps", &s.pose_pca_comps);
   ReadOptional(fit, "joint_limits", &s.joint_limits);
   ReadOptional(fit, "optimise_shape", &s.optimise_shape);
+  ReadOptional(fit, "silhouette_check", &s.silhouette_check);
+  ReadOptional(fit, "unknown_occluders", &s.unknown_occluders);
   fit.RejectUnknownKeys();
 }
 
@@ -178,7 +185,8 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
 bool FitSettings::IsDefault() const {
   return init == "triangulate" && !keypoint_loss && !keypoint_loss_scale &&
          !keypoint_sigma_px && !silhouette_sigma_px && !silhouette_rounds &&
-         !pose_pca_comps && !joint_limits && !optimise_shape;
+         !pose_pca_comps && !joint_limits && !optimise_shape && !silhouette_check &&
+         !unknown_occluders;
 }
 
 std::string ToString(RefineMode mode) {

@@ -49,6 +49,13 @@ struct FitSettings {
   std::optional<int> pose_pca_comps;          // 0 (45 axis-angle values), 12 or 45
   std::optional<bool> joint_limits;           // anatomical joint limits
   std::optional<bool> optimise_shape;         // false: betas stay at the start's
+  // Keep a silhouette fit only if it agrees with the keypoints-only fit (quality check
+  // silhouette conflict, pipeline/quality_checks.h); false: always keep it.
+  std::optional<bool> silhouette_check;
+  // Silhouettes where object masks are not used (evidence.object_masks: none):
+  // "two_sided" (the full term, guarded by the silhouette check; the default) or
+  // "one_sided" (only observed hand pixels must be covered).
+  std::optional<std::string> unknown_occluders;
 
   // True when nothing differs from the defaults (the job hash then leaves `fit` out,
   // so jobs written before the section existed keep their hash).

@@ -84,15 +84,20 @@ nlohmann::json Optional(const std::optional<T>& value) {
 }
 
 nlohmann::json FitSettingsJson(const FitSettings& f) {
-  return {f.init,
-          Optional(f.keypoint_loss),
-          Optional(f.keypoint_loss_scale),
-          Optional(f.keypoint_sigma_px),
-          Optional(f.silhouette_sigma_px),
-          Optional(f.silhouette_rounds),
-          Optional(f.pose_pca_comps),
-          Optional(f.joint_limits),
-          Optional(f.optimise_shape)};
+  nlohmann::json j = {f.init,
+                      Optional(f.keypoint_loss),
+                      Optional(f.keypoint_loss_scale),
+                      Optional(f.keypoint_sigma_px),
+                      Optional(f.silhouette_sigma_px),
+                      Optional(f.silhouette_rounds),
+                      Optional(f.pose_pca_comps),
+                      Optional(f.joint_limits),
+                      Optional(f.optimise_shape)};
+  // Added later: only when set, so the hash of older fit settings stays.
+  if (f.silhouette_check || f.unknown_occluders) {
+    j.push_back({Optional(f.silhouette_check), Optional(f.unknown_occluders)});
+  }
+  return j;
 }
 
 }  // namespace

@@ -72,13 +72,7 @@ json LabelToJson(const LabelRecord& label) {
   j["joints_native"] = JsonPoints(label.mesh.joints);
   j["vertices"] = JsonPoints(label.mesh.vertices);
   json checks = json::array();
-  for (const QualityFlag& f : label.quality.flags) {
-    checks.push_back({{"name", f.name},
-                      {"passed", f.passed},
-                      {"value", f.value},
-                      {"threshold", f.threshold},
-                      {"detail", f.detail}});
-  }
+  for (const QualityFlag& f : label.quality.flags) checks.push_back(QualityFlagJson(f));
   j["quality"] = {{"checked", !label.quality.flags.empty()},
                   {"passed", label.quality.Passed()},
                   {"checks", checks}};

@@ -35,6 +35,10 @@ CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
   o.config.pose_pca_comps = s.pose_pca_comps.value_or(o.config.pose_pca_comps);
   o.config.use_joint_limits = s.joint_limits.value_or(o.config.use_joint_limits);
   o.config.optimise_shape = s.optimise_shape.value_or(o.config.optimise_shape);
+  o.check_silhouettes = s.silhouette_check.value_or(o.check_silhouettes);
+  if (s.unknown_occluders) {
+    o.one_sided_without_object_masks = *s.unknown_occluders == "one_sided";
+  }
   return o;
 }
 

@@ -4,6 +4,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/errors.h"
 #include "core/triangulation.h"
 
 namespace handlabel {
@@ -139,6 +140,14 @@ QualityFlag ViewAgreementFlag(const Rig& rig, const MeshPrediction& prediction,
 
 }  // namespace
 
+nlohmann::json QualityFlagJson(const QualityFlag& f) {
+  return {{"name", f.name},
+          {"passed", f.passed},
+          {"value", f.value},
+          {"threshold", f.threshold},
+          {"detail", f.detail}};
+}
+
 bool QualityReport::Passed() const {
   for (const QualityFlag& f : flags) {
     if (!f.passed) return false;
@@ -188,6 +197,54 @@ QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
   report.flags.push_back(
       ReprojectionFlag(rig, prediction, confident, confident_views, t));
   report.flags.push_back(ViewAgreementFlag(rig, prediction, confident, t));
+  return report;
+}
+
+void SilhouetteCheckThresholds::Check() const {
+  if (!(max_keypoint_rms_rise_px >= 0)) {
+    throw InputError("silhouette check", "max_keypoint_rms_rise_px", ">= 0",
+                     Format(max_keypoint_rms_rise_px));
+  }
+  if (!(min_view_iou >= 0 && min_view_iou <= 1)) {
+    throw InputError("silhouette check", "min_view_iou", "0..1", Format(min_view_iou));
+  }
+}
+
+QualityReport CheckSilhouetteFit(const HandFitStageResult& silhouette_fit,
+                                 const HandFitStageResult& keypoints_only,
+                                 const SilhouetteCheckThresholds& t) {
+  HL_CHECK(silhouette_fit.view_rms_px.size() == keypoints_only.view_rms_px.size() &&
+               silhouette_fit.view_iou.size() == silhouette_fit.view_rms_px.size(),
+           "the two fits have the same views");
+  QualityReport report;
+  double rise = 0;
+  int views = 0;
+  for (size_t v = 0; v < silhouette_fit.view_rms_px.size(); ++v) {
+    const double a = silhouette_fit.view_rms_px[v], b = keypoints_only.view_rms_px[v];
+    if (!std::isfinite(a) || !std::isfinite(b)) continue;
+    rise += a - b;
+    ++views;
+  }
+  if (views > 0) rise /= views;
+  report.flags.push_back({"keypoint_agreement", rise <= t.max_keypoint_rms_rise_px, rise,
+                          t.max_keypoint_rms_rise_px,
+                          "keypoint RMS " + Format(rise) +
+                              " px above the keypoints-only fit's (mean over " +
+                              std::to_string(views) + " views)"});
+  double worst = kInf;
+  int worst_view = -1;
+  for (size_t v = 0; v < silhouette_fit.view_iou.size(); ++v) {
+    if (std::isfinite(silhouette_fit.view_iou[v]) && silhouette_fit.view_iou[v] < worst) {
+      worst = silhouette_fit.view_iou[v];
+      worst_view = static_cast<int>(v);
+    }
+  }
+  const bool any = worst_view >= 0;
+  report.flags.push_back(
+      {"silhouette_iou", !any || worst >= t.min_view_iou, any ? worst : 1.0,
+       t.min_view_iou,
+       any ? "worst IoU " + Format(worst) + " in view " + std::to_string(worst_view)
+           : "no view with a mask"});
   return report;
 }
 

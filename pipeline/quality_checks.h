@@ -6,9 +6,11 @@
 // policy (refine.mode fallback) fits from 2D evidence alone when any check fails.
 // Thresholds come from the job's `refine` section (QualityThresholds).
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "fitting/ceres_hand_fitter.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_stages.h"
 
@@ -22,8 +24,11 @@ struct QualityFlag {
   std::string detail;    // human-readable explanation
 };
 
+// {name, passed, value, threshold, detail}: how labels record a check.
+nlohmann::json QualityFlagJson(const QualityFlag& flag);
+
 struct QualityReport {
-  std::vector<QualityFlag> flags;  // always all five, in the order above
+  std::vector<QualityFlag> flags;  // in the order its check function lists them
   bool Passed() const;
   // Names of the failed checks, comma separated ("" when all passed).
   std::string FailedNames() const;
@@ -42,5 +47,33 @@ struct QualityReport {
 //                   views and the 3D keypoints <= max_view_disagreement_mm (value: mm)
 QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
                               const QualityThresholds& thresholds);
+
+// Silhouette conflict: does a fit with silhouettes still agree with the 2D keypoints,
+// and does its hand cover the observed hand mask? Masks show the visible hand only, and
+// an object nobody masked, a wrong mask or a bad match can pull the fit away from the
+// keypoints; the keypoints-only fit it started from (HandFitResult::keypoints_only) is
+// the reference. The fitter's label then prefers the keypoints-only fit
+// (pipeline/ceres_label_fitter.h).
+struct SilhouetteCheckThresholds {
+  // Largest rise (px) of the keypoint reprojection RMS, averaged over the views with
+  // keypoints, from the keypoints-only fit to the silhouette fit. Chosen on 48 object
+  // frames (3 tuning seeds, docs/fitting.md "Occlusion"): 0.2 px beat 0.1, 0.15, 0.3
+  // and 0.5 (MPJPE 2.29 mm vs 2.37, 2.33, 2.33, 2.40).
+  double max_keypoint_rms_rise_px = 0.2;
+  // Smallest per-view silhouette IoU of the silhouette fit (occluded pixels left out,
+  // views with a mask only): a sanity bound for gross failures (0.53 was the lowest
+  // of an accepted fit in those frames).
+  double min_view_iou = 0.5;
+  // Throws InputError naming the field.
+  void Check() const;
+};
+
+// Flags, in this order:
+//   keypoint_agreement  mean over views of (RMS of the silhouette fit - RMS of the
+//                       keypoints-only fit) <= max_keypoint_rms_rise_px (value: px)
+//   silhouette_iou      worst view's IoU of the silhouette fit >= min_view_iou (value)
+QualityReport CheckSilhouetteFit(const HandFitStageResult& silhouette_fit,
+                                 const HandFitStageResult& keypoints_only,
+                                 const SilhouetteCheckThresholds& thresholds);
 
 }  // namespace handlabel

@@ -42,6 +42,45 @@ TEST(FitCommand, BadLossIsAnError) {
   EXPECT_NE(r.err.find("--loss"), std::string::npos) << r.err;
 }
 
+TEST(FitCommand, BadUnknownOccludersIsAnErrorNamingTheFlag) {
+  const std::string dir = testing::ScratchDir();
+  const CommandResult r = RunHandlabelCommand(
+      {"fit", "--capture", dir, "--out", dir + "/out", "--unknown-occluders", "x"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--unknown-occluders"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("one_sided | two_sided"), std::string::npos) << r.err;
+}
+
+// The silhouette flags are job fields too: --no-silhouette-check is
+// fit.silhouette_check: false, --unknown-occluders is fit.unknown_occluders.
+TEST(FitCommand, SilhouetteCheckFlagsMapToJobFields) {
+  const std::string dir = testing::ScratchDir();
+  testing::WriteTestCapture(dir + "/capture", 1, 6);
+  const CommandResult fit = RunHandlabelCommand(
+      {"fit", "--capture", dir + "/capture", "--out", dir + "/fit", "--hand-model",
+       "capsule", "--evidence", "keypoints", "--masks", "truth", "--silhouette-rounds",
+       "1", "--object-masks", "none", "--unknown-occluders", "one_sided",
+       "--no-silhouette-check"});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  const std::string job = dir + "/job.yaml";
+  std::ofstream(job) << "hand_model: capsule\n"
+                     << "input: {format: native, path: capture}\n"
+                     << "refine: {mode: always}\n"
+                     << "evidence: {keypoints_2d: files, masks: files, keypoint_files: "
+                        "keypoints, mask_files: truth, object_masks: none}\n"
+                     << "fit: {silhouette_rounds: 1, silhouette_check: false, "
+                        "unknown_occluders: one_sided}\n"
+                     << "output: {dir: label, overlays: false}\n";
+  const CommandResult label = RunHandlabelCommand({"label", "--job", job});
+  ASSERT_EQ(label.status, 0) << label.err;
+  EXPECT_EQ(testing::FilesUnder(dir + "/fit/labels"),
+            testing::FilesUnder(dir + "/label/labels"));
+  const LabelRecord record = ReadLabelFile(LabelFilePath(dir + "/fit", "000000"));
+  EXPECT_EQ(record.fit.at("silhouettes"), "files+one_sided");
+  EXPECT_EQ(record.fit.at("used"), "silhouettes");
+  EXPECT_EQ(record.fit.at("silhouette_check").size(), 2u);
+}
+
 // `fit` is a label job without a network: on the same capture it writes the same label
 // files, byte for byte, as `label` with the matching job (default rules: detections
 // and detection masks, triangulated start), and reports the errors against the truth.

@@ -222,5 +222,35 @@ TEST(CeresHandFitterSilhouetteTest, OccluderMasksKeepFingersBehindAnObject) {
   }
 }
 
+// The same object, but nobody masked it: with unknown_occluders the silhouettes are
+// one-sided and leave the hidden fingers where the keypoints put them. The result
+// also carries the keypoints-only fit the silhouette rounds started from.
+TEST(CeresHandFitterSilhouetteTest, OneSidedSilhouettesWithUnknownOccluders) {
+  const SilhouetteScene scene;
+  for (int trial = 0; trial < 2; ++trial) {
+    auto [frame, input] = scene.NextTrial();
+    const CeresHandFitter& fitter = scene.fitter;
+    OccludeTwoFingers(frame, &input.masks);
+    input.unknown_occluders = true;
+    const HandParams init = fitter.InitFromViews(input.views);
+    const HandFitResult one_sided = fitter.Fit(input, init);
+    const double one_sided_mm =
+        1000 * FingerError(one_sided.keypoints, frame.mesh.keypoints);
+    std::cout << "trial " << trial << ": one-sided " << one_sided_mm << " mm\n";
+    EXPECT_LT(one_sided_mm, 2.0) << trial;
+    ASSERT_TRUE(one_sided.keypoints_only.has_value());
+    const HandFitStageResult& kp = *one_sided.keypoints_only;
+    EXPECT_LT(MeanPointError(kp.keypoints, frame.mesh.keypoints), 0.002) << trial;
+    EXPECT_EQ(kp.view_rms_px.size(), 8u);
+    EXPECT_EQ(kp.view_iou.size(), 8u);
+    // The keypoints-only fit is what the same fit without silhouettes gives.
+    HandFitInput no_masks = input;
+    no_masks.masks.clear();
+    const HandFitResult plain = fitter.Fit(no_masks, init);
+    EXPECT_FALSE(plain.keypoints_only.has_value());
+    EXPECT_LT(MeanPointError(plain.keypoints, kp.keypoints), 1e-9) << trial;
+  }
+}
+
 }  // namespace
 }  // namespace handlabel

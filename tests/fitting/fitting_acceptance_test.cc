@@ -53,11 +53,19 @@ struct Totals {
   }
 };
 
+// Objects in the scene: none, a ball held against the fingers with its occluder masks
+// given to the fitter, the same ball with occluders unknown (HandFitInput::
+// unknown_occluders: one-sided silhouettes), or unknown and ignored (the two-sided term
+// as on empty hands).
+enum class Objects { kNone, kMasked, kUnknown, kIgnored };
+
 // noisy = false: exact keypoints and masks. true: 2 px noise, 10 % outliers, one or
 // two views without keypoints or masks (alternating), masks kept for the others.
+// With objects, keypoints behind the ball get 6 px more noise and confidence 0.3
+// (testing::HoldBall) and the masks show the visible hand only.
 // image_scale 0.5 (320x240 images) keeps the enabled tests fast.
 Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed,
-                   double image_scale = 1.0) {
+                   double image_scale = 1.0, Objects objects = Objects::kNone) {
   const std::vector<PixelRays> rays = RigRays(image_scale);
   const HandModel& model = OpenHand();
   HandFitOptions options;
@@ -72,9 +80,16 @@ Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed,
   for (int f = 0; f < frames; ++f) {
     testing::SceneFrame frame = testing::RandomSceneFrame(model, rng, 0.8, image_scale);
     HandFitInput input;
-    for (size_t v = 0; v < frame.views.size(); ++v) {
-      input.masks.push_back(RenderHandMask(frame.mesh.vertices, model.faces,
-                                           frame.views[v].camera, rays[v]));
+    if (objects == Objects::kNone) {
+      for (size_t v = 0; v < frame.views.size(); ++v) {
+        input.masks.push_back(RenderHandMask(frame.mesh.vertices, model.faces,
+                                             frame.views[v].camera, rays[v]));
+      }
+    } else {
+      testing::HeldBall ball = testing::HoldBall(model, &frame, rays, 6.0, rng);
+      input.masks = std::move(ball.hand_masks);
+      if (objects == Objects::kMasked) input.occluder_masks = ball.occluder_masks;
+      input.unknown_occluders = objects == Objects::kUnknown;
     }
     if (noisy) {
       const std::vector<int> occluded =
@@ -131,6 +146,32 @@ TEST(FittingAcceptance, SilhouettesImproveNoisyKeypoints) {
   const Totals without = RunScenario(2, true, false, 11, 0.5);
   without.Print("noisy kp only");
   EXPECT_LT(with.mpvpe, 0.9 * without.mpvpe);
+}
+
+// Hands holding a ball (noisy keypoints, outliers, occluded views as above): with the
+// ball's occluder masks the silhouettes must not make the fit worse than keypoints
+// alone; ignoring the ball (two-sided silhouettes on the carved masks) does.
+TEST(FittingAcceptance, HeldBallWithOccluderMasks) {
+  const Totals masked = RunScenario(2, true, true, 21, 0.5, Objects::kMasked);
+  masked.Print("ball, kp+masks+occluder masks");
+  const Totals kp = RunScenario(2, true, false, 21, 0.5, Objects::kMasked);
+  kp.Print("ball, kp only");
+  const Totals ignored = RunScenario(2, true, true, 21, 0.5, Objects::kIgnored);
+  ignored.Print("ball, kp+masks, ball ignored");
+  EXPECT_LE(masked.mpjpe / masked.frames, 0.006);
+  EXPECT_LE(masked.mpjpe, 1.02 * kp.mpjpe);
+  EXPECT_GT(ignored.mpjpe, masked.mpjpe);
+}
+
+TEST(FittingAcceptance, DISABLED_FiftyFramesHoldingABall) {
+  for (Objects o : {Objects::kMasked, Objects::kUnknown, Objects::kIgnored}) {
+    const char* names[] = {"", "ball, kp+masks+occluder masks", "ball, one-sided",
+                           "ball, ball ignored"};
+    RunScenario(50, true, true, 12, 1.0, o).Print(names[static_cast<int>(o)]);
+  }
+  RunScenario(50, true, false, 12, 1.0, Objects::kMasked).Print("ball, kp only");
+  RunScenario(50, false, true, 12, 1.0, Objects::kMasked)
+      .Print("ball, exact kp+masks+occluder masks");
 }
 
 TEST(FittingAcceptance, DISABLED_FiftyFrames) {

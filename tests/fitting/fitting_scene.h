@@ -6,6 +6,7 @@
 // occluded views are added by the caller.
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -13,6 +14,9 @@
 #include "core/hand_anatomy.h"
 #include "core/hand_lbs.h"
 #include "core/hand_pose_sampler.h"
+#include "core/mask_image.h"
+#include "core/mesh_primitives.h"
+#include "core/rasterizer.h"
 #include "core/rig.h"
 #include "fitting/keypoint_view.h"
 
@@ -97,6 +101,69 @@ inline void CorruptViews(std::vector<KeypointView>* views, double sigma_px,
     }
   }
   for (int v : occluded) (*views)[v].keypoints.confidence.setZero();
+}
+
+// A ball held against the fingers: radius 2.5 cm, centred 2 cm off the middle of the
+// index and middle fingers (PIP and DIP keypoints) on the palm side. Per view: the
+// visible hand pixels (replacing the full hand mask), the ball's pixels (the occluder
+// mask, 255) and which keypoints the ball hides. A detector sees those worse: they get
+// confidence 0.3 and `hidden_sigma_px` of extra Gaussian noise (the rule of
+// capture/synth_detections.h in short).
+struct HeldBall {
+  std::vector<MaskImage> hand_masks;
+  std::vector<MaskImage> occluder_masks;
+  int hidden_keypoints = 0;  // over all views
+};
+
+inline HeldBall HoldBall(const HandModel& model, SceneFrame* frame,
+                         const std::vector<PixelRays>& rays, double hidden_sigma_px,
+                         std::mt19937_64& rng) {
+  const Points3d& kp = frame->mesh.keypoints;
+  const Eigen::Vector3d wrist = kp.row(0).transpose();
+  const Eigen::Vector3d palm_normal =
+      (kp.row(5).transpose() - wrist).cross(kp.row(17).transpose() - wrist).normalized();
+  const Eigen::Vector3d fingers =
+      (kp.row(6) + kp.row(7) + kp.row(10) + kp.row(11)).transpose() / 4.0;
+  RenderMesh ball = MakeSphere(0.025);
+  TransformMesh(Rigid3(Eigen::Quaterniond::Identity(), fingers + 0.02 * palm_normal),
+                &ball);
+  RenderMesh hand;
+  hand.vertices = frame->mesh.vertices;
+  hand.faces = model.faces;
+  std::normal_distribution<double> g(0.0, hidden_sigma_px);
+  HeldBall out;
+  for (size_t v = 0; v < frame->views.size(); ++v) {
+    KeypointView& view = frame->views[v];
+    VisibilityBuffer buffer;
+    buffer.Reset(rays[v].width(), rays[v].height());
+    RasterizeMesh(hand, 0, view.camera.cam_from_world, rays[v], &buffer);
+    RasterizeMesh(ball, 1, view.camera.cam_from_world, rays[v], &buffer);
+    MaskImage hand_mask = MaskImage::Zero(rays[v].height(), rays[v].width());
+    MaskImage ball_mask = hand_mask;
+    for (int y = 0; y < rays[v].height(); ++y) {
+      for (int x = 0; x < rays[v].width(); ++x) {
+        const int id = buffer.mesh_id[buffer.index(x, y)];
+        hand_mask(y, x) = id == 0 ? 255 : 0;
+        ball_mask(y, x) = id == 1 ? 255 : 0;
+      }
+    }
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      const Eigen::Vector2d uv = view.keypoints.uv_px.row(k).transpose();
+      const int x = static_cast<int>(std::lround(uv.x()));
+      const int y = static_cast<int>(std::lround(uv.y()));
+      if (x < 0 || y < 0 || x >= rays[v].width() || y >= rays[v].height()) continue;
+      const size_t i = buffer.index(x, y);
+      const double z = (view.camera.cam_from_world * kp.row(k).transpose()).z();
+      if (buffer.mesh_id[i] != 1 || !(buffer.depth[i] < z)) continue;
+      view.keypoints.uv_px(k, 0) += g(rng);
+      view.keypoints.uv_px(k, 1) += g(rng);
+      view.keypoints.confidence[k] = std::min(view.keypoints.confidence[k], 0.3);
+      ++out.hidden_keypoints;
+    }
+    out.hand_masks.push_back(std::move(hand_mask));
+    out.occluder_masks.push_back(std::move(ball_mask));
+  }
+  return out;
 }
 
 }  // namespace handlabel::testing

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace handlabel {
@@ -40,17 +41,18 @@ TEST(SilhouetteOutlineTest, MatchesNearestValidPoint) {
 }
 
 // A square hand mask whose right side touches an object: the outline keeps the other
-// three sides and drops the pixels within kOccluderReachPx of the object.
+// three sides and drops the pixels within the occluder reach of the object.
 TEST(SilhouetteOutlineTest, NoOutlineNextToAnOccluder) {
+  constexpr int kReach = 2;  // SampleMaskOutline's default
   MaskImage hand = MaskImage::Zero(40, 40);
   hand.block(10, 10, 20, 20).setConstant(255);  // columns 10..29
   MaskImage object = MaskImage::Zero(40, 40);
   object.block(5, 30, 30, 6).setConstant(255);  // columns 30..35, right of the hand
   const MaskOutline all = SampleMaskOutline(hand, 1000);
   const MaskOutline visible = SampleMaskOutline(hand, 1000, &object);
-  // Kept boundary pixels reach column 29 - kOccluderReachPx; points sit at most half a
-  // pixel further out.
-  const double last_kept = 29 - kOccluderReachPx + 0.5;
+  // Kept boundary pixels reach column 29 - kReach; points sit at most half a pixel
+  // further out.
+  const double last_kept = 29 - kReach + 0.5;
   int right_all = 0, right_visible = 0;
   for (const Eigen::Vector2d& p : all.points) right_all += p.x() > last_kept;
   for (const Eigen::Vector2d& p : visible.points) right_visible += p.x() > last_kept;
@@ -61,6 +63,25 @@ TEST(SilhouetteOutlineTest, NoOutlineNextToAnOccluder) {
   EXPECT_EQ(joined(20, 33), 255);
   EXPECT_EQ(joined(20, 20), 255);
   EXPECT_EQ(joined(2, 2), 0);
+}
+
+// A wider reach drops more of the outline: the pixels of the top and bottom sides
+// within reach of the object's columns go too.
+TEST(SilhouetteOutlineTest, OccluderReachIsTheGapThatStillCounts) {
+  MaskImage hand = MaskImage::Zero(40, 40);
+  hand.block(10, 10, 20, 20).setConstant(255);  // columns 10..29
+  MaskImage object = MaskImage::Zero(40, 40);
+  object.block(5, 33, 30, 4).setConstant(255);  // columns 33..36: a 3-pixel gap
+  auto rightmost = [](const MaskOutline& outline) {
+    double x = 0;
+    for (const Eigen::Vector2d& p : outline.points) x = std::max(x, p.x());
+    return x;
+  };
+  // Reach 2 does not bridge the gap: the right side stays an outline (x = 29.5).
+  EXPECT_NEAR(rightmost(SampleMaskOutline(hand, 1000, &object, 2)), 29.5, 1e-9);
+  // Reach 4 does: boundary pixels from column 33 - 4 = 29 on are dropped.
+  EXPECT_LE(rightmost(SampleMaskOutline(hand, 1000, &object, 4)), 28.5 + 1e-9);
+  EXPECT_LE(rightmost(SampleMaskOutline(hand, 1000, &object, 6)), 26.5 + 1e-9);
 }
 
 }  // namespace

@@ -77,6 +77,8 @@ TEST(FitCaptureTest, ObjectMasksKeepTheSilhouettesFromPullingTheHandOut) {
   const FitCaptureSummary aware = FitCapture(o);
   o.out_dir = scratch + "/unaware";
   o.object_masks = "none";
+  o.fit.unknown_occluders = "two_sided";  // as if the frames were free of objects
+  o.fit.silhouette_check = false;
   const FitCaptureSummary unaware = FitCapture(o);
   RecordProperty("aware_um", int(1e6 * aware.mpjpe));
   RecordProperty("unaware_um", int(1e6 * unaware.mpjpe));
@@ -87,6 +89,54 @@ TEST(FitCaptureTest, ObjectMasksKeepTheSilhouettesFromPullingTheHandOut) {
   EXPECT_GT(unaware.mpjpe, 1.5 * aware.mpjpe);
   const LabelRecord label = ReadLabelFile(LabelFilePath(scratch + "/aware", "000000"));
   EXPECT_EQ(label.fit.value("silhouettes", ""), "files+object_masks");
+  EXPECT_EQ(label.fit.value("used", ""), "silhouettes");
+}
+
+// The same capture without object masks: the two-sided silhouettes pull the hand out of
+// the objects' pixels, the silhouette check notices that the fit left the keypoints and
+// the label is the keypoints-only fit (the default); unchecked, the labels are far off.
+TEST(FitCaptureTest, WithoutObjectMasksTheSilhouetteCheckFallsBackToKeypoints) {
+  const std::string scratch = testing::ScratchDir();
+  FitCaptureOptions o;
+  o.capture_dir = SmallCapture(scratch, 4, /*objects=*/true);
+  o.evidence = "keypoints";
+  o.hand_model = "capsule";
+  o.num_threads = 2;
+  o.masks = "none";
+  o.out_dir = scratch + "/keypoints";
+  const FitCaptureSummary keypoints = FitCapture(o);
+  o.masks = "truth";
+  o.object_masks = "none";
+  o.out_dir = scratch + "/checked";
+  const FitCaptureSummary checked = FitCapture(o);
+  o.fit.silhouette_check = false;
+  o.out_dir = scratch + "/unchecked";
+  const FitCaptureSummary unchecked = FitCapture(o);
+  o.fit.unknown_occluders = "one_sided";
+  o.out_dir = scratch + "/one_sided";
+  FitCapture(o);
+  std::cout << "MPJPE mm: keypoints only " << 1e3 * keypoints.mpjpe
+            << ", two-sided + check " << 1e3 * checked.mpjpe << ", unchecked "
+            << 1e3 * unchecked.mpjpe << "\n";
+  EXPECT_LT(checked.mpjpe, keypoints.mpjpe + 0.0005);
+  EXPECT_GT(unchecked.mpjpe, checked.mpjpe + 0.002);
+  int fell_back = 0;
+  for (const char* frame : {"000000", "000001", "000002", "000003"}) {
+    const LabelRecord label = ReadLabelFile(LabelFilePath(scratch + "/checked", frame));
+    EXPECT_EQ(label.fit.value("silhouettes", ""), "files");
+    ASSERT_EQ(label.fit.at("silhouette_check").size(), 2u);
+    if (label.fit.value("used", "") != "keypoints_only") continue;
+    ++fell_back;
+    EXPECT_NE(label.fit.value("used_why", "").find("silhouette check failed"),
+              std::string::npos);
+  }
+  EXPECT_GT(fell_back, 0);
+  const LabelRecord unchecked_label =
+      ReadLabelFile(LabelFilePath(scratch + "/unchecked", "000000"));
+  EXPECT_EQ(unchecked_label.fit.value("used", ""), "silhouettes");
+  const LabelRecord one_sided =
+      ReadLabelFile(LabelFilePath(scratch + "/one_sided", "000000"));
+  EXPECT_EQ(one_sided.fit.value("silhouettes", ""), "files+one_sided");
 }
 
 TEST(FitCaptureTest, PreviousStartsFromThePreviousLabel) {

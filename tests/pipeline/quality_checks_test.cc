@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "core/errors.h"
 #include "tests/pipeline/label_test_stages.h"
 #include "tests/test_util.h"
 
@@ -115,6 +116,49 @@ TEST(QualityChecks, ImplausibleSizeOrAHandBehindACameraFailsRange) {
   MeshPrediction behind = ExactPrediction(rig);
   behind.keypoints.rowwise() += 1.5 * rig[0].CenterInWorld().transpose();
   EXPECT_FALSE(Flag(CheckPrediction(rig, behind, {}), "range").passed);
+}
+
+// Silhouette conflict: per-view keypoint RMS and IoU of a silhouette fit against the
+// keypoints-only fit it started from. Views without keypoints (NaN) do not count.
+HandFitStageResult StageWith(std::vector<double> rms, std::vector<double> iou) {
+  HandFitStageResult r;
+  r.view_rms_px = std::move(rms);
+  r.view_iou = std::move(iou);
+  return r;
+}
+
+TEST(SilhouetteCheck, AgreeingFitsPass) {
+  const double nan = std::nan("");
+  const HandFitStageResult kp = StageWith({2.0, 3.0, nan}, {0.80, 0.70, nan});
+  const HandFitStageResult sil = StageWith({2.1, 3.1, nan}, {0.90, 0.85, nan});
+  const QualityReport r = CheckSilhouetteFit(sil, kp, {});
+  ASSERT_EQ(r.flags.size(), 2u);
+  EXPECT_TRUE(r.Passed()) << r.FailedNames();
+  EXPECT_NEAR(Flag(r, "keypoint_agreement").value, 0.1, 1e-12);  // (0.1 + 0.1) / 2
+  EXPECT_NEAR(Flag(r, "silhouette_iou").value, 0.85, 1e-12);
+}
+
+TEST(SilhouetteCheck, ASilhouetteFitThatLeavesTheKeypointsFails) {
+  const HandFitStageResult kp = StageWith({2.0, 3.0}, {0.80, 0.70});
+  SilhouetteCheckThresholds t;
+  t.max_keypoint_rms_rise_px = 0.5;
+  // Mean rise (0.4 + 0.8) / 2 = 0.6 px > 0.5.
+  const QualityReport r = CheckSilhouetteFit(StageWith({2.4, 3.8}, {0.9, 0.9}), kp, t);
+  EXPECT_EQ(r.FailedNames(), "keypoint_agreement");
+  EXPECT_NEAR(Flag(r, "keypoint_agreement").value, 0.6, 1e-12);
+  // At the threshold it passes.
+  EXPECT_TRUE(CheckSilhouetteFit(StageWith({2.4, 3.6}, {0.9, 0.9}), kp, t).Passed());
+}
+
+TEST(SilhouetteCheck, AViewWhoseMaskTheFitMissesFailsIou) {
+  const HandFitStageResult kp = StageWith({2.0, 3.0}, {0.80, 0.70});
+  SilhouetteCheckThresholds t;
+  t.min_view_iou = 0.5;
+  const QualityReport r = CheckSilhouetteFit(StageWith({2.0, 3.0}, {0.9, 0.3}), kp, t);
+  EXPECT_EQ(r.FailedNames(), "silhouette_iou");
+  EXPECT_NEAR(Flag(r, "silhouette_iou").value, 0.3, 1e-12);
+  t.min_view_iou = -0.1;
+  EXPECT_THROW(t.Check(), InputError);
 }
 
 }  // namespace
