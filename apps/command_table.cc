@@ -31,11 +31,14 @@ const std::vector<Command>& AllCommands() {
       {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",
        RunCameras},
       {"calib", "calibrate a camera rig from board images or with COLMAP", RunCalib},
-      {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
+      {"synth", "generate a synthetic multi-view hand capture with ground truth",
+       RunSynth},
       {"fit", "fit the hand model to a capture's 2D keypoints and masks (Ceres)", RunFit},
       {"train", "train the POEM network on synthetic captures (resumable)", RunTrain},
       {"eval-network", "MPJPE / MPVPE / AUC of POEM weights on held-out synthetic frames",
        RunEvalNetwork},
+      {"compare", "run every method on the same frames: the paper's table, HTML report",
+       RunCompare},
   };
   return commands;
 }

@@ -33,5 +33,6 @@ int RunSynth(int argc, char** argv);
 int RunFit(int argc, char** argv);
 int RunTrain(int argc, char** argv);
 int RunEvalNetwork(int argc, char** argv);
+int RunCompare(int argc, char** argv);
 
 }  // namespace handlabel
