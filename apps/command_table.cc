@@ -34,12 +34,16 @@ const std::vector<Command>& AllCommands() {
       {"capture", "make a capture from a rig and import image folders or videos",
        RunCapture},
       {"synth", "generate a synthetic multi-view hand capture with ground truth", RunSynth},
+      {"synth", "generate a synthetic multi-view hand capture with ground truth",
+       RunSynth},
       {"fit", "fit the hand model to a capture's 2D keypoints and masks (Ceres)", RunFit},
       {"train", "train the POEM network on synthetic captures (resumable)", RunTrain},
       {"eval-network", "MPJPE / MPVPE / AUC of POEM weights on held-out synthetic frames",
        RunEvalNetwork},
       {"detect", "MediaPipe Hands 2D keypoints: a capture's views (multi-view) or images",
        RunDetect},
+      {"compare", "run every method on the same frames: the paper's table, HTML report",
+       RunCompare},
   };
   return commands;
 }

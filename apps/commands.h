@@ -35,5 +35,6 @@ int RunFit(int argc, char** argv);
 int RunTrain(int argc, char** argv);
 int RunEvalNetwork(int argc, char** argv);
 int RunDetect(int argc, char** argv);
+int RunCompare(int argc, char** argv);
 
 }  // namespace handlabel

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "core/draw.h"
+#include "core/errors.h"
 
 namespace handlabel {
 namespace {
@@ -136,16 +137,21 @@ void DrawSeries(const PlotFrame& f, const PlotOptions& o,
       const Eigen::Vector2d p(
           std::clamp(f.Px(s.x[i]), double(f.left), double(f.left + f.pw)),
           std::clamp(f.Py(s.y[i]), double(f.top), double(f.top + f.ph)));
-      if (have_prev) DrawLine(img, prev, p, s.color, 2);
-      if (s.x.size() == 1)
+      if (have_prev && s.lines) DrawLine(img, prev, p, s.color, 2);
+      if (s.x.size() == 1 && s.lines && s.marker_radius <= 0)
         DrawLine(img, {p.x() - 2, p.y()}, {p.x() + 2, p.y()}, s.color, 2);
+      if (s.marker_radius > 0) DrawDisc(img, p, s.marker_radius, s.color);
       prev = p;
       have_prev = true;
     }
     const int lx =
         f.left + f.pw - 8 - kFontAdvance * static_cast<int>(s.name.size()) - 24;
-    DrawLine(img, {double(lx), double(legend_y + 3)},
-             {double(lx + 16), double(legend_y + 3)}, s.color, 2);
+    if (s.lines || s.marker_radius <= 0) {
+      DrawLine(img, {double(lx), double(legend_y + 3)},
+               {double(lx + 16), double(legend_y + 3)}, s.color, 2);
+    } else {
+      DrawDisc(img, {lx + 8.0, legend_y + 3.0}, s.marker_radius, s.color);
+    }
     DrawText(img, lx + 22, legend_y, s.name, black);
     legend_y += 12;
   }
@@ -173,6 +179,85 @@ ImageU8 DrawLinePlot(const std::vector<PlotSeries>& series, const PlotOptions& o
   DrawAxes(frame, o, &img);
   DrawSeries(frame, o, series, &img);
   return img;
+}
+
+ImageU8 DrawBarPlot(const std::vector<PlotSeries>& series, const PlotOptions& options) {
+  size_t categories = 0;
+  for (const PlotSeries& s : series) categories = std::max(categories, s.y.size());
+  PlotOptions o = options;
+  o.log_y = false;
+  if (std::isnan(o.x_min)) o.x_min = -0.5;
+  if (std::isnan(o.x_max)) o.x_max = std::max<double>(categories, 1) - 0.5;
+  if (std::isnan(o.y_min)) o.y_min = 0;
+  // The frame from the bar tops (x = category index).
+  std::vector<PlotSeries> tops;
+  for (const PlotSeries& s : series) {
+    PlotSeries t = s;
+    t.x.clear();
+    for (size_t i = 0; i < s.y.size(); ++i) t.x.push_back(double(i));
+    tops.push_back(std::move(t));
+  }
+  ImageU8 img(o.width, o.height, 3, 255);
+  const PlotFrame f = MakeFrame(tops, o);
+  DrawAxes(f, o, &img);
+  const double slot = f.pw / (f.x1 - f.x0);  // pixels per category
+  const double bar = 0.8 * slot / std::max<size_t>(series.size(), 1);
+  const Rgb black = {0, 0, 0};
+  int legend_y = f.top + 6;
+  for (size_t k = 0; k < series.size(); ++k) {
+    const PlotSeries& s = series[k];
+    for (size_t i = 0; i < s.y.size(); ++i) {
+      if (!std::isfinite(s.y[i])) continue;
+      const double x_left = f.Px(double(i)) - 0.4 * slot + k * bar;
+      const double y_top = std::clamp(f.Py(s.y[i]), double(f.top), double(f.top + f.ph));
+      const double y_base =
+          std::clamp(f.Py(std::max(f.y0, 0.0)), double(f.top), double(f.top + f.ph));
+      for (int x = static_cast<int>(std::lround(x_left));
+           x < static_cast<int>(std::lround(x_left + bar)); ++x) {
+        for (int y = static_cast<int>(std::lround(std::min(y_top, y_base)));
+             y <= static_cast<int>(std::lround(std::max(y_top, y_base))); ++y) {
+          SetPixel(&img, x, y, s.color);
+        }
+      }
+    }
+    const int lx =
+        f.left + f.pw - 8 - kFontAdvance * static_cast<int>(s.name.size()) - 24;
+    for (int y = legend_y; y < legend_y + 7; ++y)
+      for (int x = lx + 4; x < lx + 14; ++x) SetPixel(&img, x, y, s.color);
+    DrawText(&img, lx + 22, legend_y, s.name, black);
+    legend_y += 12;
+  }
+  return img;
+}
+
+std::vector<int> HistogramCounts(const std::vector<double>& values, double lo, double hi,
+                                 int bins) {
+  HL_CHECK(bins >= 1 && hi > lo, "bins >= 1 and hi > lo");
+  std::vector<int> counts(bins, 0);
+  for (double v : values) {
+    if (!std::isfinite(v)) continue;
+    const int b = static_cast<int>(std::floor((v - lo) / (hi - lo) * bins));
+    ++counts[std::clamp(b, 0, bins - 1)];
+  }
+  return counts;
+}
+
+ImageU8 StackHorizontally(const std::vector<ImageU8>& images, int gap) {
+  int width = 0, height = 0;
+  for (const ImageU8& im : images) {
+    width += im.width + (width > 0 ? gap : 0);
+    height = std::max(height, im.height);
+  }
+  ImageU8 out(std::max(width, 1), std::max(height, 1), 3, 255);
+  int x0 = 0;
+  for (const ImageU8& im : images) {
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x)
+        for (int c = 0; c < 3; ++c)
+          out.at(x0 + x, y, c) = im.at(x, y, std::min(c, im.channels - 1));
+    x0 += im.width + gap;
+  }
+  return out;
 }
 
 ImageU8 StackVertically(const std::vector<ImageU8>& images) {

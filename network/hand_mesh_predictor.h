@@ -56,6 +56,8 @@ class HandMeshPredictor {
   virtual int crop_size() const = 0;
   // True when predictions carry per-view masks (a POEM with a mask head).
   virtual bool predicts_masks() const = 0;
+  // Learned parameters (weights and biases, not buffers); 0 when unknown.
+  virtual int64_t num_parameters() const { return 0; }
   // One prediction per frame. Throws InputError naming the frame, view and field of
   // the first invalid input, before any inference runs.
   virtual std::vector<HandMeshPrediction> Predict(

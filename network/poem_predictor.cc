@@ -30,6 +30,11 @@ class PoemPredictor : public HandMeshPredictor {
   int num_views() const override { return model_->config().num_views; }
   int crop_size() const override { return model_->config().crop_size; }
   bool predicts_masks() const override { return model_->config().mask_head; }
+  int64_t num_parameters() const override {
+    int64_t count = 0;
+    for (const torch::Tensor& p : model_->parameters()) count += p.numel();
+    return count;
+  }
 
   std::vector<HandMeshPrediction> Predict(
       const std::vector<HandMeshInput>& frames) override {

@@ -127,6 +127,7 @@ NetworkStage LoadNetworkStage(const JobConfig& job) {
       network->name() + " (" + std::filesystem::path(weights).filename().string() + ")";
   stage.weights_sha256 = Sha256OfFile(weights);
   stage.predicts_masks = network->predicts_masks();
+  stage.num_parameters = network->num_parameters();
   stage.predict = [network](const std::vector<const FrameInput*>& frames) {
     return PredictFramesInRig(*network, frames);
   };

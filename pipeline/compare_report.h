@@ -1,0 +1,38 @@
+#pragma once
+// What `handlabel compare` writes: one table in the POEM paper's layout (Table 1:
+// MPVPE, RR-V, PA-V, AUC-V, MPJPE, RR-J, PA-J, AUC-J; errors in mm, AUC over the
+// comparison's PCK range) with seconds per frame, threads and network parameters per
+// method, the view-count ablation, the quality-check study and the pictures:
+//   <out>/compare.json    every number (the HTML and Markdown show these, rounded)
+//   <out>/compare.md      the tables, for terminals and docs
+//   <out>/report.html     one self-contained page (inline CSS, images as data: URIs):
+//                         tables, pictures, the job and the versions
+//   <out>/pictures/*.png  the pictures as files: pck, per_joint, histogram,
+//                         time_accuracy, worst_frames, ablation, qa_scatter, qa_roc
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "pipeline/compare_qa.h"
+#include "pipeline/compare_run.h"
+
+namespace handlabel {
+
+struct CompareReportFiles {
+  std::string json, markdown, html, pictures_dir;
+};
+
+// The result as JSON (the numbers the report shows).
+nlohmann::json CompareToJson(const JobConfig& base, const CompareResult& result,
+                             const QualityStudy& qa);
+
+// The main table as Markdown (what the command prints).
+std::string CompareTableMarkdown(const CompareResult& result);
+
+// Writes every file above (each atomically) and returns their paths. `worst_frames`:
+// how many frames the overlay picture shows.
+CompareReportFiles WriteCompareReport(const JobConfig& base, const CompareResult& result,
+                                      const QualityStudy& qa,
+                                      const CompareOptions& options);
+
+}  // namespace handlabel

@@ -1,0 +1,215 @@
+// `handlabel compare` end to end on a small synthetic capture (capsule hand, 8 views at
+// 160x120, a tiny POEM with random weights: the plumbing, not the network's accuracy,
+// is under test). Its numbers must be those of the separate commands on the same
+// frames: `fit` for the fit from the capture's 2D, `label` with the matching job for
+// the network rows; and its root-relative errors those of a plain computation here.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <stdlib.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "network/hand_mesh_predictor.h"
+#include "network/poem_config.h"
+#include "pipeline/job_config.h"
+#include "pipeline/label_outputs.h"
+#include "pipeline/label_record.h"
+#include "pipeline/label_stage_factory.h"
+#include "tests/apps/label_test_capture.h"
+#include "tests/apps/run_command.h"
+#include "tests/test_util.h"
+
+namespace handlabel {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::RunHandlabelCommand;
+
+nlohmann::json ReadJson(const std::string& path) {
+  return nlohmann::json::parse(testing::ReadFileBytes(path));
+}
+
+const nlohmann::json& Method(const nlohmann::json& compare, const std::string& name) {
+  for (const nlohmann::json& m : compare.at("methods")) {
+    if (m.at("method") == name) return m;
+  }
+  ADD_FAILURE() << "no row " << name;
+  static const nlohmann::json none;
+  return none;
+}
+
+// The label job summary's group means against the compare row's metrics.
+void ExpectSameNumbers(const nlohmann::json& row, const nlohmann::json& summary,
+                       const std::string& group) {
+  const nlohmann::json& s = summary.at("metrics").at(group);
+  const nlohmann::json& m = row.at("metrics");
+  EXPECT_NEAR(m.at("mpjpe_mm").get<double>(), s.at("mpjpe_mm").get<double>(), 1e-9);
+  EXPECT_NEAR(m.at("pa_mpjpe_mm").get<double>(), s.at("pa_mpjpe_mm").get<double>(), 1e-9);
+  EXPECT_NEAR(m.at("auc_j").get<double>(), s.at("auc").get<double>(), 1e-9);
+  if (s.contains("mpvpe_mm")) {
+    EXPECT_NEAR(m.at("mpvpe_mm").get<double>(), s.at("mpvpe_mm").get<double>(), 1e-9);
+    EXPECT_NEAR(m.at("pa_mpvpe_mm").get<double>(), s.at("pa_mpvpe_mm").get<double>(),
+                1e-9);
+  } else {
+    EXPECT_TRUE(m.at("mpvpe_mm").is_null());
+  }
+  EXPECT_EQ(m.at("frames").get<int>(), s.at("frames").get<int>());
+}
+
+class CompareCommand : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // One capture and one comparison for the suite (ScratchDir needs a running test).
+    std::string pattern =
+        (std::filesystem::temp_directory_path() / "handlabel-compare-XXXXXX").string();
+    dir_ = new std::string(mkdtemp(pattern.data()));
+    testing::WriteTestCapture(*dir_ + "/capture", 3, 11);
+    WriteRandomPoemCheckpoint(PoemConfigByName("tiny", 8), 4, *dir_ + "/tiny.pt");
+    result_ = new testing::CommandResult(RunHandlabelCommand(
+        {"compare", "--capture", *dir_ + "/capture", "--weights", *dir_ + "/tiny.pt",
+         "--hand-model", "capsule", "--threads", "2", "--seed", "3", "--out",
+         *dir_ + "/compare", "--ablation-views", "2", "--ablation-frames", "2"}));
+  }
+  static void TearDownTestSuite() {
+    std::error_code ignored;
+    std::filesystem::remove_all(*dir_, ignored);
+    delete result_;
+    delete dir_;
+  }
+  static std::string* dir_;
+  static testing::CommandResult* result_;
+};
+std::string* CompareCommand::dir_ = nullptr;
+testing::CommandResult* CompareCommand::result_ = nullptr;
+
+TEST_F(CompareCommand, PrintsTheTableAndWritesTheReport) {
+  ASSERT_EQ(result_->status, 0) << result_->err;
+  for (const char* column : {"MPVPE", "RR-V", "PA-V", "AUC-V", "MPJPE", "RR-J", "PA-J",
+                             "AUC-J", "s/frame", "threads", "params"}) {
+    EXPECT_THAT(result_->out, HasSubstr(column));
+  }
+  for (const char* file :
+       {"compare.json", "compare.md", "report.html", "pictures/pck.png",
+        "pictures/per_joint.png", "pictures/histogram.png", "pictures/time_accuracy.png",
+        "pictures/worst_frames.png", "pictures/ablation.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(*dir_ + "/compare/" + file)) << file;
+  }
+  const nlohmann::json c = ReadJson(*dir_ + "/compare/compare.json");
+  ASSERT_EQ(c.at("methods").size(), 5u);
+  for (const nlohmann::json& m : c.at("methods")) {
+    EXPECT_TRUE(m.at("ran").get<bool>()) << m.at("method") << ": " << m.at("why_not");
+  }
+  EXPECT_EQ(c.at("auc_range_mm")[1].get<double>(), 20.0);
+  // Three frames are too few for the quality-check study; it says so.
+  EXPECT_THAT(c.at("qa").at("why_not").get<std::string>(), HasSubstr("fewer than 4"));
+  EXPECT_FALSE(std::filesystem::exists(*dir_ + "/compare/pictures/qa_roc.png"));
+  // The tiny network's parameters are counted; fits have none.
+  EXPECT_GT(Method(c, "network").at("metrics").at("parameters").get<double>(), 1000);
+  EXPECT_TRUE(Method(c, "fit_detections").at("metrics").at("parameters").is_null());
+}
+
+TEST_F(CompareCommand, FitRowEqualsTheFitCommand) {
+  ASSERT_EQ(result_->status, 0) << result_->err;
+  const auto fit = RunHandlabelCommand({"fit", "--capture", *dir_ + "/capture", "--out",
+                                        *dir_ + "/fit", "--hand-model", "capsule"});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  const nlohmann::json c = ReadJson(*dir_ + "/compare/compare.json");
+  ExpectSameNumbers(Method(c, "fit_detections"),
+                    ReadJson(SummaryJsonPath(*dir_ + "/fit")), "labels");
+}
+
+TEST_F(CompareCommand, NetworkRowsEqualLabelJobs) {
+  ASSERT_EQ(result_->status, 0) << result_->err;
+  const nlohmann::json c = ReadJson(*dir_ + "/compare/compare.json");
+  // refine off, and the baseline as a fallback job whose enough_views check never passes.
+  const std::vector<std::pair<std::string, std::string>> jobs = {
+      {"network", "refine: {mode: off}\nevidence: {keypoints_2d: both, masks: files}\n"},
+      {"fit_network_2d",
+       "refine: {mode: fallback, min_views: 1000000}\n"
+       "evidence: {keypoints_2d: network, masks: none}\n"}};
+  for (const auto& [method, fields] : jobs) {
+    const std::string job = *dir_ + "/" + method + ".yaml";
+    std::ofstream(job) << "name: " << method << "\nseed: 3\nhand_model: capsule\n"
+                       << "input: {format: native, path: capture}\n"
+                       << "network: {weights: tiny.pt, threads: 2}\n"
+                       << fields << "output: {dir: " << method << ", overlays: false}\n";
+    const auto label = RunHandlabelCommand({"label", "--job", job, "--quiet"});
+    ASSERT_EQ(label.status, 0) << label.err;
+    ExpectSameNumbers(Method(c, method), ReadJson(SummaryJsonPath(*dir_ + "/" + method)),
+                      "labels");
+  }
+}
+
+// RR-J computed here from the label files and the capture's truth, the plain way.
+TEST_F(CompareCommand, RootRelativeErrorsFromTheLabels) {
+  ASSERT_EQ(result_->status, 0) << result_->err;
+  const nlohmann::json c = ReadJson(*dir_ + "/compare/compare.json");
+  const nlohmann::json& row = Method(c, "fit_exact_2d");
+  JobConfig job;
+  job.input_path = *dir_ + "/capture";
+  const auto source = BuildFrameSource(job);
+  double sum = 0;
+  int frames = 0;
+  for (const std::string& frame : source->FrameIds()) {
+    const LabelRecord label =
+        ReadLabelFile(LabelFilePath(row.at("output_dir").get<std::string>(), frame));
+    const Points3d truth = source->Load(frame).ground_truth->keypoints;
+    double frame_sum = 0;
+    for (int k = 0; k < 21; ++k) {
+      const Eigen::Vector3d p = label.mesh.keypoints.row(k) - label.mesh.keypoints.row(0);
+      const Eigen::Vector3d t = truth.row(k) - truth.row(0);
+      frame_sum += (p - t).norm();
+    }
+    sum += frame_sum / 21;
+    ++frames;
+  }
+  ASSERT_EQ(frames, 3);
+  EXPECT_NEAR(row.at("metrics").at("rr_mpjpe_mm").get<double>(), 1000 * sum / frames,
+              1e-9);
+  // Exact 2D and true masks: the upper bound is better than the noisy detections.
+  EXPECT_LT(row.at("metrics").at("mpjpe_mm").get<double>(),
+            Method(c, "fit_detections").at("metrics").at("mpjpe_mm").get<double>());
+}
+
+TEST_F(CompareCommand, AblationHasTwoAndAllViews) {
+  ASSERT_EQ(result_->status, 0) << result_->err;
+  const nlohmann::json c = ReadJson(*dir_ + "/compare/compare.json");
+  int fit_cells = 0;
+  for (const nlohmann::json& cell : c.at("ablation")) {
+    if (cell.at("method") != "fit_detections") continue;
+    ++fit_cells;
+    EXPECT_TRUE(cell.at("views") == 2 || cell.at("views") == 8) << cell.dump();
+    EXPECT_EQ(cell.at("frames"), 2) << cell.dump();
+  }
+  EXPECT_EQ(fit_cells, 2);
+}
+
+TEST(CompareCommandRows, WithoutWeightsTheNetworkRowsSayWhy) {
+  const std::string dir = testing::ScratchDir();
+  testing::WriteTestCapture(dir + "/capture", 1, 4);
+  const auto r = RunHandlabelCommand(
+      {"compare", "--capture", dir + "/capture", "--hand-model", "capsule", "--out",
+       dir + "/compare", "--methods", "network,fit_exact_2d", "--ablation-views", "none",
+       "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json c = ReadJson(dir + "/compare/compare.json");
+  const nlohmann::json& network = Method(c, "network");
+  EXPECT_FALSE(network.at("ran").get<bool>());
+  EXPECT_THAT(network.at("why_not").get<std::string>(), HasSubstr("no network weights"));
+  EXPECT_TRUE(Method(c, "fit_exact_2d").at("ran").get<bool>());
+  EXPECT_THAT(r.out, HasSubstr("not run: no network weights"));
+}
+
+TEST(CompareCommandRows, UnknownMethodNamesTheFlag) {
+  const std::string dir = testing::ScratchDir();
+  const auto r = RunHandlabelCommand(
+      {"compare", "--capture", dir, "--out", dir + "/o", "--methods", "magic"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_THAT(r.err, HasSubstr("--methods"));
+}
+
+}  // namespace
+}  // namespace handlabel
