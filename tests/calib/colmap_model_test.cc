@@ -173,13 +173,15 @@ TEST(ColmapModel, ImageSizesAreRangeCheckedBeforeNarrowing) {
        {uint64_t{4294967936}, uint64_t{1} << 31, uint64_t{1} << 40}) {
     ColmapModel model = RandomColmapModel();
     model.cameras.begin()->second.width = width;
-    const std::string text = testing::ScratchDir() + "/text";
+    const std::string text = ScratchDir() + "/text";
+    std::filesystem::create_directories(text);
     WriteColmapText(model, text);
     std::string error = testing::InputErrorOf([&] { ReadColmapText(text); });
     EXPECT_NE(error.find("cameras.txt"), std::string::npos) << error;
     EXPECT_NE(error.find("WIDTH"), std::string::npos) << error;
     EXPECT_NE(error.find(std::to_string(width)), std::string::npos) << error;
-    const std::string binary = testing::ScratchDir() + "/binary";
+    const std::string binary = ScratchDir() + "/binary";
+    std::filesystem::create_directories(binary);
     WriteColmapBinary(model, binary);
     error = testing::InputErrorOf([&] { ReadColmapBinary(binary); });
     EXPECT_NE(error.find("cameras.bin"), std::string::npos) << error;
