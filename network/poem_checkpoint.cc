@@ -87,8 +87,14 @@ c10::IValue ReadCheckpointAttributes(const std::string& path, RecordSizes* recor
     return n;
   };
   auto unit = std::make_shared<torch::jit::CompilationUnit>();
+  // Classes (the `__torch__` module) get a fresh class type; container tags such as
+  // "Dict[str, Tensor]" (the unpickler asks the resolver for them too) are parsed.
   const auto resolve_type = [&](const c10::QualifiedName& name) {
-    return c10::StrongTypePtr(unit, c10::ClassType::create(name, unit));
+    if (name.prefix().rfind("__torch__", 0) == 0) {
+      return c10::StrongTypePtr(unit, c10::ClassType::create(name, unit));
+    }
+    return c10::StrongTypePtr(
+        unit, torch::jit::Unpickler::defaultTypeParser(name.qualifiedName()));
   };
   c10::IValue attributes;
   int objects = 0;

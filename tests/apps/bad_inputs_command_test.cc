@@ -54,11 +54,13 @@ TEST(BadInputsCommand, FramesWithoutEvidenceOrWithBrokenFilesFailByName) {
   }
   ASSERT_FALSE(broken.empty());
   std::ofstream(broken, std::ios::trunc) << "not a picture";
-  const std::string job =
-      testing::WriteTestJob(dir, "job", "capture", "out", ", overlays: true");
+  const std::string job = testing::WriteTestJob(dir, "job", "capture", "out");
+  std::string text = testing::ReadFileBytes(job);  // a fit-only job with overlays
+  text.replace(text.find("overlays: false"), 15, "overlays: true");
+  std::ofstream(job, std::ios::trunc) << text;
   const auto r = RunHandlabelCommand({"label", "--job", job});
   EXPECT_EQ(r.status, 0) << r.err;  // the job goes on; failures are per frame
-  EXPECT_THAT(r.out, HasSubstr("3 failed"));
+  EXPECT_THAT(r.out + r.err, HasSubstr("3 failed"));  // the summary: stderr
   const std::string out = dir + "/out";
   const nlohmann::json silent = ManifestEntry(out, "000000");
   EXPECT_EQ(silent["status"], "failed");
