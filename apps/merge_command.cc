@@ -7,6 +7,7 @@
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_stage_factory.h"
+#include "pipeline/output_lock.h"
 
 namespace handlabel {
 
@@ -28,10 +29,21 @@ int RunMerge(int argc, char** argv) {
     const std::vector<std::string> frames = JobFrames(job, *source);
     const std::string weights_sha =
         job.network_weights.empty() ? "" : Sha256OfFile(job.network_weights);
-    const LabelSummary summary =
-        MergeLabelOutputs(job.output_dir, job.name, JobHash(job, weights_sha), frames);
+    // One writer: no label run or other merge may use the folder meanwhile.
+    const OutputFolderLock lock =
+        OutputFolderLock::Whole(job.output_dir, "merge", job_file);
+    std::vector<std::string> not_labelled;
+    const LabelSummary summary = MergeLabelOutputs(
+        job.output_dir, job.name, JobHash(job, weights_sha), frames, "", &not_labelled);
     std::cout << summary.ToText() << "manifest: " << ManifestPath(job.output_dir)
               << "\nsummary: " << SummaryMarkdownPath(job.output_dir) << "\n";
+    if (!not_labelled.empty()) {
+      std::cout << "not labelled (" << not_labelled.size() << "):\n";
+      for (size_t i = 0; i < not_labelled.size() && i < 50; ++i) {
+        std::cout << "  " << not_labelled[i] << "\n";
+      }
+      if (not_labelled.size() > 50) std::cout << "  ... (see the manifest)\n";
+    }
     return summary.missing > 0 ? 1 : 0;
   });
 }

@@ -16,6 +16,7 @@
 #include "core/errors.h"
 #include "core/hand_lbs.h"
 #include "core/hand_model_io.h"
+#include "openhand/builder.h"
 
 namespace handlabel {
 namespace {
@@ -91,6 +92,30 @@ int RunModelInfo(int argc, char** argv) {
   });
 }
 
+// --side and --tips for files that record their own: the loader keeps the file's, so
+// convert applies them here rather than ignoring them. A side other than the file's
+// mirrors the model (x -> -x). Returns what changed, for the closing line.
+std::string ApplyModelFileFlags(const ModelFileFlags& flags, HandModel* model) {
+  std::string changes;
+  const HandModelLoadOptions options = flags.Options();
+  if (options.side && *options.side != model->side) {
+    *model = MirrorHandModel(*model);
+    changes += ", mirrored: the file records the other side";
+  }
+  if (options.tip_vertex_ids && *options.tip_vertex_ids != model->tip_vertex_ids) {
+    for (const int id : *options.tip_vertex_ids) {
+      if (id < 0 || id >= model->num_vertices()) {
+        throw InputError("--tips", "fingertip vertex ids",
+                         "ids in [0, " + std::to_string(model->num_vertices()) + ")",
+                         std::to_string(id));
+      }
+    }
+    model->tip_vertex_ids = *options.tip_vertex_ids;
+    changes += ", fingertips from --tips";
+  }
+  return changes;
+}
+
 int RunModelConvert(int argc, char** argv) {
   CLI::App app(
       "Convert any supported hand model file (MANO pickle, re-saved pickle, smplx npz) "
@@ -103,12 +128,13 @@ int RunModelConvert(int argc, char** argv) {
   flags.Register(app);
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("model convert", [&] {
-    const LoadedHandModel loaded = LoadHandModelFile(in, flags.Options());
+    LoadedHandModel loaded = LoadHandModelFile(in, flags.Options());
+    const std::string changes = ApplyModelFileFlags(flags, &loaded.model);
     SaveHandModel(loaded.model, out);
     std::cout << "wrote " << out << " (" << loaded.model.name << ", "
               << (loaded.model.side == HandSide::kLeft ? "left" : "right") << ", "
               << loaded.model.num_vertices() << " vertices, from "
-              << HandModelFormatName(loaded.format) << ")\n";
+              << HandModelFormatName(loaded.format) << changes << ")\n";
     return 0;
   });
 }

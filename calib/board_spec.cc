@@ -65,7 +65,7 @@ const std::vector<ArucoDictionaryInfo>& ArucoDictionaries() {
 
 void BoardSpec::Check(const std::string& source) const {
   if (cols < 2 || rows < 2 || cols > 1000 || rows > 1000) {
-    throw InputError(source, "COLSxROWS", "at least 2x2 squares",
+    throw InputError(source, "COLSxROWS", "2 to 1000 squares each way",
                      std::to_string(cols) + "x" + std::to_string(rows));
   }
   if (!(square > 0) || !std::isfinite(square)) {

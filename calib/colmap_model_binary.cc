@@ -6,6 +6,7 @@
 #include <iterator>
 
 #include "calib/colmap_model.h"
+#include "calib/rig_json.h"
 #include "core/errors.h"
 
 namespace handlabel {
@@ -116,6 +117,8 @@ std::map<uint32_t, ColmapCamera> ReadCamerasBinary(const std::string& path) {
     cam.model = CameraModelFromId(r.Read<int32_t>("model_id"), path + " " + r.Where(""));
     cam.width = r.Read<uint64_t>("width");
     cam.height = r.Read<uint64_t>("height");
+    CheckedImageSide(cam.width, path, r.Where("width"));
+    CheckedImageSide(cam.height, path, r.Where("height"));
     for (int k = 0; k < NumCameraParams(cam.model); ++k) {
       cam.params.push_back(r.ReadDouble("params"));
     }

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "calib/colmap_model.h"
+#include "calib/rig_json.h"
 #include "core/errors.h"
 
 namespace handlabel {
@@ -81,7 +82,9 @@ std::map<uint32_t, ColmapCamera> ReadCamerasText(const std::string& path) {
     cam.id = r.Next<uint32_t>("CAMERA_ID");
     cam.model = CameraModelFromName(r.NextString("MODEL"), path + " " + r.where());
     cam.width = r.Next<uint64_t>("WIDTH");
+    CheckedImageSide(cam.width, path, r.where() + " WIDTH");
     cam.height = r.Next<uint64_t>("HEIGHT");
+    CheckedImageSide(cam.height, path, r.where() + " HEIGHT");
     const int num_params = NumCameraParams(cam.model);
     for (int i = 0; i < num_params; ++i) cam.params.push_back(r.Next<double>("PARAMS"));
     if (!r.AtEnd()) {

@@ -4,6 +4,7 @@
 #include <limits>
 #include <set>
 
+#include "calib/rig_json.h"
 #include "core/errors.h"
 
 namespace handlabel {
@@ -62,6 +63,7 @@ Rig RigFromColmap(const ColmapModel& model, const std::string& source) {
                        static_cast<int>(cam->second.height), cam->second.params,
                        source + ": camera " + std::to_string(cam->first));
     rc.cam_from_world = image.cam_from_world;
+    CheckPlausibleCamera(rc, source, "camera " + std::to_string(cam->first) + " ");
     if (rig.IndexOf(rc.name) >= 0) {
       throw InputError(source, where + " NAME", "one image per camera name",
                        "'" + rc.name + "' twice");

@@ -144,7 +144,14 @@ ColmapSfmResult CalibrateWithColmap(const std::string& images_dir,
                                options.distance_m, "--scale");
   }
   const std::string master = options.master.empty() ? result.rig[0].name : options.master;
-  result.rig.Find(master);  // throws, listing the cameras, if unknown
+  if (result.rig.IndexOf(master) < 0) {
+    std::string known;
+    for (const RigCamera& c : result.rig.cameras()) {
+      known += (known.empty() ? "" : ", ") + c.name;
+    }
+    throw InputError("--master", "camera",
+                     "one of the registered cameras [" + known + "]", "'" + master + "'");
+  }
   result.rig.SetWorldToCamera(static_cast<size_t>(result.rig.IndexOf(master)));
   return result;
 }

@@ -23,6 +23,10 @@ RigDifference CompareRigs(const Rig& a_in, const Rig& b_in,
   b.SetWorldToCamera(ib);
   out.worst.name = "max";
   for (const RigCamera& cb : b.cameras()) {
+    if (a.IndexOf(cb.name) < 0) {
+      throw InputError("rig compare", "camera '" + cb.name + "'",
+                       "the same camera names in both rigs", "only in the second rig");
+    }
     const RigCamera& ca = a.Find(cb.name);
     CameraDifference d;
     d.name = cb.name;

@@ -1,10 +1,13 @@
 #include "calib/rig_json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
+#include "core/camera_models.h"
 #include "core/errors.h"
+#include "core/json_util.h"
 
 namespace handlabel {
 namespace {
@@ -37,16 +40,22 @@ std::vector<double> NumberArray(const json& value, size_t expected_size,
   return out;
 }
 
-int PositiveInt(const json& value, const std::string& source, const std::string& field) {
-  if (!value.is_number_integer() || value.get<long long>() <= 0) {
+// An image side as written: any JSON number, range-checked before narrowing.
+int ImageSide(const json& value, const std::string& source, const std::string& field) {
+  if (!value.is_number_integer()) {
     throw InputError(source, field, "a positive integer", value.dump());
   }
-  return static_cast<int>(value.get<long long>());
+  const long double side = value.is_number_unsigned()
+                               ? static_cast<long double>(value.get<uint64_t>())
+                               : static_cast<long double>(value.get<int64_t>());
+  return CheckedImageSide(side, source, field);
 }
 
 RigCamera CameraFromJson(const json& j, const std::string& source,
                          const std::string& where) {
   if (!j.is_object()) throw InputError(source, where, "an object", j.dump());
+  RejectUnknownKeys(j, {"name", "model", "width", "height", "params", "cam_from_world"},
+                    source, where + ".");
   RigCamera cam;
   const json& name = Member(j, "name", source, where + ".");
   if (!name.is_string() || name.get<std::string>().empty()) {
@@ -58,9 +67,9 @@ RigCamera CameraFromJson(const json& j, const std::string& source,
   if (!model.is_string())
     throw InputError(source, at + "model", "a model name", model.dump());
   const CameraModelId model_id =
-      CameraModelFromName(model.get<std::string>(), source + ": " + where);
-  const int width = PositiveInt(Member(j, "width", source, at), source, at + "width");
-  const int height = PositiveInt(Member(j, "height", source, at), source, at + "height");
+      CameraModelFromName(model.get<std::string>(), source + ": " + at + "model");
+  const int width = ImageSide(Member(j, "width", source, at), source, at + "width");
+  const int height = ImageSide(Member(j, "height", source, at), source, at + "height");
   const std::vector<double> params = NumberArray(
       Member(j, "params", source, at), NumCameraParams(model_id), source, at + "params");
   cam.camera = Camera(model_id, width, height, params, source + ": " + where);
@@ -70,6 +79,7 @@ RigCamera CameraFromJson(const json& j, const std::string& source,
     throw InputError(source, at + "cam_from_world", "an object", pose.dump());
   }
   const std::string pose_at = at + "cam_from_world.";
+  RejectUnknownKeys(pose, {"rotation_xyzw", "translation"}, source, pose_at);
   const std::vector<double> q =
       NumberArray(Member(pose, "rotation_xyzw", source, pose_at), 4, source,
                   pose_at + "rotation_xyzw");
@@ -82,14 +92,77 @@ RigCamera CameraFromJson(const json& j, const std::string& source,
                      "norm " + std::to_string(norm));
   }
   cam.cam_from_world = Rigid3(rotation, Eigen::Vector3d(t[0], t[1], t[2]));
+  CheckPlausibleCamera(cam, source, at);
   return cam;
 }
 
 }  // namespace
 
+int CheckedImageSide(long double value, const std::string& source,
+                     const std::string& field, const CameraLimits& limits) {
+  if (!(value >= 1 && value <= static_cast<long double>(limits.max_image_side)) ||
+      value != std::floor(value)) {
+    std::ostringstream got;
+    got.precision(20);
+    got << value;
+    throw InputError(
+        source, field,
+        "a whole number of pixels in [1, " + std::to_string(limits.max_image_side) + "]",
+        got.str());
+  }
+  return static_cast<int>(value);
+}
+
+void CheckPlausibleCamera(const RigCamera& cam, const std::string& source,
+                          const std::string& where, const CameraLimits& limits) {
+  const Camera& c = cam.camera;
+  const std::vector<double>& p = c.params();
+  const Intrinsics<double> in = UnpackIntrinsics(c.model(), p.data());
+  const double side = std::max(c.width(), c.height());
+  const auto fail = [&](const std::string& field, const std::string& expected,
+                        double got) {
+    std::ostringstream text;
+    text << got;
+    throw InputError(source, where + field, expected, text.str());
+  };
+  const double max_focal = limits.max_focal_per_side * side;
+  for (const double f : {in.fx, in.fy}) {
+    if (!(f > 0 && f <= max_focal)) {
+      fail("params (focal length)",
+           "a focal length in (0, " + std::to_string(max_focal) + "] pixels", f);
+    }
+  }
+  const double m = limits.max_principal_offset;
+  if (!(in.cx >= -m * c.width() && in.cx <= (1 + m) * c.width())) {
+    fail("params (cx)",
+         "a principal point x near the image (width " + std::to_string(c.width()) + ")",
+         in.cx);
+  }
+  if (!(in.cy >= -m * c.height() && in.cy <= (1 + m) * c.height())) {
+    fail("params (cy)",
+         "a principal point y near the image (height " + std::to_string(c.height()) + ")",
+         in.cy);
+  }
+  for (const double d : in.d) {
+    if (!(std::abs(d) <= limits.max_distortion)) {
+      fail("params (distortion)",
+           "distortion coefficients within +-" + std::to_string(limits.max_distortion),
+           d);
+    }
+  }
+  const Eigen::Vector3d& t = cam.cam_from_world.translation;
+  for (int k = 0; k < 3; ++k) {
+    if (!(std::abs(t[k]) <= limits.max_translation_m)) {
+      fail("cam_from_world.translation",
+           "metres within +-" + std::to_string(limits.max_translation_m), t[k]);
+    }
+  }
+}
+
 Rig RigFromJson(const json& j, const std::string& source, RigFileInfo* info) {
   if (!j.is_object())
     throw InputError(source, "(top level)", "a JSON object", j.type_name());
+  RejectUnknownKeys(j, {"format", "version", "world", "cameras"}, source);
   const json& format = Member(j, "format", source, "");
   if (format != "handlabel-rig") {
     throw InputError(source, "format", "\"handlabel-rig\"", format.dump());
@@ -144,15 +217,7 @@ json RigToJson(const Rig& rig, const RigFileInfo& info) {
 }
 
 Rig ReadRigJson(const std::string& path, RigFileInfo* info) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "(file)", "a readable JSON rig file", "cannot open");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(path, "(JSON syntax)", "valid JSON", e.what());
-  }
-  return RigFromJson(j, path, info);
+  return RigFromJson(ReadJsonFileStrict(path), path, info);
 }
 
 void WriteRigJson(const Rig& rig, const std::string& path, const RigFileInfo& info) {

@@ -44,6 +44,10 @@ json ManifestToJson(const CaptureManifest& m) {
 }
 
 CaptureManifest ManifestFromJson(const json& j, const std::string& source) {
+  RejectUnknownKeys(j,
+                    {"format", "version", "rig", "colmap", "cameras", "frames", "files",
+                     "depth_unit_m", "world", "hand_side", "generator"},
+                    source);
   CaptureManifest m;
   if (JsonString(j, "format", source) != "handlabel-capture") {
     throw InputError(source, "format", "\"handlabel-capture\"",
@@ -132,12 +136,16 @@ json ViewKeypointsToJson(const std::string& frame,
 
 std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
                                                  const std::string& source) {
+  RejectUnknownKeys(j, {"frame", "views"}, source);
   const json& views = JsonMember(j, "views", source);
   if (!views.is_array()) throw InputError(source, "views", "an array", views.dump());
   std::vector<ViewKeypoints> out;
   for (size_t i = 0; i < views.size(); ++i) {
     const std::string where = "views[" + std::to_string(i) + "].";
     const json& jv = views[i];
+    RejectUnknownKeys(
+        jv, {"camera", "keypoints", "visibility", "confidence", "status", "hand_pixels"},
+        source, where);
     ViewKeypoints v;
     v.camera = JsonString(jv, "camera", source, where);
     const json& kp = JsonMember(jv, "keypoints", source, where);
@@ -171,6 +179,12 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
     if (jv.contains("confidence")) {
       const Eigen::VectorXd c =
           JsonVector(jv["confidence"], source, where + "confidence", 21);
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        if (!(c[k] >= 0 && c[k] <= 1)) {
+          throw InputError(source, where + "confidence[" + std::to_string(k) + "]",
+                           "a confidence in [0, 1]", std::to_string(c[k]));
+        }
+      }
       v.keypoints.confidence = c;
     }
     if (jv.contains("status")) v.status = JsonString(jv, "status", source, where);
@@ -207,6 +221,11 @@ json GroundTruthToJson(const std::string& frame, const HandGroundTruth& gt) {
 }
 
 HandGroundTruth GroundTruthFromJson(const json& j, const std::string& source) {
+  RejectUnknownKeys(
+      j,
+      {"frame", "hand_model", "side", "pose_kind", "global_orient", "hand_pose", "betas",
+       "transl", "keypoints3d", "joints3d", "vertices", "objects"},
+      source);
   HandGroundTruth gt;
   gt.hand_model = JsonString(j, "hand_model", source);
   gt.side = JsonString(j, "side", source);

@@ -1,24 +1,42 @@
 #include "capture/capture_reader.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
 #include "calib/rig_json.h"
 #include "core/errors.h"
+#include "core/json_util.h"
 
 namespace handlabel {
 namespace {
 
 namespace fs = std::filesystem;
 
+// Strict: repeated keys are refused too (json_util.h).
 nlohmann::json ReadJsonFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "file", "an existing readable JSON file", "missing");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path, "content", "valid JSON", e.what());
+  if (!fs::exists(path)) {
+    throw InputError(path, "file", "an existing readable JSON file", "missing");
   }
+  return ReadJsonFileStrict(path);
+}
+
+// Detections with no keypoint that has a position and a confidence above 0 in any view
+// give the fitter nothing: the frame must fail by name, not be labelled from nothing.
+void RequireSomeEvidence(const std::vector<ViewKeypoints>& views,
+                         const std::string& path) {
+  for (const ViewKeypoints& v : views) {
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (v.keypoints.confidence[k] > 0 && std::isfinite(v.keypoints.uv_px(k, 0)) &&
+          std::isfinite(v.keypoints.uv_px(k, 1))) {
+        return;
+      }
+    }
+  }
+  throw InputError(path, "confidence",
+                   "at least one detected keypoint (confidence > 0, with a position) in "
+                   "some view",
+                   "none in " + std::to_string(views.size()) + " views");
 }
 
 }  // namespace
@@ -42,7 +60,7 @@ CaptureReader::CaptureReader(const std::string& dir) : dir_(dir) {
       throw InputError(manifest_path, "cameras",
                        "camera names that " + manifest_.rig_file + " defines", name);
     }
-    rig_.Add(file_rig.Find(name));
+    rig_.Add(file_rig.Find(name));  // present: checked above
   }
   if (rig_.empty())
     throw InputError(manifest_path, "cameras", "at least one camera", "none");
@@ -158,7 +176,9 @@ std::vector<ViewKeypoints> CaptureReader::ReadKeypoints(int frame) const {
   return ReadViews(kFileKeypoints, frame);
 }
 std::vector<ViewKeypoints> CaptureReader::ReadDetections(int frame) const {
-  return ReadViews(kFileDetections, frame);
+  std::vector<ViewKeypoints> views = ReadViews(kFileDetections, frame);
+  RequireSomeEvidence(views, Path(kFileDetections, frame));
+  return views;
 }
 
 HandGroundTruth CaptureReader::ReadGroundTruth(int frame) const {

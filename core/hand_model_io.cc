@@ -425,6 +425,9 @@ LoadedHandModel LoadHandModelFile(const std::string& path,
     in.read(head.data(), 4);
     head.resize(static_cast<size_t>(in.gcount()));
   }
+  if (head.empty()) {  // else it would be reported as a pickle without opcodes
+    throw InputError(path, "", "a hand model file (.npz or MANO .pkl)", "an empty file");
+  }
   if (LooksLikeZip(head)) {
     const Entries entries = ReadNpzEntries(path, &out.format);
     out.model = ModelFromEntries(entries, out.format, options);

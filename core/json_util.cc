@@ -1,6 +1,10 @@
 #include "core/json_util.h"
 
 #include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <vector>
 
 #include "core/errors.h"
 
@@ -23,6 +27,57 @@ json JsonHandParams(const HandParams& params) {
           {"hand_pose", JsonArray(params.hand_pose)},
           {"betas", JsonArray(params.betas)},
           {"transl", JsonArray(params.transl)}};
+}
+
+json ParseJsonStrict(const std::string& text, const std::string& source) {
+  // The keys seen in each open object, innermost last.
+  std::vector<std::set<std::string>> open_objects;
+  std::string duplicate;
+  const json::parser_callback_t check = [&](int /*depth*/, json::parse_event_t event,
+                                            json& parsed) {
+    if (event == json::parse_event_t::object_start) {
+      open_objects.emplace_back();
+    } else if (event == json::parse_event_t::object_end) {
+      if (!open_objects.empty()) open_objects.pop_back();
+    } else if (event == json::parse_event_t::key && !open_objects.empty() &&
+               !open_objects.back().insert(parsed.get<std::string>()).second &&
+               duplicate.empty()) {
+      duplicate = parsed.get<std::string>();
+    }
+    return true;
+  };
+  json j;
+  try {
+    j = json::parse(text, check);
+  } catch (const json::exception& e) {
+    throw InputError(source, "(JSON syntax)", "valid JSON", e.what());
+  }
+  if (!duplicate.empty()) {
+    throw InputError(source, duplicate, "each key once per object", "a duplicate key");
+  }
+  return j;
+}
+
+json ReadJsonFileStrict(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "(file)", "a readable JSON file", "cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return ParseJsonStrict(text.str(), path);
+}
+
+void RejectUnknownKeys(const json& object, std::initializer_list<const char*> known,
+                       const std::string& source, const std::string& where) {
+  if (!object.is_object()) return;
+  for (const auto& [key, value] : object.items()) {
+    bool ok = false;
+    for (const char* k : known) ok |= key == k;
+    if (ok) continue;
+    std::string names;
+    for (const char* k : known) names += (names.empty() ? "" : ", ") + std::string(k);
+    throw InputError(source, where + key, "one of the known keys (" + names + ")",
+                     "an unknown key");
+  }
 }
 
 const json& JsonMember(const json& object, const char* key, const std::string& source,
@@ -89,11 +144,26 @@ HandParams HandParamsFromJson(const json& object, const std::string& source,
     return JsonVector(JsonMember(object, key, source, where), source, where + key, size,
                       nulls);
   };
+  // Plausible magnitudes: a typo such as 1e300 would otherwise reach the fitter and
+  // come back as a label of NaNs. NaN (null with kAsNan) is left to the caller.
+  const auto bounded = [&](const char* key, int size, double limit, const char* unit) {
+    const Eigen::VectorXd v = vector(key, size);
+    for (Eigen::Index i = 0; i < v.size(); ++i) {
+      if (std::abs(v[i]) > limit) {
+        std::ostringstream got;
+        got << v[i];
+        throw InputError(
+            source, where + key + "[" + std::to_string(i) + "]",
+            "a value within +-" + JsonNumberOrNull(limit).dump() + " " + unit, got.str());
+      }
+    }
+    return v;
+  };
   HandParams params;
-  params.global_orient = vector("global_orient", 3);
-  params.hand_pose = vector("hand_pose", kNumPoseParams);
-  params.betas = vector("betas", -1);
-  params.transl = vector("transl", 3);
+  params.global_orient = bounded("global_orient", 3, kMaxAxisAngle, "rad");
+  params.hand_pose = bounded("hand_pose", kNumPoseParams, kMaxAxisAngle, "rad");
+  params.betas = bounded("betas", -1, kMaxBeta, "(shape coefficient)");
+  params.transl = bounded("transl", 3, kMaxTranslationM, "m");
   return params;
 }
 

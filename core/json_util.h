@@ -7,6 +7,7 @@
 // whether null reads back as NaN (JsonNull::kAsNan) or is an error.
 
 #include <Eigen/Core>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -34,6 +35,18 @@ nlohmann::json JsonPoints(const Points3d& points);
 // {"betas": [...], "global_orient": [3], "hand_pose": [45], "transl": [3]}.
 nlohmann::json JsonHandParams(const HandParams& params);
 
+// Parses JSON text strictly: a syntax error, or a key given twice in one object
+// (nlohmann would silently keep the last), throws InputError naming `source`.
+nlohmann::json ParseJsonStrict(const std::string& text, const std::string& source);
+// The same for a file; a file that cannot be read is an InputError too.
+nlohmann::json ReadJsonFileStrict(const std::string& path);
+
+// Throws InputError naming source, where + the key and the known keys when `object`
+// has a key outside `known` (a misspelt field must not be silently ignored).
+void RejectUnknownKeys(const nlohmann::json& object,
+                       std::initializer_list<const char*> known,
+                       const std::string& source, const std::string& where = "");
+
 // object[key]; throws when `object` is not an object or has no `key`. `where` is
 // prepended to the key in messages ("views[2].").
 const nlohmann::json& JsonMember(const nlohmann::json& object, const char* key,
@@ -58,8 +71,15 @@ Points3d JsonPointList(const nlohmann::json& value, const std::string& source,
                        const std::string& field, Eigen::Index rows,
                        JsonNull nulls = JsonNull::kReject);
 
+// Largest magnitudes HandParamsFromJson accepts: far beyond any hand, so only typos
+// and overflowed numbers are refused.
+inline constexpr double kMaxAxisAngle = 100.0;   // rad, per component
+inline constexpr double kMaxBeta = 100.0;        // shape coefficients (MANO: +-5)
+inline constexpr double kMaxTranslationM = 1e4;  // metres
+
 // The four parameter arrays of JsonHandParams from `object` (global_orient 3,
-// hand_pose 45, betas any count, transl 3); fields are named where + key.
+// hand_pose 45, betas any count, transl 3), each within the limits above; fields are
+// named where + key.
 HandParams HandParamsFromJson(const nlohmann::json& object, const std::string& source,
                               const std::string& where = "",
                               JsonNull nulls = JsonNull::kReject);

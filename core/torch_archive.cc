@@ -61,7 +61,10 @@ NdArray TorchArchive::Tensor(const TensorRef& t) const {
   const int64_t item = FixedDTypeSize(t.dtype);
   const ZipEntry* e = zip_.Find(entry);
   if (!e) throw InputError(zip_.source(), entry, "the tensor's storage entry", "missing");
-  if (e->uncompressed_size != static_cast<uint64_t>(t.storage_numel) * item) {
+  // Compared by division: storage_numel * item may wrap around (2^62 + 24 floats
+  // would pass as 96 bytes and the view check below would trust the huge count).
+  if (t.storage_numel < 0 || e->uncompressed_size % item != 0 ||
+      e->uncompressed_size / item != static_cast<uint64_t>(t.storage_numel)) {
     throw InputError(
         where, "storage",
         std::to_string(t.storage_numel) + " elements of " + DTypeName(t.dtype),

@@ -12,12 +12,11 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   handlabel::PickleLimits limits;
-  limits.max_values = 1 << 16;         // keep each run fast and small
+  limits.max_values = 1 << 16;  // keep each run fast and small
   limits.max_total_bytes = 64 << 20;
   try {
-    const handlabel::PickleValue v =
-        handlabel::ReadPickle(std::string(reinterpret_cast<const char*>(data), size),
-                              "fuzz", limits);
+    const handlabel::PickleValue v = handlabel::ReadPickle(
+        std::string(reinterpret_cast<const char*>(data), size), "fuzz", limits);
     (void)v.Describe();
   } catch (const handlabel::InputError&) {
   }

@@ -1,6 +1,13 @@
 #include "network/poem_checkpoint.h"
 
+#include <caffe2/serialize/inline_container.h>
+#include <torch/csrc/jit/api/compilation_unit.h>
+#include <torch/csrc/jit/serialization/unpickler.h>
+
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
+#include <limits>
 #include <set>
 
 #include "core/errors.h"
@@ -28,33 +35,132 @@ struct Archive {
   std::map<std::string, torch::Tensor> tensors;
 };
 
+// Raw bytes of every storage record the unpickler asked for, by address, so that each
+// tensor can be checked against the bytes really behind it.
+using RecordSizes = std::map<const void*, size_t>;
+
+// LibTorch 1.13 builds a storage of the size the pickle declares over whatever bytes
+// the record holds, so a short record is read past its end by the first operation on
+// the tensor. Every view must lie inside its record; checked before any element is
+// read.
+void CheckTensorInsideRecord(const torch::Tensor& t, const RecordSizes& records,
+                             const std::string& path, const std::string& key) {
+  if (t.numel() == 0) return;
+  const auto record = records.find(t.storage().data());
+  if (record == records.end()) {
+    throw InputError(path, key, "a tensor stored in the archive", "no storage record");
+  }
+  int64_t last = t.storage_offset();
+  for (int64_t d = 0; d < t.dim(); ++d) {
+    if (t.stride(d) < 0 || last < 0) {
+      throw InputError(path, key, "non-negative strides and offset", "negative");
+    }
+    const int64_t reach = (t.size(d) - 1);
+    if (t.stride(d) > 0 &&
+        reach > (std::numeric_limits<int64_t>::max() - last) / t.stride(d)) {
+      throw InputError(path, key, "a view inside its storage", "an overflowing extent");
+    }
+    last += reach * t.stride(d);
+  }
+  const uint64_t needed = static_cast<uint64_t>(last + 1) * t.element_size();
+  if (needed > record->second || t.storage().nbytes() > record->second) {
+    throw InputError(
+        path, key + " storage",
+        "at least " + std::to_string(std::max<uint64_t>(needed, t.storage().nbytes())) +
+            " bytes for shape " + ShapeString(t),
+        std::to_string(record->second) + " bytes in the archive");
+  }
+}
+
+// Decodes the archive's data.pkl with LibTorch's unpickler but none of its module
+// import: the one object in it (the checkpoint, a `__torch__` module) is returned as
+// its attribute dictionary, and every storage record's size is kept.
+c10::IValue ReadCheckpointAttributes(const std::string& path, RecordSizes* records) {
+  caffe2::serialize::PyTorchStreamReader reader(path);
+  const auto [pickle, pickle_size] = reader.getRecord("data.pkl");
+  const char* bytes = static_cast<const char*>(pickle.get());
+  size_t offset = 0;
+  const auto read = [&](char* buffer, size_t n) {
+    n = std::min(n, pickle_size - offset);
+    std::memcpy(buffer, bytes + offset, n);
+    offset += n;
+    return n;
+  };
+  auto unit = std::make_shared<torch::jit::CompilationUnit>();
+  // Classes (the `__torch__` module) get a fresh class type; container tags such as
+  // "Dict[str, Tensor]" (the unpickler asks the resolver for them too) are parsed.
+  const auto resolve_type = [&](const c10::QualifiedName& name) {
+    if (name.prefix().rfind("__torch__", 0) == 0) {
+      return c10::StrongTypePtr(unit, c10::ClassType::create(name, unit));
+    }
+    return c10::StrongTypePtr(
+        unit, torch::jit::Unpickler::defaultTypeParser(name.qualifiedName()));
+  };
+  c10::IValue attributes;
+  int objects = 0;
+  const auto load_object = [&](const c10::StrongTypePtr& type, c10::IValue state) {
+    ++objects;
+    attributes = std::move(state);
+    return c10::ivalue::Object::create(type, 0);
+  };
+  const auto read_record = [&](const std::string& name) {
+    auto [data, size] = reader.getRecord("data/" + name);
+    (*records)[data.get()] = size;
+    return std::move(data);
+  };
+  torch::jit::Unpickler unpickler(read, resolve_type, load_object, read_record,
+                                  c10::Device(c10::kCPU));
+  unpickler.parse_ivalue();
+  if (objects != 1 || !attributes.isGenericDict()) {
+    throw InputError(path, "data.pkl", "one checkpoint object with named attributes",
+                     std::to_string(objects) + " objects");
+  }
+  return attributes;
+}
+
+c10::IValue Attribute(const c10::IValue& attributes, const std::string& name) {
+  const auto dict = attributes.toGenericDict();
+  const auto it = dict.find(name);
+  return it == dict.end() ? c10::IValue() : it->value();
+}
+
 Archive ReadArchive(const std::string& path) {
   if (!std::filesystem::exists(path)) {
     throw InputError(path, "", "an existing POEM checkpoint file", "no such file");
   }
-  torch::serialize::InputArchive archive;
+  RecordSizes records;
+  c10::IValue attributes;
   try {
-    archive.load_from(path);
+    attributes = ReadCheckpointAttributes(path, &records);
+  } catch (const InputError&) {
+    throw;
   } catch (const std::exception& e) {
     throw InputError(path, "", "a handlabel POEM checkpoint (LibTorch archive)",
                      std::string("unreadable: ") + e.what());
   }
-  c10::IValue format, config, state;
-  if (!archive.try_read("format", format) || !format.isString() ||
-      format.toStringRef() != kFormat) {
+  const c10::IValue format = Attribute(attributes, "format");
+  if (!format.isString() || format.toStringRef() != kFormat) {
     throw InputError(path, "format", kFormat,
                      format.isString() ? format.toStringRef() : "missing");
   }
-  if (!archive.try_read("config", config) || !config.isString()) {
+  const c10::IValue config = Attribute(attributes, "config");
+  if (!config.isString()) {
     throw InputError(path, "config", "the embedded POEM config (JSON string)", "missing");
   }
-  if (!archive.try_read("state_dict", state) || !state.isGenericDict()) {
+  const c10::IValue state = Attribute(attributes, "state_dict");
+  if (!state.isGenericDict()) {
     throw InputError(path, "state_dict", "a dictionary of tensors", "missing");
   }
   Archive a;
   a.config = PoemConfig::FromJson(config.toStringRef(), path + " (embedded config)");
   for (const auto& item : state.toGenericDict()) {
-    a.tensors[item.key().toStringRef()] = item.value().toTensor();
+    if (!item.key().isString() || !item.value().isTensor()) {
+      throw InputError(path, "state_dict", "text keys and tensor values",
+                       item.key().tagKind() + " -> " + item.value().tagKind());
+    }
+    const std::string& key = item.key().toStringRef();
+    CheckTensorInsideRecord(item.value().toTensor(), records, path, key);
+    a.tensors[key] = item.value().toTensor();
   }
   return a;
 }

@@ -17,6 +17,7 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/json_util.h"
 #include "core/metrics.h"
 #include "core/random.h"
 #include "network/poem_batch_norm_update.h"
@@ -34,6 +35,25 @@ std::string ReadText(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// latest.json of a training folder, checked: a corrupt or hand-edited file names the
+// file and field instead of surfacing as a raw JSON exception.
+struct LatestCheckpoint {
+  int64_t step = 0;
+  std::string model, optimizer;  // relative to the training folder
+};
+
+LatestCheckpoint ReadLatestJson(const std::string& path) {
+  const nlohmann::json j = ReadJsonFileStrict(path);
+  RejectUnknownKeys(
+      j, {"step", "model", "optimizer", "config", "seed", "batch_size", "steps"}, path);
+  const nlohmann::json& step = JsonMember(j, "step", path);
+  if (!step.is_number_integer() || step.get<int64_t>() < 0) {
+    throw InputError(path, "step", "a non-negative integer", step.dump());
+  }
+  return {step.get<int64_t>(), JsonString(j, "model", path),
+          JsonString(j, "optimizer", path)};
 }
 
 std::string StepName(int64_t step) {
@@ -415,10 +435,10 @@ struct PoemTrainer::State {
   }
 
   int64_t LoadLatest() {
-    const nlohmann::json latest = nlohmann::json::parse(ReadText(Path("latest.json")));
-    LoadPoemCheckpointInto(model, Path(latest.at("model").get<std::string>()));
+    const LatestCheckpoint latest = ReadLatestJson(Path("latest.json"));
+    LoadPoemCheckpointInto(model, Path(latest.model));
     torch::serialize::InputArchive archive;
-    archive.load_from(Path(latest.at("optimizer").get<std::string>()));
+    archive.load_from(Path(latest.optimizer));
     optimizer->load(archive);
     torch::Tensor step;
     archive.read("step", step);
@@ -513,14 +533,13 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
 int64_t LatestPoemCheckpointStep(const std::string& out_dir) {
   const fs::path p = fs::path(out_dir) / "latest.json";
   if (!fs::exists(p)) return -1;
-  return nlohmann::json::parse(ReadText(p.string())).at("step").get<int64_t>();
+  return ReadLatestJson(p.string()).step;
 }
 
 std::string LatestPoemCheckpointModel(const std::string& out_dir) {
   const fs::path p = fs::path(out_dir) / "latest.json";
   if (!fs::exists(p)) return "";
-  const auto j = nlohmann::json::parse(ReadText(p.string()));
-  return (fs::path(out_dir) / j.at("model").get<std::string>()).string();
+  return (fs::path(out_dir) / ReadLatestJson(p.string()).model).string();
 }
 
 void ConvertPoemCheckpointToHalf(const std::string& in_path,

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "core/errors.h"
+#include "core/json_util.h"
 #include "core/mask_image.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/label_record.h"
@@ -16,21 +17,6 @@ using nlohmann::json;
 
 // Network vertices pulled in refinement: every n-th (the keypoints carry most of it).
 constexpr int kVertexTargetStride = 8;
-
-Eigen::VectorXd VectorFromJson(const json& j, const std::string& source,
-                               const std::string& field, int size) {
-  if (!j.is_array() || (size >= 0 && static_cast<int>(j.size()) != size)) {
-    throw InputError(source, field,
-                     size >= 0 ? "an array of " + std::to_string(size) + " numbers"
-                               : "an array of numbers");
-  }
-  Eigen::VectorXd v(j.size());
-  for (size_t i = 0; i < j.size(); ++i) {
-    if (!j[i].is_number()) throw InputError(source, field, "numbers");
-    v[i] = j[i].get<double>();
-  }
-  return v;
-}
 
 // A label of a job (label_record.h), or MANO parameters at the top or under "params".
 HandParams ParamsFromJson(const json& file, const std::string& source) {
@@ -47,12 +33,8 @@ HandParams ParamsFromJson(const json& file, const std::string& source) {
                        "MANO parameters (global_orient, hand_pose, betas, transl)");
     }
   }
-  HandParams p;
-  p.global_orient = VectorFromJson(j["global_orient"], source, "global_orient", 3);
-  p.hand_pose = VectorFromJson(j["hand_pose"], source, "hand_pose", kNumPoseParams);
-  p.betas = VectorFromJson(j["betas"], source, "betas", -1);
-  p.transl = VectorFromJson(j["transl"], source, "transl", 3);
-  return p;
+  // Shared reader: also refuses implausible magnitudes (1e300) and NaN.
+  return HandParamsFromJson(j, source);
 }
 
 HandParams ReadInitFile(const std::string& dir, const std::string& frame) {
@@ -61,14 +43,7 @@ HandParams ReadInitFile(const std::string& dir, const std::string& frame) {
        {frame + ".json", "frames/" + frame + ".json", "labels/" + stem + ".json"}) {
     const fs::path path = fs::path(dir) / rel;
     if (!fs::exists(path)) continue;
-    std::ifstream in(path);
-    json j;
-    try {
-      j = json::parse(in);
-    } catch (const json::exception& e) {
-      throw InputError(path.string(), "(file)", "JSON", e.what());
-    }
-    return ParamsFromJson(j, path.string());
+    return ParamsFromJson(ReadJsonFileStrict(path.string()), path.string());
   }
   throw InputError("fit.init " + dir, frame + ".json",
                    "a per-frame parameter file (<frame>.json, frames/ or labels/)");

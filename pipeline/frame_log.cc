@@ -8,6 +8,8 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/sha256.h"
+#include "pipeline/label_record.h"
 
 namespace handlabel {
 namespace {
@@ -26,6 +28,9 @@ FrameRecord ParseRecord(const std::string& line, const std::string& source) {
     r.path = j.value("path", "");
     r.reason = j.value("reason", "");
     r.seconds = j.value("seconds", 0.0);
+    r.label_bytes = j.value("label_bytes", int64_t{-1});
+    r.label_sha256 = j.value("label_sha256", "");
+    r.job_hash = j.value("job_hash", "");
     if (j.contains("metrics")) {
       for (const auto& [name, value] : j.at("metrics").items()) {
         r.metrics[name] = value.is_null() ? std::nan("") : value.get<double>();
@@ -41,6 +46,30 @@ FrameRecord ParseRecord(const std::string& line, const std::string& source) {
 }
 
 }  // namespace
+
+std::string LabelFileProblem(const FrameRecord& record, const std::string& label_path) {
+  std::error_code error;
+  const uintmax_t bytes = std::filesystem::file_size(label_path, error);
+  if (error) return "label file " + label_path + " is missing";
+  if (record.label_sha256.empty()) {
+    try {
+      ReadLabelFile(label_path);
+    } catch (const std::exception& e) {
+      return "label file " + label_path + " is unreadable: " + e.what();
+    }
+    return "";
+  }
+  if (static_cast<int64_t>(bytes) != record.label_bytes) {
+    return "label file " + label_path + " has " + std::to_string(bytes) +
+           " bytes, the log recorded " + std::to_string(record.label_bytes) +
+           " (truncated or replaced)";
+  }
+  if (Sha256OfFile(label_path) != record.label_sha256) {
+    return "label file " + label_path +
+           " does not match the SHA-256 the log recorded (changed after it was written)";
+  }
+  return "";
+}
 
 std::vector<FrameRecord> FrameLog::Read(const std::string& path) {
   std::vector<FrameRecord> records;
@@ -88,6 +117,9 @@ void FrameLog::Record(const FrameRecord& record) {
                       {"seconds", record.seconds}};
   if (!record.reason.empty()) j["reason"] = record.reason;
   if (!record.metrics.empty()) j["metrics"] = record.metrics;
+  if (record.label_bytes >= 0) j["label_bytes"] = record.label_bytes;
+  if (!record.label_sha256.empty()) j["label_sha256"] = record.label_sha256;
+  if (!record.job_hash.empty()) j["job_hash"] = record.job_hash;
   std::lock_guard<std::mutex> lock(mutex_);
   AppendLineDurably(path_, j.dump());
   latest_[record.frame] = record;

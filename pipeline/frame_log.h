@@ -4,6 +4,7 @@
 // outputs were renamed into place, so "in the log with status ok" implies "outputs
 // complete". A crash can leave a partial last line; it is ignored on load.
 
+#include <cstdint>
 #include <map>
 #include <mutex>
 #include <string>
@@ -20,7 +21,18 @@ struct FrameRecord {
   // Per-frame errors against ground truth, "<group>/<metric>" -> value (label_summary.h);
   // empty when the capture has no ground truth.
   std::map<std::string, double> metrics;
+  // The label file as written (ok records): its size and SHA-256, checked on resume
+  // and merge so that a truncated or replaced label is never taken as done. -1 / ""
+  // in logs written before these were recorded.
+  int64_t label_bytes = -1;
+  std::string label_sha256;
+  std::string job_hash;  // the job the record belongs to ("" in older logs)
 };
+
+// Why the label file at `label_path` is not the one `record` (an ok record) wrote:
+// missing, another size or another checksum; "" when it is. Records without a
+// checksum (older logs) need a label that exists and parses.
+std::string LabelFileProblem(const FrameRecord& record, const std::string& label_path);
 
 class FrameLog {
  public:

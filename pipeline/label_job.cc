@@ -5,8 +5,12 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -21,6 +25,7 @@
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
+#include "pipeline/output_lock.h"
 
 namespace handlabel {
 namespace {
@@ -53,28 +58,54 @@ std::string Describe(const std::exception_ptr& error) {
   }
 }
 
-// A folder holds the outputs of one job: refuse to mix labels of different jobs.
-void ClaimOutputFolder(const JobConfig& job, const std::string& job_hash, bool force) {
-  const std::string stamp = JobStampPath(job.output_dir);
-  if (fs::exists(stamp) && !force) {
-    std::ifstream in(stamp);
-    std::string recorded;
-    try {
-      recorded = nlohmann::json::parse(in).at("job_hash").get<std::string>();
-    } catch (const std::exception& e) {
-      throw InputError(stamp, "job_hash", "a job stamp written by handlabel", e.what());
-    }
-    if (recorded != job_hash) {
-      throw InputError(stamp, "job_hash",
-                       "this job's hash " + job_hash +
-                           " (the folder holds labels of a different job or job version; "
-                           "use another output.dir, or --force to relabel every frame)",
-                       recorded);
-    }
-    return;
+// The job hash recorded in job.json.
+std::string RecordedJobHash(const std::string& stamp) {
+  std::ifstream in(stamp);
+  try {
+    return nlohmann::json::parse(in).at("job_hash").get<std::string>();
+  } catch (const std::exception& e) {
+    throw InputError(stamp, "job_hash", "a job stamp written by handlabel", e.what());
   }
+}
+
+// Creates `path` with `content` unless it exists (no-replace, so that shards starting
+// together cannot overwrite each other's stamp); false if it existed.
+bool CreateFileIfAbsent(const std::string& path, const std::string& content) {
+  const std::string staged = path + ".tmp." + std::to_string(::getpid()) + ".new";
+  WriteFileAtomically(staged, content);
+  const bool created = ::link(staged.c_str(), path.c_str()) == 0;
+  const int error = errno;
+  fs::remove(staged);
+  if (!created && error != EEXIST) {
+    throw InputError(path, "", "a job stamp the run can create", std::strerror(error));
+  }
+  return created;
+}
+
+// A folder holds the outputs of one job: refuse to mix labels of different jobs.
+// Replacing another job's stamp (--force) needs the folder to itself.
+void ClaimOutputFolder(const JobConfig& job, const std::string& job_hash, bool force,
+                       OutputFolderLock* lock) {
+  const std::string stamp = JobStampPath(job.output_dir);
   const nlohmann::json j = {
       {"job", job.name}, {"job_hash", job_hash}, {"job_file", job.source_file}};
+  if (!fs::exists(stamp) && CreateFileIfAbsent(stamp, j.dump(1) + "\n")) return;
+  const std::string recorded = RecordedJobHash(stamp);
+  if (recorded == job_hash) return;
+  if (!force) {
+    throw InputError(stamp, "job_hash",
+                     "this job's hash " + job_hash +
+                         " (the folder holds labels of a different job or job version; "
+                         "use another output.dir, or --force to relabel every frame)",
+                     recorded);
+  }
+  lock->MakeWhole("replace " + stamp + " of another job");
+  // The other job's records describe labels this job replaces: none may count as done.
+  std::error_code ignored;
+  for (const auto& e :
+       fs::directory_iterator(fs::path(job.output_dir) / "shards", ignored)) {
+    if (e.path().extension() == ".jsonl") fs::remove(e.path(), ignored);
+  }
   WriteFileAtomically(stamp, j.dump(1) + "\n");
 }
 
@@ -166,7 +197,10 @@ std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames
         throw InputError(source, "input.frames", "frame ids of the capture",
                          "'" + id + "'");
       }
-      chosen.insert(id);
+      if (!chosen.insert(id).second) {
+        throw InputError(source, "input.frames", "each frame id once",
+                         "'" + id + "' listed twice");
+      }
     }
     start = comma + 1;
   }
@@ -178,8 +212,15 @@ std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames
 }
 
 std::vector<std::string> JobFrames(const JobConfig& job, const FrameSource& source) {
-  std::vector<std::string> frames =
-      SelectFrames(source.FrameIds(), job.frames, job.source_file);
+  const std::vector<std::string> all = source.FrameIds();
+  std::set<std::string> seen;
+  for (const std::string& id : all) {  // a frame listed twice would be labelled twice
+    if (!seen.insert(id).second) {
+      throw InputError(source.Describe(), "frames", "each frame id once",
+                       "'" + id + "' listed twice");
+    }
+  }
+  std::vector<std::string> frames = SelectFrames(all, job.frames, job.source_file);
   if (job.max_frames > 0 && static_cast<int>(frames.size()) > job.max_frames) {
     frames.resize(job.max_frames);
   }
@@ -232,7 +273,8 @@ class LabelJobRun {
     all_frames_ = JobFrames(job_, *stages_.source);
     mine_ = FramesOfShard(all_frames_, options_.shard);
     for (const std::string& f : mine_) FrameFileStem(f, stages_.source->Describe());
-    ClaimOutputFolder(job_, job_hash_, options_.force);
+    lock_ = OutputFolderLock::ForShard(out_, options_.shard, job_.source_file);
+    ClaimOutputFolder(job_, job_hash_, options_.force, &lock_);
     log_path_ = ShardLogPath(out_, options_.shard);
     if (options_.force) fs::remove(log_path_);
     RemoveStaleFrameTemporaries(out_, mine_);
@@ -255,8 +297,10 @@ class LabelJobRun {
         options_.force ? std::map<std::string, FrameRecord>{} : ReadShardLogs(out_);
     for (const std::string& f : mine_) {
       const auto it = records.find(f);
+      // Done: an ok record of this job whose label is still the file it wrote.
       if (it != records.end() && it->second.status == "ok" &&
-          fs::exists(LabelFilePath(out_, f))) {
+          (it->second.job_hash.empty() || it->second.job_hash == job_hash_) &&
+          LabelFileProblem(it->second, LabelFilePath(out_, f)).empty()) {
         ++done_before_;
       } else {
         todo_.push_back(f);
@@ -385,6 +429,12 @@ class LabelJobRun {
       std::error_code ignored;  // no stale label of a failed frame
       fs::remove(LabelFilePath(out_, record.frame), ignored);
     }
+    record.job_hash = job_hash_;
+    if (error.empty()) {  // what resume and merge check the file against
+      const std::string label = LabelFilePath(out_, record.frame);
+      record.label_bytes = static_cast<int64_t>(fs::file_size(label));
+      record.label_sha256 = Sha256OfFile(label);
+    }
     record.seconds = batch.seconds[i] + SecondsSince(frame_start);
     log_->Record(record);
     progress_->FrameDone(!error.empty());
@@ -501,6 +551,7 @@ class LabelJobRun {
   bool in_order_ = false;
   size_t next_ = 0;  // next frame of todo_ to hand out
   LabelContext context_;
+  OutputFolderLock lock_;  // held for the whole run
   FrameLog* log_ = nullptr;
   Progress* progress_ = nullptr;
 };

@@ -14,6 +14,9 @@
 //    the exception's message; the job goes on. A re-run tries failed frames again.
 //  - Shards: ShardSpec picks a deterministic contiguous part of the frames (shard.h).
 //    A run of the whole job (shard 0/1) also merges (manifest + summary).
+//  - One writer: the run holds its shard's lock and the folder's shared lock
+//    (output_lock.h) from planning to the end; a finished frame's record carries the
+//    label file's size and SHA-256, checked on resume (frame_log.h).
 
 #include <ostream>
 #include <string>
@@ -73,8 +76,10 @@ std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames
 std::vector<std::string> JobFrames(const JobConfig& job, const FrameSource& source);
 
 // Runs the shard; returns its summary (also written to the shard's summary file).
-// Throws InputError when the output folder belongs to another job (unless force), or
-// holds finished frames of this shard and neither resume nor force is set.
+// Throws InputError when the output folder belongs to another job (unless force), is
+// in use by another process (the same shard, a merge, or anything during a --force
+// of another job), or holds finished frames of this shard and neither resume nor
+// force is set.
 LabelSummary RunLabelJob(const JobConfig& job, const LabelStageSet& stages,
                          const LabelRunOptions& options);
 

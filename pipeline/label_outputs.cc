@@ -2,9 +2,11 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <set>
 
 #include "core/atomic_file.h"
+#include "core/errors.h"
 #include "pipeline/label_record.h"
 
 namespace handlabel {
@@ -70,23 +72,65 @@ std::map<std::string, FrameRecord> ReadShardLogs(const std::string& output_dir) 
   return latest;
 }
 
+void CheckOutputsBelongToJob(const std::string& output_dir, const std::string& job_hash) {
+  const std::string stamp = JobStampPath(output_dir);
+  if (fs::exists(stamp)) {
+    std::string recorded;
+    try {
+      std::ifstream in(stamp);
+      recorded = nlohmann::json::parse(in).at("job_hash").get<std::string>();
+    } catch (const std::exception& e) {
+      throw InputError(stamp, "job_hash", "a job stamp written by handlabel", e.what());
+    }
+    if (recorded != job_hash) {
+      throw InputError(
+          stamp, "job_hash",
+          "this job's hash " + job_hash +
+              " (the folder holds the outputs of another job or job version)",
+          recorded);
+    }
+  }
+  const fs::path dir = fs::path(output_dir) / "shards";
+  if (!fs::is_directory(dir)) return;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() != ".jsonl") continue;
+    for (const FrameRecord& r : FrameLog::Read(entry.path().string())) {
+      if (!r.job_hash.empty() && r.job_hash != job_hash) {
+        throw InputError(entry.path().string(), "job_hash",
+                         "records of this job (hash " + job_hash + ")",
+                         "frame '" + r.frame + "' of job " + r.job_hash);
+      }
+    }
+  }
+}
+
 LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string& job_name,
                                const std::string& job_hash,
                                const std::vector<std::string>& frames,
-                               const std::string& keypoints_2d_source) {
+                               const std::string& keypoints_2d_source,
+                               std::vector<std::string>* not_labelled) {
+  CheckOutputsBelongToJob(output_dir, job_hash);  // before anything is written
   std::map<std::string, FrameRecord> records = ReadShardLogs(output_dir);
   nlohmann::json entries = nlohmann::json::array();
   for (const std::string& frame : frames) {
     auto it = records.find(frame);
     nlohmann::json entry = {{"frame", frame}};
     const std::string label = "labels/" + FrameFileStem(frame, "frame id") + ".json";
-    if (it != records.end() && it->second.status == "ok" &&
-        !fs::exists(output_dir + "/" + label)) {
-      records.erase(it);  // logged but the file is gone: label it again
+    std::string problem;
+    if (it != records.end() && it->second.status == "ok") {
+      problem = LabelFileProblem(it->second, output_dir + "/" + label);
+    }
+    if (!problem.empty()) {
+      records.erase(it);  // logged but the file is gone or damaged: label it again
       it = records.end();
     }
     if (it == records.end()) {
       entry["status"] = "missing";
+      if (!problem.empty()) entry["reason"] = problem;
+      if (not_labelled) {
+        not_labelled->push_back(
+            frame + (problem.empty() ? " (not yet run)" : " (" + problem + ")"));
+      }
     } else if (it->second.status == "ok") {
       entry["status"] = "ok";
       entry["path"] = it->second.path;

@@ -32,15 +32,22 @@ std::string OverlayPath(const std::string& output_dir, const std::string& frame,
 // one: labels are deterministic, so any ok label of the job is the label.
 std::map<std::string, FrameRecord> ReadShardLogs(const std::string& output_dir);
 
+// Throws InputError, before anything is written, when job.json or a shard log record
+// carries another job hash than `job_hash` (the folder holds another job's outputs).
+void CheckOutputsBelongToJob(const std::string& output_dir, const std::string& job_hash);
+
 // Joins the shards: every frame of `frames` with its latest record; an ok record whose
-// label file is missing counts as missing. Writes manifest.json (frames, status, path,
-// label file, reason: nothing run-dependent, so it is identical however the job was
+// label file is missing or not the file it wrote (size, SHA-256) counts as missing.
+// First checks CheckOutputsBelongToJob. `not_labelled`, if given, receives each
+// missing frame with why ("f7 (not yet run)"). Writes manifest.json (frames, status,
+// path, label file, reason: nothing run-dependent, so it is identical however the job was
 // sharded), summary.json and summary.md, each atomically, and returns the summary.
 // `keypoints_2d_source` (FrameSource::KeypointsSource) is stated in the summary.
 LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string& job_name,
                                const std::string& job_hash,
                                const std::vector<std::string>& frames,
-                               const std::string& keypoints_2d_source = "");
+                               const std::string& keypoints_2d_source = "",
+                               std::vector<std::string>* not_labelled = nullptr);
 
 // Removes leftovers of interrupted atomic writes that belong to `frames` (never other
 // shards' files, which may be in flight). Returns how many were removed.

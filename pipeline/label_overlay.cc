@@ -4,6 +4,7 @@
 
 #include "core/atomic_file.h"
 #include "core/draw.h"
+#include "core/errors.h"
 #include "core/hand_skeleton.h"
 #include "core/image_file.h"
 #include "core/rasterizer.h"
@@ -49,19 +50,40 @@ void DrawLabelOverlay(const RigCamera& camera, const LabelRecord& label,
   }
 }
 
+namespace {
+
+// The view's image as 3-channel RGB (grey replicated, alpha dropped); throws InputError
+// naming the file when its size is not the camera's.
+ImageU8 OverlayBackground(const std::string& path, const RigCamera& camera) {
+  const ImageU8 image = ReadImageFile(path);
+  if (image.width != camera.camera.width() || image.height != camera.camera.height()) {
+    throw InputError(path, "image size",
+                     std::to_string(camera.camera.width()) + "x" +
+                         std::to_string(camera.camera.height()) + " (camera " +
+                         camera.name + ")",
+                     std::to_string(image.width) + "x" + std::to_string(image.height));
+  }
+  if (image.channels == 3) return image;
+  ImageU8 rgb(image.width, image.height, 3, 0);
+  for (size_t p = 0; p < size_t(image.width) * image.height; ++p) {
+    for (int c = 0; c < 3; ++c) {
+      rgb.data[3 * p + c] = image.data[p * image.channels + (image.channels < 3 ? 0 : c)];
+    }
+  }
+  return rgb;
+}
+
+}  // namespace
+
 void RasterOverlayWriter::Write(const std::string& output_dir, const FrameInput& frame,
                                 const LabelRecord& label) const {
   for (size_t v = 0; v < frame.rig.size(); ++v) {
     const RigCamera& camera = frame.rig[v];
-    ImageU8 rgb;
-    try {
-      if (v < frame.image_paths.size()) rgb = ReadImageFile(frame.image_paths[v]);
-    } catch (const std::exception&) {
-      rgb = ImageU8();
-    }
-    if (rgb.width != camera.camera.width() || rgb.height != camera.camera.height() ||
-        rgb.channels != 3) {
-      rgb = ImageU8(camera.camera.width(), camera.camera.height(), 3, 96);
+    // Grey only for a view without an image file; a file that cannot be read or does
+    // not fit the camera fails the frame (the error names it), never a grey overlay.
+    ImageU8 rgb(camera.camera.width(), camera.camera.height(), 3, 96);
+    if (v < frame.image_paths.size() && !frame.image_paths[v].empty()) {
+      rgb = OverlayBackground(frame.image_paths[v], camera);
     }
     DrawLabelOverlay(camera, label, faces_, &rgb);
     WriteFileAtomically(OverlayPath(output_dir, frame.id, camera.name), EncodePng(rgb));

@@ -19,7 +19,9 @@ void DrawLabelOverlay(const RigCamera& camera, const LabelRecord& label,
 class RasterOverlayWriter : public OverlayWriter {
  public:
   explicit RasterOverlayWriter(const HandModel& model) : faces_(model.faces) {}
-  // Reads each view's image (a gray picture when it cannot be read), draws, writes.
+  // Reads each view's image (a grey picture for a view without an image file), draws,
+  // writes. An image that cannot be read or has another size than its camera throws
+  // (the frame fails naming the file): never a grey overlay over a broken capture.
   void Write(const std::string& output_dir, const FrameInput& frame,
              const LabelRecord& label) const override;
 

@@ -155,6 +155,11 @@ void ResolveNetwork(const YAML::Node& overrides, const std::string& path,
 void DeriveSampleOptions(const std::string& path, TrainConfig* c) {
   c->samples.crop_size = c->network.crop_size;
   c->samples.masks = c->network.mask_head;  // the mask head's targets
+  // Checked here, by its own name: it becomes the samples' internal reuse_group.
+  if (c->trainer.batch_size < 1) {
+    throw InputError(path, "train.batch_size", "an integer >= 1",
+                     std::to_string(c->trainer.batch_size));
+  }
   c->samples.reuse_group = c->trainer.batch_size;
   c->samples.augment_seed = c->synth.seed;
   c->samples.Check(path);

@@ -21,6 +21,7 @@ class Section {
     if (node_ && !node_.IsMap()) {
       throw InputError(file_, prefix_.empty() ? "(top level)" : prefix_, "a mapping");
     }
+    if (prefix_.empty()) RejectDuplicateKeys(node_, prefix_);
   }
 
   template <typename T>
@@ -48,7 +49,7 @@ class Section {
   void RejectUnknownKeys() const {
     if (!node_) return;
     for (const auto& entry : node_) {
-      const std::string key = entry.first.as<std::string>();
+      const std::string key = entry.first.Scalar();  // scalar: checked on load
       if (!seen_.count(key)) {
         std::string known;
         for (const std::string& k : seen_) known += (known.empty() ? "" : ", ") + k;
@@ -63,6 +64,31 @@ class Section {
   }
 
  private:
+  // yaml-cpp keeps every entry of a mapping and lookups find the first, so a key
+  // written twice would silently ignore the second value: refused in the whole tree.
+  void RejectDuplicateKeys(const YAML::Node& node, const std::string& at) const {
+    if (!node) return;
+    if (node.IsSequence()) {
+      for (size_t i = 0; i < node.size(); ++i) {
+        RejectDuplicateKeys(node[i], at + "[" + std::to_string(i) + "]");
+      }
+    } else if (node.IsMap()) {
+      std::set<std::string> keys;
+      for (const auto& entry : node) {
+        if (!entry.first.IsScalar()) {
+          throw InputError(file_, at.empty() ? "(top level)" : at, "plain text keys",
+                           "a list or mapping used as a key");
+        }
+        const std::string key = entry.first.Scalar();
+        const std::string name = at.empty() ? key : at + "." + key;
+        if (!keys.insert(key).second) {
+          throw InputError(file_, name, "each key once per mapping", "a duplicate key");
+        }
+        RejectDuplicateKeys(entry.second, name);
+      }
+    }
+  }
+
   std::string Text(const char* key) const {
     YAML::Emitter out;
     out << node_[key];

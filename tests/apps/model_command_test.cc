@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <string>
+
+#include "core/hand_model_io.h"
 
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
@@ -58,6 +61,31 @@ TEST(ModelCommand, ErrorsAndUsage) {
   EXPECT_EQ(r.status, 0);
   EXPECT_NE(r.out.find("convert"), std::string::npos);
   EXPECT_EQ(RunHandlabelCommand({"model", "convert", "--help"}).status, 0);
+}
+
+// Files that record their side and fingertips: --side and --tips used to be ignored
+// (a right hand written for --side left). The other side mirrors the model.
+TEST(ModelCommand, ConvertHonoursSideAndTipsForFilesThatRecordThem) {
+  const std::string dir = testing::ScratchDir();
+  auto r = RunHandlabelCommand({"model", "convert", ManoFixture("mano_py2_right.pkl"),
+                                dir + "/right.npz", "--tips", FixtureTips()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = RunHandlabelCommand({"model", "convert", dir + "/right.npz", dir + "/left.npz",
+                           "--side", "left", "--tips", "2,3,4,5,6"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("mirrored"), std::string::npos) << r.out;
+  const HandModel right = LoadHandModel(dir + "/right.npz");
+  const HandModel left = LoadHandModel(dir + "/left.npz");
+  EXPECT_EQ(right.side, HandSide::kRight);
+  EXPECT_EQ(left.side, HandSide::kLeft);
+  EXPECT_TRUE(left.v_template.col(0).isApprox(-right.v_template.col(0)));
+  EXPECT_TRUE(left.v_template.col(1).isApprox(right.v_template.col(1)));
+  EXPECT_EQ(left.tip_vertex_ids, (std::array<int, 5>{2, 3, 4, 5, 6}));
+  r = RunHandlabelCommand(
+      {"model", "convert", dir + "/right.npz", dir + "/bad.npz", "--tips", "1,2,3,4,99"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--tips"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("99"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -1,6 +1,11 @@
 #pragma once
-// Runs `handlabel <args...>` in-process, as the shell would, capturing its output.
+// Runs `handlabel <args...>` in-process, as the shell would, capturing its output; or
+// as a real child process of the built binary (SpawnHandlabel), for tests of several
+// processes at once.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <string>
 #include <vector>
@@ -24,6 +29,32 @@ inline CommandResult RunHandlabelCommand(std::vector<std::string> args) {
   const int status = RunHandlabel(static_cast<int>(argv.size()), argv.data());
   return {status, ::testing::internal::GetCapturedStdout(),
           ::testing::internal::GetCapturedStderr()};
+}
+
+// Starts build/apps/handlabel with `args`; stdout and stderr are appended to `log`.
+inline pid_t SpawnHandlabel(const std::vector<std::string>& args,
+                            const std::string& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    std::string binary = std::string(HANDLABEL_BINARY_DIR) + "/apps/handlabel";
+    std::vector<std::string> copy = args;
+    std::vector<char*> argv = {binary.data()};
+    for (std::string& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(binary.c_str(), argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// The child's exit status, or minus the signal that ended it.
+inline int WaitForExit(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
 }
 
 }  // namespace handlabel::testing

@@ -167,5 +167,27 @@ TEST(ColmapRig, PointsProjectWhereTheModelSays) {
       testing::MatrixNear(-(q.conjugate() * Eigen::Vector3d(0.1, -0.2, 3)), 1e-12));
 }
 
+// A width that wraps to 640 in 32 bits, and 2^31 / 2^40: refused when read, by value.
+TEST(ColmapModel, ImageSizesAreRangeCheckedBeforeNarrowing) {
+  for (const uint64_t width :
+       {uint64_t{4294967936}, uint64_t{1} << 31, uint64_t{1} << 40}) {
+    ColmapModel model = RandomColmapModel();
+    model.cameras.begin()->second.width = width;
+    const std::string text = ScratchDir() + "/text";
+    std::filesystem::create_directories(text);
+    WriteColmapText(model, text);
+    std::string error = testing::InputErrorOf([&] { ReadColmapText(text); });
+    EXPECT_NE(error.find("cameras.txt"), std::string::npos) << error;
+    EXPECT_NE(error.find("WIDTH"), std::string::npos) << error;
+    EXPECT_NE(error.find(std::to_string(width)), std::string::npos) << error;
+    const std::string binary = ScratchDir() + "/binary";
+    std::filesystem::create_directories(binary);
+    WriteColmapBinary(model, binary);
+    error = testing::InputErrorOf([&] { ReadColmapBinary(binary); });
+    EXPECT_NE(error.find("cameras.bin"), std::string::npos) << error;
+    EXPECT_NE(error.find(std::to_string(width)), std::string::npos) << error;
+  }
+}
+
 }  // namespace
 }  // namespace handlabel

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 
 #include "core/errors.h"
 #include "tests/calib/rig_fixture.h"
@@ -96,6 +97,42 @@ TEST(RigJson, ErrorsNameFileAndField) {
 
   ExpectInputError([&] { ReadRigJson(dir + "/absent.json"); },
                    {"absent.json", "cannot open"});
+}
+
+// Numbers that used to pass silently: a width that wraps to 640 in 32 bits, sizes of
+// 2^31 and 2^40, focal 1e300, cx -1e6, translation 1e308, unknown and repeated keys.
+TEST(RigJson, RefusesImplausibleNumbersAndUnknownOrRepeatedKeys) {
+  const std::string path = ScratchDir() + "/bad.json";
+  const nlohmann::json good = RigToJson(RandomRig(2));
+  const auto expect = [&](const std::function<void(nlohmann::json&)>& edit,
+                          std::vector<std::string> fragments) {
+    nlohmann::json j = good;
+    edit(j);
+    WriteText(path, j.dump());
+    fragments.push_back(path);
+    ExpectInputError([&] { ReadRigJson(path); }, fragments);
+  };
+  expect([](auto& j) { j["cameras"][0]["width"] = 4294967936ull; },
+         {"cameras[0](cam0).width", "4294967936", "[1, 65536]"});
+  expect([](auto& j) { j["cameras"][0]["width"] = 2147483648ll; },
+         {"width", "2147483648"});
+  expect([](auto& j) { j["cameras"][1]["height"] = 1099511627776ll; },
+         {"cameras[1](cam1).height", "1099511627776"});
+  expect([](auto& j) { j["cameras"][0]["params"][0] = 1e300; },
+         {"cameras[0](cam0).params (focal length)", "1e+300"});
+  expect([](auto& j) { j["cameras"][1]["params"][2] = -1e6; },
+         {"cameras[1](cam1).params (cx)", "-1e+06"});
+  expect([](auto& j) { j["cameras"][0]["cam_from_world"]["translation"][1] = 1e308; },
+         {"cameras[0](cam0).cam_from_world.translation", "1e+308"});
+  expect([](auto& j) { j["cameras"][1]["focal"] = 500; },
+         {"cameras[1].focal", "unknown key", "params"});
+  expect([](auto& j) { j["camera"] = nlohmann::json::array(); },
+         {"camera", "unknown key", "cameras"});
+  // A repeated key: nlohmann would keep the last, so it is written by hand.
+  std::string text = good.dump();
+  text.insert(text.find("\"version\""), "\"version\":1,");
+  WriteText(path, text);
+  ExpectInputError([&] { ReadRigJson(path); }, {path, "version", "each key once"});
 }
 
 }  // namespace

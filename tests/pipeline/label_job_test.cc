@@ -265,10 +265,14 @@ TEST(LabelJob, MergeReportsFramesNoShardHasLabelledYet) {
   LabelRunOptions options;
   options.shard = {1, 4};
   RunLabelJob(job, s.Set(), options);
+  std::vector<std::string> not_labelled;
   const LabelSummary merged =
-      MergeLabelOutputs(out, "test", JobHash(job, "x"), s.capture.FrameIds());
+      MergeLabelOutputs(out, "test", JobHash(job, s.predictor.weights_sha256),
+                        s.capture.FrameIds(), "", &not_labelled);
   EXPECT_EQ(merged.ok, 3);
   EXPECT_EQ(merged.missing, 9);
+  ASSERT_EQ(not_labelled.size(), 9u);
+  EXPECT_EQ(not_labelled[0], "000000 (not yet run)");
 }
 
 TEST(LabelJob, RefusesAnOutputFolderOfAnotherJob) {
@@ -339,6 +343,114 @@ TEST(LabelJob, JobHashCoversTheFitFieldsOnlyWhenSet) {
     change(&b);
     EXPECT_NE(JobHash(b, "w"), plain);
   }
+}
+
+// A label file cut short after its record was logged (disk full, a copy interrupted):
+// resume labels it again and merge reports it instead of counting it as done.
+TEST(LabelJob, TruncatedLabelIsRedoneOnResumeAndReportedByMerge) {
+  Stages s;
+  const std::string out = testing::ScratchDir() + "/out";
+  const JobConfig job = MakeJob(out, RefineMode::kFallback);
+  RunLabelJob(job, s.Set(), {});
+  const std::string label = LabelFilePath(out, "000004");
+  const std::string full = testing::ReadFileBytes(label);
+  fs::resize_file(label, full.size() / 2);
+  const std::string hash = JobHash(job, s.predictor.weights_sha256);
+  std::vector<std::string> not_labelled;
+  const LabelSummary merged =
+      MergeLabelOutputs(out, "test", hash, s.capture.FrameIds(), "", &not_labelled);
+  EXPECT_EQ(merged.ok, 11);
+  ASSERT_EQ(not_labelled.size(), 1u);
+  EXPECT_THAT(not_labelled[0], HasSubstr("000004"));
+  EXPECT_THAT(not_labelled[0], HasSubstr("truncated"));
+  // Same size, other content: caught by the checksum.
+  std::string edited = full;
+  edited[edited.size() / 2] = edited[edited.size() / 2] == '1' ? '2' : '1';
+  std::ofstream(LabelFilePath(out, "000007"), std::ios::binary | std::ios::trunc)
+      << edited;
+
+  s.capture.loads = 0;
+  LabelRunOptions resume;
+  resume.resume = true;
+  const LabelSummary summary = RunLabelJob(job, s.Set(), resume);
+  EXPECT_EQ(s.capture.loads.load(), 2);
+  EXPECT_EQ(summary.ok, 12);
+  EXPECT_EQ(testing::ReadFileBytes(label), full);
+  EXPECT_TRUE(
+      LabelFileProblem(FrameLog(ShardLogPath(out, {0, 1})).Latest()[4], label).empty());
+}
+
+// merge with another job's file: refused before the manifest is touched.
+TEST(LabelJob, MergeRefusesAnotherJobWithoutTouchingTheManifest) {
+  Stages s;
+  const std::string out = testing::ScratchDir() + "/out";
+  const JobConfig job = MakeJob(out, RefineMode::kFallback);
+  RunLabelJob(job, s.Set(), {});
+  const std::string manifest = testing::ReadFileBytes(ManifestPath(out));
+  JobConfig other = job;
+  other.seed = 9;
+  const std::string error = testing::InputErrorOf([&] {
+    MergeLabelOutputs(out, "other", JobHash(other, "w"), s.capture.FrameIds());
+  });
+  EXPECT_THAT(error, HasSubstr("job.json"));
+  EXPECT_THAT(error, HasSubstr("another job"));
+  EXPECT_EQ(testing::ReadFileBytes(ManifestPath(out)), manifest);
+  // A record of another job in a shard log (the stamp says this job) is refused too.
+  const std::string hash = JobHash(job, s.predictor.weights_sha256);
+  FrameLog foreign(ShardLogPath(out, {1, 2}));
+  FrameRecord r;
+  r.frame = "000003";
+  r.status = "ok";
+  r.job_hash = JobHash(other, "w");
+  foreign.Record(r);
+  const std::string record_error = testing::InputErrorOf(
+      [&] { MergeLabelOutputs(out, "test", hash, s.capture.FrameIds()); });
+  EXPECT_THAT(record_error, HasSubstr("shard-00001-of-00002.jsonl"));
+  EXPECT_THAT(record_error, HasSubstr("000003"));
+  EXPECT_EQ(testing::ReadFileBytes(ManifestPath(out)), manifest);
+}
+
+// --force with another job replaces the stamp and drops every old record, so the new
+// job's resume never counts the old job's labels as its own.
+TEST(LabelJob, ForceWithAnotherJobDropsTheOldRecords) {
+  Stages s;
+  const std::string out = testing::ScratchDir() + "/out";
+  JobConfig job = MakeJob(out, RefineMode::kFallback);
+  LabelRunOptions half;
+  half.shard = {0, 2};
+  RunLabelJob(job, s.Set(), half);
+  JobConfig other = job;
+  other.seed = 9;
+  LabelRunOptions force;
+  force.force = true;
+  force.shard = {1, 2};
+  RunLabelJob(other, s.Set(), force);
+  EXPECT_FALSE(fs::exists(ShardLogPath(out, {0, 2})));
+  LabelRunOptions resume;
+  resume.resume = true;
+  resume.shard = {0, 2};
+  s.capture.loads = 0;
+  RunLabelJob(other, s.Set(), resume);
+  EXPECT_EQ(s.capture.loads.load(), 6);  // shard 0 labelled again for the new job
+  const LabelSummary merged = MergeLabelOutputs(
+      out, "test", JobHash(other, s.predictor.weights_sha256), s.capture.FrameIds());
+  EXPECT_EQ(merged.ok, 12);
+}
+
+TEST(LabelJob, FrameListedTwiceIsRefused) {
+  const std::vector<std::string> all = {"a", "b", "c"};
+  const std::string error =
+      testing::InputErrorOf([&] { SelectFrames(all, "a,b,a", "job.yaml"); });
+  EXPECT_THAT(error, HasSubstr("job.yaml"));
+  EXPECT_THAT(error, HasSubstr("input.frames"));
+  EXPECT_THAT(error, HasSubstr("'a' listed twice"));
+  Stages s;
+  s.capture.duplicate = "000003";
+  const std::string out = testing::ScratchDir() + "/out";
+  const std::string run_error = testing::InputErrorOf(
+      [&] { RunLabelJob(MakeJob(out, RefineMode::kFallback), s.Set(), {}); });
+  EXPECT_THAT(run_error, HasSubstr("'000003' listed twice"));
+  EXPECT_FALSE(fs::exists(ShardLogPath(out, {0, 1})));
 }
 
 }  // namespace

@@ -73,7 +73,11 @@ class TestCapture : public FrameSource {
     }
   }
 
-  std::vector<std::string> FrameIds() const override { return ids_; }
+  std::vector<std::string> FrameIds() const override {
+    std::vector<std::string> ids = ids_;
+    if (!duplicate.empty()) ids.push_back(duplicate);  // a capture listing it twice
+    return ids;
+  }
 
   FrameInput Load(const std::string& id) const override {
     ++loads;
@@ -102,6 +106,7 @@ class TestCapture : public FrameSource {
 
   const HandModel& model() const { return model_; }
   std::set<std::string> unreadable;
+  std::string duplicate;  // a frame id FrameIds() lists a second time (bad captures)
   mutable std::atomic<int> loads{0};
 
  private:
