@@ -136,7 +136,9 @@ json ViewKeypointsToJson(const std::string& frame,
 
 std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
                                                  const std::string& source) {
-  RejectUnknownKeys(j, {"frame", "views"}, source);
+  // "detector" and "hand" (and the per-view fields after "hand_pixels") are what
+  // `handlabel detect` records beside the keypoints (docs/detector.md).
+  RejectUnknownKeys(j, {"frame", "views", "detector", "hand"}, source);
   const json& views = JsonMember(j, "views", source);
   if (!views.is_array()) throw InputError(source, "views", "an array", views.dump());
   std::vector<ViewKeypoints> out;
@@ -144,7 +146,10 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
     const std::string where = "views[" + std::to_string(i) + "].";
     const json& jv = views[i];
     RejectUnknownKeys(
-        jv, {"camera", "keypoints", "visibility", "confidence", "status", "hand_pixels"},
+        jv,
+        {"camera", "keypoints", "visibility", "confidence", "status", "hand_pixels",
+         "detected", "palm_candidates", "source", "presence", "handedness",
+         "median_reprojection_px", "reason"},
         source, where);
     ViewKeypoints v;
     v.camera = JsonString(jv, "camera", source, where);
