@@ -145,12 +145,11 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
   for (size_t i = 0; i < views.size(); ++i) {
     const std::string where = "views[" + std::to_string(i) + "].";
     const json& jv = views[i];
-    RejectUnknownKeys(
-        jv,
-        {"camera", "keypoints", "visibility", "confidence", "status", "hand_pixels",
-         "detected", "palm_candidates", "source", "presence", "handedness",
-         "median_reprojection_px", "reason"},
-        source, where);
+    RejectUnknownKeys(jv,
+                      {"camera", "keypoints", "visibility", "confidence", "status",
+                       "hand_pixels", "detected", "palm_candidates", "source", "presence",
+                       "handedness", "median_reprojection_px", "reason"},
+                      source, where);
     ViewKeypoints v;
     v.camera = JsonString(jv, "camera", source, where);
     const json& kp = JsonMember(jv, "keypoints", source, where);
