@@ -44,6 +44,7 @@
 #include "core/camera_models.h"
 #include "core/distance_transform.h"
 #include "core/dual.h"
+#include "core/errors.h"
 #include "core/hand_evaluator.h"
 #include "core/rig.h"
 #include "core/scalar_ops.h"
@@ -62,6 +63,17 @@ struct SilhouetteView {
 
 // Bilinear lookup with clamping at the border; T may be a Jet (the weights carry the
 // derivative).
+// Every outline sample names an index into the cost's vertex_ids (or -1 for none):
+// the residuals index the projected vertices with it, so it is checked at creation.
+inline void CheckOutlineVertices(const std::vector<SilhouetteView>& views,
+                                 size_t num_vertex_ids) {
+  for (const SilhouetteView& view : views) {
+    for (int c : view.outline_vertex) {
+      HL_CHECK(c < static_cast<int>(num_vertex_ids), "outline vertex within vertex_ids");
+    }
+  }
+}
+
 template <typename T>
 T BilinearLookup(const DistanceImage& image, const T& u, const T& v) {
   using std::floor;
@@ -162,6 +174,7 @@ class MultiViewSilhouetteCost {
                                      const std::vector<int>& vertex_ids,
                                      const std::vector<SilhouetteView>& views,
                                      double sigma_px) {
+    CheckOutlineVertices(views, vertex_ids.size());
     auto* functor = new MultiViewSilhouetteCost(evaluator, vertex_ids, views, sigma_px);
     return new ceres::AutoDiffCostFunction<MultiViewSilhouetteCost, ceres::DYNAMIC, 3,
                                            kPoseDim, kNumBetas, 3>(
@@ -200,6 +213,7 @@ class MultiViewSilhouetteCostFunction : public ceres::CostFunction {
                                      const std::vector<int>& vertex_ids,
                                      const std::vector<SilhouetteView>& views,
                                      double sigma_px) {
+    CheckOutlineVertices(views, vertex_ids.size());
     return new MultiViewSilhouetteCostFunction(evaluator, vertex_ids, views, sigma_px);
   }
 

@@ -226,7 +226,7 @@ TEST_F(CostGradientsTest, Silhouette) {
     for (int s = 0; s < 5; ++s) {
       views[v].outline_px.emplace_back(300 + 10 * s, 250 - 7 * s);
       views[v].outline_normal.push_back(Eigen::Vector2d(1, s).normalized());
-      views[v].outline_vertex.push_back(3 * s + v);
+      views[v].outline_vertex.push_back(2 * s + v);  // < ids.size()
     }
   }
   const std::vector<int> ids = {0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20};
