@@ -8,6 +8,7 @@
 
 #include "capture/capture_format.h"
 #include "core/errors.h"
+#include "core/stopwatch.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_stage_factory.h"
 #include "pipeline/network_stage.h"
@@ -17,10 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 std::string Join(const std::vector<std::string>& items) {
   std::string out;

@@ -9,6 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/json_util.h"
+#include "core/stopwatch.h"
 
 namespace handlabel {
 namespace {
@@ -112,8 +113,7 @@ DetectCaptureSummary DetectCapture(const std::string& capture_dir,
     if (on_frame) on_frame(f + 1, capture.num_frames());
   }
   ListDetections(capture);
-  summary.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  summary.seconds = SecondsSince(t0);
   return summary;
 }
 

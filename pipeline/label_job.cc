@@ -21,6 +21,7 @@
 #include "core/errors.h"
 #include "core/progress.h"
 #include "core/sha256.h"
+#include "core/stopwatch.h"
 #include "pipeline/build_info.h"
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
@@ -32,10 +33,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // The frames of one batch as they move through the stages.
 struct Batch {

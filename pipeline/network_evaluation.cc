@@ -6,6 +6,7 @@
 #include "core/errors.h"
 #include "core/line_plot.h"
 #include "core/mesh_keypoints.h"
+#include "core/stopwatch.h"
 #include "network/hand_mesh_predictor.h"
 #include "network/mask_sheet.h"
 
@@ -88,8 +89,7 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
     for (const TrainingSample& s : samples) inputs.push_back(NetworkInput(s));
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<HandMeshPrediction> pred = predictor->Predict(inputs);
-    r.seconds +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.seconds += SecondsSince(t0);
     for (size_t i = 0; i < samples.size(); ++i) {
       const int f = first + static_cast<int>(i);
       const TrainingSample& s = samples[i];
