@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <iostream>
+#include <sstream>
 
 namespace handlabel {
 
@@ -26,6 +27,15 @@ int RunReportingErrors(const char* command, const std::function<int()>& body) {
     std::cerr << "handlabel " << command << ": error: " << e.what() << "\n";
     return 1;
   }
+}
+
+std::vector<std::string> SplitCommas(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream list(text);
+  for (std::string item; std::getline(list, item, ',');) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
 }
 
 }  // namespace handlabel

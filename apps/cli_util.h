@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
+#include <vector>
 
 namespace handlabel {
 
@@ -12,5 +14,8 @@ int ParseCommandLine(CLI::App& app, int argc, char** argv);
 
 // Runs `body`, turning exceptions into a one-line message on stderr and status 1.
 int RunReportingErrors(const char* command, const std::function<int()>& body);
+
+// "a,b,,c" -> {"a", "b", "c"}: the comma lists of flags such as --frames, --ignore-views.
+std::vector<std::string> SplitCommas(const std::string& text);
 
 }  // namespace handlabel

@@ -13,15 +13,6 @@
 namespace handlabel {
 namespace {
 
-std::vector<std::string> SplitCommas(const std::string& text) {
-  std::vector<std::string> items;
-  std::stringstream list(text);
-  for (std::string item; std::getline(list, item, ',');) {
-    if (!item.empty()) items.push_back(item);
-  }
-  return items;
-}
-
 struct CompareFlags {
   std::string job_file, capture, weights, frames, hand_model;
   int max_frames = 0, threads = 0;

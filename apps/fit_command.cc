@@ -12,15 +12,6 @@
 namespace handlabel {
 namespace {
 
-std::vector<std::string> SplitCommas(const std::string& text) {
-  std::vector<std::string> items;
-  std::stringstream list(text);
-  for (std::string item; std::getline(list, item, ',');) {
-    if (!item.empty()) items.push_back(item);
-  }
-  return items;
-}
-
 // A fitter setting given on the command line becomes a job field (fit.*); one left
 // out stays unset, so the job equals a YAML job without that field.
 template <typename T>

@@ -44,6 +44,24 @@ std::string TensorsError(const std::string& path) {
   return "";
 }
 
+TEST(TorchArchive, RefusesViewsOutsideTheirStorage) {
+  using namespace std::string_literals;
+  EXPECT_EQ(TensorsError(ArchiveWithPickleEdit("cpuq\x07K\x18"s, "cpuq\x07K\x18"s)), "");
+  // The storage claims 16 floats but its entry holds 24.
+  std::string error =
+      TensorsError(ArchiveWithPickleEdit("cpuq\x07K\x18"s, "cpuq\x07K\x10"s));
+  EXPECT_NE(error.find("16 elements of float32"), std::string::npos) << error;
+  EXPECT_NE(error.find("state_dict/data/0"), std::string::npos) << error;
+  // Size (2, 3, 5) with strides (12, 4, 1) reaches element 24 of 24.
+  error =
+      TensorsError(ArchiveWithPickleEdit("K\x02K\x03K\x04\x87"s, "K\x02K\x03K\x05\x87"s));
+  EXPECT_NE(error.find("a view inside the storage"), std::string::npos) << error;
+  // A stride of 127 jumps out of the storage at once.
+  error =
+      TensorsError(ArchiveWithPickleEdit("K\x0cK\x04K\x01\x87"s, "K\x7fK\x04K\x01\x87"s));
+  EXPECT_NE(error.find("stride"), std::string::npos) << error;
+}
+
 // A storage count of 2^62 + 24 floats is 96 bytes modulo 2^64, the size of the real
 // entry: a multiplied check passes it, and then a (2, 3, 5) view (one element past
 // the 24 stored) looks inside the claimed storage and is read past the entry's end.
