@@ -145,6 +145,10 @@ TEST(LabelCommand, ShardsFromFlagOrEnvironmentMergeToTheSingleProcessResult) {
   const auto merged = RunHandlabelCommand({"merge", "--job", sharded});
   ASSERT_EQ(merged.status, 0) << merged.err;
   EXPECT_THAT(merged.out, HasSubstr("5 frames: 5 labelled"));
+  // merge states where the 2D came from, as the shards did.
+  EXPECT_THAT(merged.out, HasSubstr("2D keypoints: "));
+  EXPECT_THAT(testing::ReadFileBytes(dir + "/sharded/summary.md"),
+              HasSubstr("2D keypoints: "));
   EXPECT_EQ(testing::FilesUnder(dir + "/sharded/labels"),
             testing::FilesUnder(dir + "/single/labels"));
   EXPECT_EQ(testing::ReadFileBytes(dir + "/sharded/manifest.json"),
