@@ -75,7 +75,7 @@ TEST(PoemModel, InferenceKernelsMatchTheAutogradPath) {
   const PoemConfig c = SmallPoemConfig(3);
   PoemModel model = MakeRandomPoemModel(c, 8);
   model->eval();
-  const PoemBatch batch = testing::MakeSyntheticBatch(c, 2, 9);
+  const PoemBatch batch = testing::MakeSyntheticBatch(c, 1, 9);
   const PoemOutputs want = model->forward(batch);
   ASSERT_TRUE(want.layer_coords.requires_grad());
   torch::NoGradGuard no_grad;
