@@ -32,7 +32,7 @@ ViewHandResult DetectedView() {
   palm.xmin = 0.25;  // 160 px of 640
   palm.ymin = 0.5;   // 240 px of 480
   palm.width = 0.125;
-  palm.height = 0.125;
+  palm.height = 0.125;  // 80 x 60 px
   v.palms = {palm};
   v.hand.roi = {0.5, 0.5, 0.25, 1.0 / 3.0, 0.0};  // 160 x 160 px around (320, 240)
   for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -48,19 +48,23 @@ TEST(DetectOverlay, DrawsPalmBoxRoiKeypointsAndCaption) {
   ImageU8 img(640, 480, 3, 0);
   const ViewHandResult view = DetectedView();
   DrawHandDetection(view, &img);
-  // Palm box: x 159.5..239.5 -> pixels 160 and 240 at its corners (rounded), in yellow.
-  EXPECT_EQ(PixelAt(img, 200, 240), kPalmBoxColor);  // top edge (y0 = 239.5 -> 240)
-  EXPECT_GT(CountColor(img, kPalmBoxColor, 150, 230, 250, 330), 300);
+  // Palm box: (159.5, 239.5) to (239.5, 299.5), edges rounded to pixels 160..240 and
+  // 240..300, in yellow (perimeter 280 px, some under the ROI and keypoints).
+  EXPECT_EQ(PixelAt(img, 200, 240), kPalmBoxColor);  // top edge
+  EXPECT_EQ(PixelAt(img, 160, 270), kPalmBoxColor);  // left edge
+  EXPECT_GT(CountColor(img, kPalmBoxColor, 150, 230, 250, 310), 200);
   // ROI corners at (239.5, 159.5) and (399.5, 319.5): its top and right edges in cyan
   // (away from keypoints and the palm box).
   EXPECT_GT(CountColor(img, kRoiColor, 380, 150, 420, 340), 150);
   EXPECT_GT(CountColor(img, kRoiColor, 250, 150, 400, 170), 140);
-  // Keypoint 0 at (260, 180), confidence 1: a disc of radius 4 in its finger colour.
+  // Keypoint 0 at (260, 180), confidence 1: a disc of radius 4 in its finger colour
+  // (the skeleton leaves it only rightwards and downwards).
   EXPECT_EQ(PixelAt(img, 260, 180), SnapKeypointColor(0));
-  EXPECT_EQ(PixelAt(img, 263, 180), SnapKeypointColor(0));
-  // Keypoint 1 at (290, 180), confidence 0.05: radius ~1.6, 3 px away is not its disc.
+  EXPECT_EQ(PixelAt(img, 262, 177), SnapKeypointColor(0));  // 3.6 px from its centre
+  // Keypoint 1 at (290, 180), confidence 0.05: radius ~1.6, so 2.2 px above-right of it
+  // is still the background.
   EXPECT_EQ(PixelAt(img, 290, 180), SnapKeypointColor(1));
-  EXPECT_NE(PixelAt(img, 293, 180), SnapKeypointColor(1));
+  EXPECT_EQ(PixelAt(img, 291, 178), (Rgb{0, 0, 0}));
   // Keypoint 20 (confidence 0, unknown) at (260 + 0, 180 + 120): not drawn.
   EXPECT_NE(PixelAt(img, 260, 300), SnapKeypointColor(20));
   // Caption "PALM P0.93" in white at the top left; no red (that is for no hand).
@@ -80,7 +84,7 @@ TEST(DetectOverlay, ViewWithoutHandShowsItsReasonInRed) {
   // No ROI and no keypoints for a view without a detection; its palm boxes still show.
   EXPECT_EQ(CountColor(img, kRoiColor, 0, 0, 640, 480), 0);
   EXPECT_NE(PixelAt(img, 260, 180), SnapKeypointColor(0));
-  EXPECT_GT(CountColor(img, kPalmBoxColor, 150, 230, 250, 330), 300);
+  EXPECT_EQ(CountColor(img, kPalmBoxColor, 150, 230, 250, 310), 280);
 }
 
 TEST(DetectOverlay, RoiCornersFollowTheRotation) {
