@@ -33,11 +33,13 @@ void DetectionStore::Put(const std::string& frame, FrameHandResult result) {
   results_[frame] = std::move(result);
 }
 
-std::optional<FrameHandResult> DetectionStore::Get(const std::string& frame) const {
+std::optional<FrameHandResult> DetectionStore::Take(const std::string& frame) {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto it = results_.find(frame);
   if (it == results_.end()) return std::nullopt;
-  return it->second;
+  FrameHandResult result = std::move(it->second);
+  results_.erase(it);
+  return result;
 }
 
 std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(

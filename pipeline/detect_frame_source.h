@@ -24,11 +24,12 @@ namespace handlabel {
 class DetectionStore {
  public:
   void Put(const std::string& frame, FrameHandResult result);
-  // nullopt when the frame was not detected (yet).
-  std::optional<FrameHandResult> Get(const std::string& frame) const;
+  // The frame's answer, removed from the store (each is drawn once: a long job does
+  // not keep them all); nullopt when the frame was not detected (yet).
+  std::optional<FrameHandResult> Take(const std::string& frame);
 
  private:
-  mutable std::mutex mutex_;
+  std::mutex mutex_;
   std::map<std::string, FrameHandResult> results_;
 };
 

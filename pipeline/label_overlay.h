@@ -25,7 +25,7 @@ class RasterOverlayWriter : public OverlayWriter {
   // (evidence.keypoints_2d: detector); each view then also shows its detection
   // (pipeline/detect_overlay.h). Null: the label only.
   explicit RasterOverlayWriter(const HandModel& model,
-                               std::shared_ptr<const DetectionStore> detections = nullptr)
+                               std::shared_ptr<DetectionStore> detections = nullptr)
       : faces_(model.faces), detections_(std::move(detections)) {}
   // Reads each view's image (a grey picture for a view without an image file), draws,
   // writes. An image that cannot be read or has another size than its camera throws
@@ -35,7 +35,7 @@ class RasterOverlayWriter : public OverlayWriter {
 
  private:
   Faces faces_;
-  std::shared_ptr<const DetectionStore> detections_;
+  std::shared_ptr<DetectionStore> detections_;
 };
 
 }  // namespace handlabel
