@@ -110,6 +110,12 @@ struct JobConfig {
   // formats without 2D keypoints (ho3d, oakink, dexycb without labels files): a job
   // never runs from no 2D. Empty = the capture's own 2D.
   std::string detections;
+  // evidence.keypoints_2d: detector: the 2D keypoints come from MediaPipe Hands run on
+  // each frame's images in the job (pipeline/detect_frame_source.h), as `handlabel
+  // detect` would write them; they then count as file evidence (keypoints = kFiles).
+  bool keypoints_from_detector = false;
+  // evidence.detector_model: full | lite (MediaPipe's two model sizes).
+  std::string detector_model = "full";
   // Camera names whose 2D keypoints and masks are not fitted to (a broken camera).
   std::vector<std::string> ignore_views;
   // Silhouette residual scale (pixels per unit) for the network's masks. In the file
