@@ -532,13 +532,9 @@ class FitRun {
     out.view_iou.assign(input.views.size(), kNaN);
     for (size_t v = 0; v < input.masks.size(); ++v) {
       if (input.masks[v].size() == 0) continue;
-      const RigCamera& camera = input.views[v].camera;
-      const MaskImage rendered =
-          input.pixel_rays != nullptr
-              ? RenderHandMask(out.vertices, model_.faces, camera, (*input.pixel_rays)[v])
-              : RenderHandMask(out.vertices, model_.faces, camera,
-                               PixelRays(camera.camera));
-      out.view_iou[v] = MaskIoU(rendered, input.masks[v], Occluder(input, v));
+      out.view_iou[v] =
+          ProjectedMeshIoU(out.vertices, model_.faces, input.views[v].camera,
+                           input.masks[v], Occluder(input, v));
     }
     return out;
   }

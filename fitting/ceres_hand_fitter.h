@@ -132,9 +132,6 @@ struct HandFitInput {
   bool unknown_occluders = false;
   std::optional<Points3dTargets> targets3d;
   std::optional<HandParams> previous;
-  // Optional per-view pixel rays of the cameras (core/rasterizer.h), for the IoU of
-  // the result; computed per call when absent (costly: cache them per rig).
-  const std::vector<PixelRays>* pixel_rays = nullptr;
 };
 
 // The result of the keypoint stage (before any silhouette round): what the same fit
