@@ -65,8 +65,10 @@ void BM_FitKeypoints(benchmark::State& state) {
   const CeresHandFitter fitter(f.model);
   size_t i = 0;
   double iterations = 0;
-  for (auto _ : state) iterations += FitOne(fitter, f.inputs[i++ % f.inputs.size()], false);
-  state.counters["iterations"] = benchmark::Counter(iterations, benchmark::Counter::kAvgIterations);
+  for (auto _ : state)
+    iterations += FitOne(fitter, f.inputs[i++ % f.inputs.size()], false);
+  state.counters["iterations"] =
+      benchmark::Counter(iterations, benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_FitKeypoints)->Unit(benchmark::kMillisecond);
 
@@ -89,7 +91,6 @@ void BM_FitKeypointsSilhouettes(benchmark::State& state) {
   size_t i = 0;
   for (auto _ : state) {
     HandFitInput input = f.inputs[i++ % f.inputs.size()];
-    input.pixel_rays = &f.rays;
     FitOne(fitter, input, true);
   }
 }

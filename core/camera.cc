@@ -84,6 +84,14 @@ bool Camera::ProjectWithJacobian(const Eigen::Vector3d& point_in_cam, Eigen::Vec
 
 Eigen::Vector2d Camera::Distort(const Eigen::Vector2d& xy,
                                 Eigen::Matrix2d* jacobian) const {
+  if (jacobian == nullptr) {  // the same arithmetic on values only (every projection)
+    double params[12] = {};
+    for (size_t i = 0; i < params_.size(); ++i) params[i] = params_[i];
+    const Intrinsics<double> in = UnpackIntrinsics(model_, params);
+    double xd, yd;
+    DistortNormalized(in, xy.x(), xy.y(), &xd, &yd);
+    return Eigen::Vector2d(xd, yd);
+  }
   using D2 = Dual<2>;
   D2 params[12];
   for (size_t i = 0; i < params_.size(); ++i) params[i] = D2(params_[i]);

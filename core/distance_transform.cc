@@ -3,6 +3,8 @@
 #include <limits>
 #include <vector>
 
+#include "core/errors.h"
+
 namespace handlabel {
 namespace {
 
@@ -51,6 +53,18 @@ void Transform1d(double* f, int n, int stride, std::vector<double>* buffer,
   for (int q = 0; q < n; ++q) f[q * stride] = d[q];
 }
 
+// In place: squared distances (0 on targets, +inf elsewhere) become distances.
+void SeparableTransform(DistanceImage* image) {
+  DistanceImage& d = *image;
+  const int h = static_cast<int>(d.rows());
+  const int w = static_cast<int>(d.cols());
+  std::vector<double> buffer, z;
+  std::vector<int> v;
+  for (int c = 0; c < w; ++c) Transform1d(d.data() + c, h, w, &buffer, &v, &z);
+  for (int r = 0; r < h; ++r) Transform1d(d.data() + r * w, w, 1, &buffer, &v, &z);
+  d = d.cwiseSqrt();
+}
+
 DistanceImage DistanceToValue(const MaskImage& mask, bool target_nonzero) {
   const int h = static_cast<int>(mask.rows());
   const int w = static_cast<int>(mask.cols());
@@ -60,11 +74,8 @@ DistanceImage DistanceToValue(const MaskImage& mask, bool target_nonzero) {
       d(r, c) = ((mask(r, c) != 0) == target_nonzero) ? 0.0 : kInf;
     }
   }
-  std::vector<double> buffer, z;
-  std::vector<int> v;
-  for (int c = 0; c < w; ++c) Transform1d(d.data() + c, h, w, &buffer, &v, &z);
-  for (int r = 0; r < h; ++r) Transform1d(d.data() + r * w, w, 1, &buffer, &v, &z);
-  return d.cwiseSqrt();
+  SeparableTransform(&d);
+  return d;
 }
 
 }  // namespace
@@ -75,6 +86,27 @@ DistanceImage DistanceToMask(const MaskImage& mask) {
 
 DistanceImage DistanceToOutside(const MaskImage& mask) {
   return DistanceToValue(mask, false);
+}
+
+DistanceImage DistanceToMaskInWindow(const MaskImage& mask, const PixelWindow& window,
+                                     const MaskImage* also) {
+  HL_CHECK(!window.empty() && window.x0 >= 0 && window.y0 >= 0 &&
+               window.x0 + window.width <= mask.cols() &&
+               window.y0 + window.height <= mask.rows(),
+           "distance window inside the image");
+  HL_CHECK(
+      also == nullptr || (also->rows() == mask.rows() && also->cols() == mask.cols()),
+      "masks of one size");
+  DistanceImage d(window.height, window.width);
+  for (int r = 0; r < window.height; ++r) {
+    for (int c = 0; c < window.width; ++c) {
+      const int y = window.y0 + r, x = window.x0 + c;
+      const bool target = mask(y, x) != 0 || (also != nullptr && (*also)(y, x) != 0);
+      d(r, c) = target ? 0.0 : kInf;
+    }
+  }
+  SeparableTransform(&d);
+  return d;
 }
 
 }  // namespace handlabel

@@ -215,12 +215,12 @@ Vec3 BlendedVertex(const SkinningArrays& s, const HandPoseState<double>& state,
   return vp;
 }
 
-// The posed position of fingertip vertex v and its derivatives (rotation columns into
-// d_orient / d_pose, shape columns into d_shape).
-Vec3 TipVertex(const SkinningArrays& s, const HandPoseState<double>& state,
-               const JointMotion& m,
-               const std::array<BetaColumns, kNumHandJoints>& dp_dbetas, int v,
-               Eigen::Matrix3d* d_orient, PoseColumns* d_pose, BetaColumns* d_shape) {
+// The posed position of vertex v (before transl) and its derivatives (rotation columns
+// into d_orient / d_pose, shape columns into d_shape).
+Vec3 SkinnedVertex(const SkinningArrays& s, const HandPoseState<double>& state,
+                   const JointMotion& m,
+                   const std::array<BetaColumns, kNumHandJoints>& dp_dbetas, int v,
+                   Eigen::Matrix3d* d_orient, PoseColumns* d_pose, BetaColumns* d_shape) {
   PoseColumns dvp_dpose;
   const Vec3 vp = BlendedVertex(s, state, m, v, &dvp_dpose);
   // Blend: point = sum_j w_j q_j, q_j = R_j (vp - J_j) + p_j; s_a collects
@@ -253,56 +253,91 @@ Vec3 TipVertex(const SkinningArrays& s, const HandPoseState<double>& state,
 
 }  // namespace
 
+// What every analytic Jacobian of one parameter vector shares: the forward pass, the
+// joints' motion and the joints' shape derivatives.
+struct HandEvaluator::JacobianPass {
+  HandPoseState<double> state;
+  JointMotion motion;
+  std::array<BetaColumns, kNumHandJoints> dp_dbetas;
+};
+
+void HandEvaluator::PrepareJacobian(const double* global_orient, const double* hand_pose,
+                                    const double* betas, const double* transl,
+                                    JacobianPass* pass) const {
+  Pose(global_orient, hand_pose, betas, transl, &pass->state);
+  double pose45[kNumPoseParams];
+  AxisAnglePose(hand_pose, pose45);
+  ComputeJointMotion(pass->state, global_orient, pose45, &pass->motion);
+  pass->dp_dbetas = JointBetaJacobians(joint_shapedirs_, parents_, pass->motion);
+}
+
+void HandEvaluator::WriteJacobianRows(const Eigen::Matrix3d& d_orient,
+                                      const PoseColumns& d_pose,
+                                      const BetaColumns& d_shape, double* rows) const {
+  Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> out(rows, 3,
+                                                                            num_params());
+  const int col_betas = 3 + pose_dim();
+  out.leftCols<3>() = d_orient;
+  if (options_.num_pca_comps > 0) {
+    out.middleCols(3, pose_dim()) = d_pose * pca_basis_.transpose();
+  } else {
+    out.middleCols<kNumPoseParams>(3) = d_pose;
+  }
+  out.middleCols(col_betas, num_betas_) = d_shape;
+  out.middleCols<3>(col_betas + num_betas_).setIdentity();
+}
+
 void HandEvaluator::KeypointsAndJacobian(const double* global_orient,
                                          const double* hand_pose, const double* betas,
                                          const double* transl, double* keypoints63,
                                          double* jacobian) const {
-  const int nb = num_betas_;
-  const int col_betas = 3 + pose_dim();
-  const int col_transl = col_betas + nb;
-
-  HandPoseState<double> state;
-  Pose(global_orient, hand_pose, betas, transl, &state);
-  double pose45[kNumPoseParams];
-  AxisAnglePose(hand_pose, pose45);
-  JointMotion motion;
-  ComputeJointMotion(state, global_orient, pose45, &motion);
-  const std::array<BetaColumns, kNumHandJoints> dp_dbetas =
-      JointBetaJacobians(joint_shapedirs_, parents_, motion);
+  JacobianPass pass;
+  PrepareJacobian(global_orient, hand_pose, betas, transl, &pass);
   const SkinningArrays arrays{v_template_,      shapedirs_,    posedirs_,
                               joint_shapedirs_, weight_start_, weight_joint_,
-                              weight_value_,    parents_,      nb};
-
-  // Jacobian w.r.t. axis-angle pose (45 columns) first; mapped to PCA at the end.
+                              weight_value_,    parents_,      num_betas_};
+  // Jacobian w.r.t. axis-angle pose (45 columns) first; mapped to PCA when written.
   PoseColumns d_pose;
-  Eigen::Map<RowMatrix> jac(jacobian, 3 * kNumHandKeypoints, num_params());
-  jac.setZero();
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     const int native = kSnapFromNative[k];
-    auto rows = jac.middleRows<3>(3 * k);
     Eigen::Matrix3d d_orient = Eigen::Matrix3d::Zero();
     d_pose.setZero();
+    BetaColumns d_shape;
     Vec3 point;
     if (native < kNumHandJoints) {
-      point = JointKeypoint(motion, parents_, native, &d_orient, &d_pose);
-      rows.middleCols(col_betas, nb) = dp_dbetas[native];
+      point = JointKeypoint(pass.motion, parents_, native, &d_orient, &d_pose);
+      d_shape = pass.dp_dbetas[native];
     } else {
-      BetaColumns d_shape;
-      point = TipVertex(arrays, state, motion, dp_dbetas,
-                        tip_vertex_ids_[native - kNumHandJoints], &d_orient, &d_pose,
-                        &d_shape);
-      rows.middleCols(col_betas, nb) = d_shape;
+      point = SkinnedVertex(arrays, pass.state, pass.motion, pass.dp_dbetas,
+                            tip_vertex_ids_[native - kNumHandJoints], &d_orient, &d_pose,
+                            &d_shape);
     }
-    rows.leftCols<3>() = d_orient;
-    if (options_.num_pca_comps > 0) {
-      rows.middleCols(3, pose_dim()) = d_pose * pca_basis_.transpose();
-    } else {
-      rows.middleCols<kNumPoseParams>(3) = d_pose;
-    }
-    rows.middleCols<3>(col_transl).setIdentity();
-    for (int c = 0; c < 3; ++c) {
-      keypoints63[3 * k + c] = point[c] + state.transl[c];
-    }
+    WriteJacobianRows(d_orient, d_pose, d_shape, jacobian + 3 * k * num_params());
+    for (int c = 0; c < 3; ++c) keypoints63[3 * k + c] = point[c] + pass.state.transl[c];
+  }
+}
+
+void HandEvaluator::VerticesAndJacobian(const double* global_orient,
+                                        const double* hand_pose, const double* betas,
+                                        const double* transl, const std::vector<int>& ids,
+                                        double* out, double* jacobian) const {
+  JacobianPass pass;
+  PrepareJacobian(global_orient, hand_pose, betas, transl, &pass);
+  const SkinningArrays arrays{v_template_,      shapedirs_,    posedirs_,
+                              joint_shapedirs_, weight_start_, weight_joint_,
+                              weight_value_,    parents_,      num_betas_};
+  PoseColumns d_pose;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    HL_CHECK(
+        ids[i] >= 0 && ids[i] < num_vertices_,
+        "vertex id " + std::to_string(ids[i]) + " of " + std::to_string(num_vertices_));
+    Eigen::Matrix3d d_orient = Eigen::Matrix3d::Zero();
+    d_pose.setZero();
+    BetaColumns d_shape;
+    const Vec3 point = SkinnedVertex(arrays, pass.state, pass.motion, pass.dp_dbetas,
+                                     ids[i], &d_orient, &d_pose, &d_shape);
+    WriteJacobianRows(d_orient, d_pose, d_shape, jacobian + 3 * i * num_params());
+    for (int c = 0; c < 3; ++c) out[3 * i + c] = point[c] + pass.state.transl[c];
   }
 }
 

@@ -138,6 +138,14 @@ class HandEvaluator {
                             const double* betas, const double* transl,
                             double* keypoints63, double* jacobian) const;
 
+  // Posed vertices `ids` (as VerticesFromState) and their analytic Jacobian, doubles
+  // only: `jacobian` is row-major (3 ids.size()) x num_params(), columns as in
+  // KeypointsAndJacobian. Several times cheaper than ceres::Jet over all parameters.
+  void VerticesAndJacobian(const double* global_orient, const double* hand_pose,
+                           const double* betas, const double* transl,
+                           const std::vector<int>& ids, double* out,
+                           double* jacobian) const;
+
   // One-call conveniences.
   template <typename T>
   void Keypoints(const T* global_orient, const T* hand_pose, const T* betas,
@@ -171,6 +179,17 @@ class HandEvaluator {
  private:
   template <typename T>
   void SkinVertex(const HandPoseState<T>& state, int v, T* out) const;
+
+  // The analytic Jacobians' shared forward pass (hand_evaluator.cc) and the writing of
+  // one point's 3 rows (axis-angle pose columns mapped to PCA where used).
+  struct JacobianPass;
+  void PrepareJacobian(const double* global_orient, const double* hand_pose,
+                       const double* betas, const double* transl,
+                       JacobianPass* pass) const;
+  void WriteJacobianRows(const Eigen::Matrix3d& d_orient,
+                         const Eigen::Matrix<double, 3, kNumPoseParams>& d_pose,
+                         const Eigen::Matrix<double, 3, Eigen::Dynamic>& d_shape,
+                         double* rows) const;
 
   using RowMatrix =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -39,6 +40,39 @@ const MaskImage* Occluder(const HandFitInput& input, size_t v) {
         std::to_string(occluder.cols()) + "x" + std::to_string(occluder.rows()));
   }
   return &occluder;
+}
+
+// The window of a view's distance transform: the hand mask's pixels and the projected
+// hand (`vertices`, world frame) with `margin_px` around them, inside the image; empty
+// when neither is in the image.
+PixelWindow HandWindow(const MaskImage& mask, const RigCamera& camera,
+                       const Points3d& vertices, int margin_px) {
+  const int w = static_cast<int>(mask.cols()), h = static_cast<int>(mask.rows());
+  int x_min = w, y_min = h, x_max = -1, y_max = -1;
+  auto include = [&](double x, double y) {
+    x_min = std::min(x_min, static_cast<int>(std::floor(x)));
+    y_min = std::min(y_min, static_cast<int>(std::floor(y)));
+    x_max = std::max(x_max, static_cast<int>(std::ceil(x)));
+    y_max = std::max(y_max, static_cast<int>(std::ceil(y)));
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (mask(y, x) != 0) include(x, y);
+    }
+  }
+  for (Eigen::Index i = 0; i < vertices.rows(); ++i) {
+    Eigen::Vector2d uv;
+    if (camera.ProjectWorld(vertices.row(i).transpose(), &uv) &&
+        uv.cwiseAbs().maxCoeff() < 1e6) {
+      include(uv.x(), uv.y());
+    }
+  }
+  PixelWindow window;
+  window.x0 = std::max(x_min - margin_px, 0);
+  window.y0 = std::max(y_min - margin_px, 0);
+  window.width = std::min(x_max + margin_px, w - 1) - window.x0 + 1;
+  window.height = std::min(y_max + margin_px, h - 1) - window.y0 + 1;
+  return window;
 }
 
 constexpr int kBetas = 10;
@@ -178,6 +212,7 @@ void HandFitOptions::Check() const {
   RequireNonNegative(silhouette_rounds, "silhouette_rounds");
   RequirePositive(silhouette_contour_cosine, "silhouette_contour_cosine");
   RequireNonNegative(occluder_reach_px, "occluder_reach_px");
+  RequireNonNegative(silhouette_window_margin_px, "silhouette_window_margin_px");
   RequirePositive(unknown_occluder_cap_px, "unknown_occluder_cap_px");
   RequireNonNegative(rigid_iterations, "rigid_iterations");
   RequireNonNegative(keypoint_iterations, "keypoint_iterations");
@@ -341,7 +376,7 @@ class FitRun {
     HandFitResult result;
     auto add_evidence = [&](StageProblem* problem) {
       if (use_kp) {
-        problem->AddFull("keypoints", MultiViewKeypointCostFunction::Create(
+        problem->AddFull("keypoints", MultiViewKeypointSquareRootCost::Create(
                                           evaluator_, input.views, options_.keypoint_loss,
                                           options_.keypoint_sigma_px));
       }
@@ -399,7 +434,11 @@ class FitRun {
     }
     std::vector<SilhouetteView> sil_views;
     std::vector<MaskOutline> outlines;
+    Points3d keypoint_stage_vertices;
     if (use_sil) {
+      keypoint_stage_vertices.resize(evaluator_.num_vertices(), 3);
+      evaluator_.AllVertices(b.orient, b.pose.data(), b.betas, b.transl,
+                             keypoint_stage_vertices.data());
       for (size_t v = 0; v < input.masks.size(); ++v) {
         if (input.masks[v].size() == 0) continue;
         SilhouetteView view;
@@ -412,8 +451,12 @@ class FitRun {
                                std::to_string(input.masks[v].rows()));
         }
         const MaskImage* occluder = Occluder(input, v);
-        view.distance_to_mask = DistanceToMask(
-            occluder ? HandOrOccluder(input.masks[v], *occluder) : input.masks[v]);
+        const PixelWindow window =
+            HandWindow(input.masks[v], view.camera, keypoint_stage_vertices,
+                       options_.silhouette_window_margin_px);
+        if (window.empty()) continue;  // no mask pixels, hand out of view
+        view.distance_to_mask = DistanceToMaskInWindow(input.masks[v], window, occluder);
+        view.distance_origin = Eigen::Vector2i(window.x0, window.y0);
         if (!std::isfinite(view.distance_to_mask(0, 0))) continue;  // empty mask
         view.one_sided = occluder == nullptr && input.unknown_occluders;
         view.cap_px = options_.unknown_occluder_cap_px;
@@ -450,7 +493,7 @@ class FitRun {
       }
       StageProblem problem(&b);
       full_problem(&problem);
-      problem.AddFull("silhouette", MultiViewSilhouetteCostFunction<P, kBetas>::Create(
+      problem.AddFull("silhouette", MultiViewSilhouetteSquareRootCost::Create(
                                         evaluator_, vertex_ids, sil_views,
                                         options_.silhouette_sigma_px));
       run(&problem, options_.silhouette_iterations);
@@ -489,13 +532,9 @@ class FitRun {
     out.view_iou.assign(input.views.size(), kNaN);
     for (size_t v = 0; v < input.masks.size(); ++v) {
       if (input.masks[v].size() == 0) continue;
-      const RigCamera& camera = input.views[v].camera;
-      const MaskImage rendered =
-          input.pixel_rays != nullptr
-              ? RenderHandMask(out.vertices, model_.faces, camera, (*input.pixel_rays)[v])
-              : RenderHandMask(out.vertices, model_.faces, camera,
-                               PixelRays(camera.camera));
-      out.view_iou[v] = MaskIoU(rendered, input.masks[v], Occluder(input, v));
+      out.view_iou[v] =
+          ProjectedMeshIoU(out.vertices, model_.faces, input.views[v].camera,
+                           input.masks[v], Occluder(input, v));
     }
     return out;
   }

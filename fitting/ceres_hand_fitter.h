@@ -77,6 +77,11 @@ struct HandFitOptions {
   int silhouette_vertex_stride = 2;
   int silhouette_outline_samples = 120;
   int silhouette_rounds = 3;
+  // Each view's distance transform covers the hand mask and the projected hand (after
+  // the keypoint stages) with this many pixels around them (>= 0); beyond it the
+  // distance is extended from the window's border (fitting/silhouette_cost.h). Vertices
+  // rarely go that far: the window only bounds the cost of the transform.
+  int silhouette_window_margin_px = 24;
   // Outline samples match only vertices whose normal makes |cos| below this with the
   // viewing ray (contour generators).
   double silhouette_contour_cosine = 0.6;
@@ -127,9 +132,6 @@ struct HandFitInput {
   bool unknown_occluders = false;
   std::optional<Points3dTargets> targets3d;
   std::optional<HandParams> previous;
-  // Optional per-view pixel rays of the cameras (core/rasterizer.h), for the IoU of
-  // the result; computed per call when absent (costly: cache them per rig).
-  const std::vector<PixelRays>* pixel_rays = nullptr;
 };
 
 // The result of the keypoint stage (before any silhouette round): what the same fit

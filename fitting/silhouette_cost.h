@@ -24,10 +24,18 @@
 // finger far outside the mask (perhaps behind an object) is barely pulled (the slope
 // falls as (cap / (cap + x))^2). Without the cap the outward-only outline inflates the
 // hand.
-// Two implementations: MultiViewSilhouetteCost (templated functor, autodiff) and
-// MultiViewSilhouetteCostFunction (the vertices once in ceres::Jet, then every view's
-// projection in doubles with its 2x3 Jacobian chained in: several times faster for 8
-// views); tests check one against the other.
+// Distances come from a window of the image around the hand (SilhouetteView::
+// distance_to_mask, origin distance_origin); beyond the window the distance grows with
+// the distance to it (the window's border value plus the distance to the border: an
+// upper bound, continuous, pointing back). Beyond the image it stays the border's, as
+// with a whole-image transform: the hand may continue outside the picture.
+// Two implementations: MultiViewSilhouetteCost (templated functor, autodiff, one
+// residual per vertex and outline sample: the reference) and
+// MultiViewSilhouetteSquareRootCost (what the fitter uses: projections in doubles,
+// analytic vertex Jacobians (HandEvaluator::VerticesAndJacobian) of only the vertices
+// with a non-zero row, the term in square-root form, fitting/
+// point_term_normal_equations.h); tests check that both give the same cost, gradient
+// and Gauss-Newton matrix.
 // Together the two vanish only when the projected outline coincides with the mask's,
 // so they neither shrink nor inflate the hand: at the true pose both are zero up to
 // the pixel grid and the vertex spacing, and any scale change violates one of them.
@@ -37,23 +45,28 @@
 #include <ceres/jet.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
 
 #include "core/camera_models.h"
 #include "core/distance_transform.h"
-#include "core/dual.h"
 #include "core/errors.h"
 #include "core/hand_evaluator.h"
 #include "core/rig.h"
 #include "core/scalar_ops.h"
+#include "fitting/point_term_normal_equations.h"
 
 namespace handlabel {
 
 struct SilhouetteView {
   RigCamera camera;
-  DistanceImage distance_to_mask;               // height x width, pixels
+  // Distance to the mask (pixels) over a window of the image whose entry (0, 0) is
+  // pixel distance_origin (x, y); the whole image when the origin is (0, 0) and the
+  // size the camera's.
+  DistanceImage distance_to_mask;
+  Eigen::Vector2i distance_origin = Eigen::Vector2i::Zero();
   std::vector<Eigen::Vector2d> outline_px;      // mask outline samples (pixel edge)
   std::vector<Eigen::Vector2d> outline_normal;  // unit, pointing out of the mask
   std::vector<int> outline_vertex;  // per outline sample: index into vertex_ids
@@ -90,6 +103,71 @@ T BilinearLookup(const DistanceImage& image, const T& u, const T& v) {
                f11 = at(u0 + 1, v0 + 1);
   return (T(1.0) - fv) * ((T(1.0) - fu) * f00 + fu * f10) +
          fv * ((T(1.0) - fu) * f01 + fu * f11);
+}
+
+// A pixel coordinate clamped to the image (0 .. size - 1): beyond the image the hand is
+// not observed, so the distance stays the border's (no pull back into the image).
+template <typename T>
+T ClampToImage(const T& u, int size) {
+  if (u < T(0.0)) return T(0.0);
+  if (u > T(size - 1.0)) return T(size - 1.0);
+  return u;
+}
+
+// The distance of pixel position (u, v) (image coordinates) to the mask: bilinear in the
+// window, plus the distance to the window beyond it (header comment).
+template <typename T>
+T DistanceLookup(const SilhouetteView& view, const T& u, const T& v) {
+  using std::sqrt;
+  const double max_x = static_cast<double>(view.distance_to_mask.cols() - 1);
+  const double max_y = static_cast<double>(view.distance_to_mask.rows() - 1);
+  const T x = ClampToImage(u, view.camera.camera.width()) -
+              static_cast<double>(view.distance_origin.x());
+  const T y = ClampToImage(v, view.camera.camera.height()) -
+              static_cast<double>(view.distance_origin.y());
+  const T xc = x < T(0.0) ? T(0.0) : (x > T(max_x) ? T(max_x) : x);
+  const T yc = y < T(0.0) ? T(0.0) : (y > T(max_y) ? T(max_y) : y);
+  const T inside = BilinearLookup(view.distance_to_mask, xc, yc);
+  const T dx = x - xc, dy = y - yc;
+  if (dx == T(0.0) && dy == T(0.0)) return inside;
+  return inside + sqrt(dx * dx + dy * dy);
+}
+
+// DistanceLookup's value and gradient in doubles (the same cell and extension).
+inline double DistanceWithGradient(const SilhouetteView& view, const Eigen::Vector2d& uv,
+                                   Eigen::Vector2d* gradient) {
+  const DistanceImage& image = view.distance_to_mask;
+  const int w = static_cast<int>(image.cols()), h = static_cast<int>(image.rows());
+  if (!(std::abs(uv.x()) < 1e6 && std::abs(uv.y()) < 1e6)) {  // far off or NaN: flat
+    gradient->setZero();
+    return image(0, 0);
+  }
+  const double u = ClampToImage(uv.x(), view.camera.camera.width());
+  const double v = ClampToImage(uv.y(), view.camera.camera.height());
+  const double x = u - view.distance_origin.x();
+  const double y = v - view.distance_origin.y();
+  const double xc = std::clamp(x, 0.0, w - 1.0), yc = std::clamp(y, 0.0, h - 1.0);
+  const int x0 = std::min(static_cast<int>(xc), std::max(w - 2, 0));
+  const int y0 = std::min(static_cast<int>(yc), std::max(h - 2, 0));
+  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+  const double fx = xc - x0, fy = yc - y0;
+  const double f00 = image(y0, x0), f10 = image(y0, x1), f01 = image(y1, x0),
+               f11 = image(y1, x1);
+  double value =
+      (1 - fy) * ((1 - fx) * f00 + fx * f10) + fy * ((1 - fx) * f01 + fx * f11);
+  // Inside the window; on a clamped axis the window's value does not change.
+  *gradient = Eigen::Vector2d(x == xc ? (1 - fy) * (f10 - f00) + fy * (f11 - f01) : 0.0,
+                              y == yc ? (1 - fx) * (f01 - f00) + fx * (f11 - f10) : 0.0);
+  const Eigen::Vector2d outside(x - xc, y - yc);
+  const double beyond = outside.norm();
+  if (beyond > 0.0) {
+    value += beyond;
+    *gradient += outside / beyond;
+  }
+  // No derivative along an axis clamped to the image.
+  if (u != uv.x()) (*gradient)[0] = 0.0;
+  if (v != uv.y()) (*gradient)[1] = 0.0;
+  return value;
 }
 
 template <int kPoseDim = kNumPoseParams, int kNumBetas = 10>
@@ -147,7 +225,7 @@ class MultiViewSilhouetteCost {
         valid[i] = ProjectToImage(cam.model(), intrinsics, p, &uv[2 * i]);
         T r = T(0.0);
         if (valid[i]) {
-          const T d = BilinearLookup(view.distance_to_mask, uv[2 * i], uv[2 * i + 1]);
+          const T d = DistanceLookup(view, uv[2 * i], uv[2 * i + 1]);
           if (d > T(0.5)) {
             const T x = d - 0.5;
             r = (view.one_sided ? view.cap_px * x / (view.cap_px + x) : x) * inv_sigma_;
@@ -188,133 +266,118 @@ class MultiViewSilhouetteCost {
   double inv_sigma_;
 };
 
-// Same residuals; the vertex subset is evaluated once with Jets over all parameters,
-// projections are chained in doubles. Parameter blocks (3, kPoseDim, kNumBetas, 3).
-template <int kPoseDim = kNumPoseParams, int kNumBetas = 10>
-class MultiViewSilhouetteCostFunction : public ceres::CostFunction {
+// The same term in square-root form (fitting/point_term_normal_equations.h): num_params
+// + 1 residuals with the same cost, gradient and Gauss-Newton matrix as
+// MultiViewSilhouetteCost. Projections and distance gradients in doubles; vertex
+// Jacobians (analytic) only for the vertices with a non-zero row (outside the mask or
+// matched by an outline sample). Parameter blocks (3, pose_dim, num_betas, 3).
+class MultiViewSilhouetteSquareRootCost : public ceres::CostFunction {
  public:
-  static constexpr int kNumParams = 3 + kPoseDim + kNumBetas + 3;
-  using Jet = ceres::Jet<double, kNumParams>;
-
   // `evaluator` and `views` must outlive the cost function.
-  MultiViewSilhouetteCostFunction(const HandEvaluator& evaluator,
-                                  const std::vector<int>& vertex_ids,
-                                  const std::vector<SilhouetteView>& views,
-                                  double sigma_px)
-      : functor_(evaluator, vertex_ids, views, sigma_px),
-        evaluator_(evaluator),
+  MultiViewSilhouetteSquareRootCost(const HandEvaluator& evaluator,
+                                    const std::vector<int>& vertex_ids,
+                                    const std::vector<SilhouetteView>& views,
+                                    double sigma_px)
+      : evaluator_(evaluator),
         vertex_ids_(vertex_ids),
         views_(views),
-        inv_sigma_(1.0 / sigma_px) {
-    set_num_residuals(functor_.num_residuals());
-    mutable_parameter_block_sizes()->assign({3, kPoseDim, kNumBetas, 3});
+        inv_sigma_(1.0 / sigma_px),
+        block_sizes_({3, evaluator.pose_dim(), evaluator.num_betas(), 3}) {
+    for (const SilhouetteView& view : views_) {
+      HL_CHECK(view.outline_px.size() == view.outline_normal.size() &&
+                   view.outline_px.size() == view.outline_vertex.size(),
+               "outline arrays differ in size");
+    }
+    set_num_residuals(evaluator.num_params() + 1);
+    mutable_parameter_block_sizes()->assign(block_sizes_.begin(), block_sizes_.end());
   }
   static ceres::CostFunction* Create(const HandEvaluator& evaluator,
                                      const std::vector<int>& vertex_ids,
                                      const std::vector<SilhouetteView>& views,
                                      double sigma_px) {
     CheckOutlineVertices(views, vertex_ids.size());
-    return new MultiViewSilhouetteCostFunction(evaluator, vertex_ids, views, sigma_px);
+    return new MultiViewSilhouetteSquareRootCost(evaluator, vertex_ids, views, sigma_px);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    if (jacobians == nullptr) {
-      return functor_(parameters[0], parameters[1], parameters[2], parameters[3],
-                      residuals);
-    }
-    const int sizes[4] = {3, kPoseDim, kNumBetas, 3};
-    const int offsets[4] = {0, 3, 3 + kPoseDim, 3 + kPoseDim + kNumBetas};
-    std::vector<Jet> blocks[4];
-    for (int b = 0; b < 4; ++b) {
-      blocks[b].resize(sizes[b]);
-      for (int i = 0; i < sizes[b]; ++i)
-        blocks[b][i] = Jet(parameters[b][i], offsets[b] + i);
-    }
-    auto state = std::make_unique<HandPoseState<Jet>>();
-    evaluator_.Pose(blocks[0].data(), blocks[1].data(), blocks[2].data(),
-                    blocks[3].data(), state.get());
-    std::vector<Jet> vertices(3 * vertex_ids_.size());
-    evaluator_.VerticesFromState(*state, vertex_ids_, vertices.data());
-
-    const int n = num_residuals();
-    Eigen::Matrix<double, Eigen::Dynamic, kNumParams, Eigen::RowMajor> jac(n, kNumParams);
-    jac.setZero();
-    std::vector<Eigen::Vector2d> uv(vertex_ids_.size());
-    std::vector<Eigen::Matrix<double, 2, kNumParams>> uv_jac(vertex_ids_.size());
-    std::vector<char> valid(vertex_ids_.size());
-    int row = 0;
+    const int n = evaluator_.num_params();
+    const bool want_jac = jacobians != nullptr;
+    const size_t nv = vertex_ids_.size();
+    thread_local std::vector<double> vertices;
+    vertices.resize(3 * nv);
+    evaluator_.Vertices(parameters[0], parameters[1], parameters[2], parameters[3],
+                        vertex_ids_, vertices.data());
+    PointTermNormalEquations normal(static_cast<int>(nv));
+    thread_local std::vector<Eigen::Vector2d> uv;
+    thread_local std::vector<Eigen::Matrix<double, 2, 3>> d_uv;  // by the world point
+    thread_local std::vector<char> valid;
+    uv.resize(nv);
+    d_uv.resize(nv);
+    valid.resize(nv);
     for (const SilhouetteView& view : views_) {
       const Eigen::Matrix3d rot = view.camera.cam_from_world.rotation.toRotationMatrix();
       const Eigen::Vector3d& t = view.camera.cam_from_world.translation;
-      for (size_t i = 0; i < vertex_ids_.size(); ++i) {
-        const Jet* x = vertices.data() + 3 * i;
-        const Eigen::Vector3d p = rot * Eigen::Vector3d(x[0].a, x[1].a, x[2].a) + t;
+      for (size_t i = 0; i < nv; ++i) {
+        const Eigen::Vector3d p =
+            rot * Eigen::Map<const Eigen::Vector3d>(&vertices[3 * i]) + t;
         Eigen::Matrix<double, 2, 3> d_point;
-        valid[i] = view.camera.camera.ProjectWithJacobian(p, &uv[i], &d_point);
-        double r = 0.0;
-        if (valid[i]) {
-          Eigen::Matrix<double, 3, kNumParams> dx;
-          dx.row(0) = x[0].v.transpose();
-          dx.row(1) = x[1].v.transpose();
-          dx.row(2) = x[2].v.transpose();
-          uv_jac[i].noalias() = d_point * rot * dx;
-          double f, dfdu, dfdv;
-          BilinearWithGradient(view.distance_to_mask, uv[i], &f, &dfdu, &dfdv);
-          if (f > 0.5) {
-            const double x = f - 0.5, cap = view.cap_px;
-            // d r / d x: 1, or (cap / (cap + x))^2 when saturated.
-            const double slope = view.one_sided ? std::pow(cap / (cap + x), 2) : 1.0;
-            r = (view.one_sided ? cap * x / (cap + x) : x) * inv_sigma_;
-            jac.row(row) =
-                inv_sigma_ * slope * (dfdu * uv_jac[i].row(0) + dfdv * uv_jac[i].row(1));
-          }
-        }
-        residuals[row++] = r;
+        valid[i] = view.camera.camera.ProjectWithJacobian(p, &uv[i],
+                                                          want_jac ? &d_point : nullptr);
+        if (valid[i] && want_jac) d_uv[i].noalias() = d_point * rot;
+      }
+      for (size_t i = 0; i < nv; ++i) {
+        if (!valid[i]) continue;
+        Eigen::Vector2d gradient;
+        const double d = DistanceWithGradient(view, uv[i], &gradient);
+        if (!(d > 0.5)) continue;
+        const double x = d - 0.5, cap = view.cap_px;
+        // d r / d x: 1, or (cap / (cap + x))^2 when saturated.
+        const double slope = view.one_sided ? std::pow(cap / (cap + x), 2) : 1.0;
+        const double r = (view.one_sided ? cap * x / (cap + x) : x) * inv_sigma_;
+        normal.AddRow(static_cast<int>(i), r,
+                      want_jac ? Eigen::Vector3d(inv_sigma_ * slope *
+                                                 d_uv[i].transpose() * gradient)
+                               : Eigen::Vector3d::Zero());
       }
       for (size_t s = 0; s < view.outline_px.size(); ++s) {
         const int c = view.outline_vertex[s];
-        double r = 0.0;
-        if (c >= 0 && valid[c]) {
-          const Eigen::Vector2d& nrm = view.outline_normal[s];
-          r = nrm.dot(uv[c] - view.outline_px[s]) * inv_sigma_;
-          if (view.one_sided && r > 0.0) {
-            r = 0.0;
-          } else {
-            jac.row(row) =
-                inv_sigma_ * (nrm[0] * uv_jac[c].row(0) + nrm[1] * uv_jac[c].row(1));
-          }
-        }
-        residuals[row++] = r;
+        if (c < 0 || !valid[c]) continue;
+        const Eigen::Vector2d& nrm = view.outline_normal[s];
+        const double r = nrm.dot(uv[c] - view.outline_px[s]) * inv_sigma_;
+        if (view.one_sided && r > 0.0) continue;
+        normal.AddRow(c, r,
+                      want_jac ? Eigen::Vector3d(inv_sigma_ * d_uv[c].transpose() * nrm)
+                               : Eigen::Vector3d::Zero());
       }
     }
-    for (int b = 0; b < 4; ++b) {
-      if (jacobians[b] == nullptr) continue;
-      for (int r = 0; r < n; ++r) {
-        for (int c = 0; c < sizes[b]; ++c) {
-          jacobians[b][r * sizes[b] + c] = jac(r, offsets[b] + c);
-        }
-      }
+    if (!want_jac) {
+      WriteCostOnly(normal.squared_norm(), n + 1, residuals);
+      return true;
     }
+    const std::vector<int> used = normal.UsedPoints();
+    std::vector<int> used_ids(used.size());
+    for (size_t i = 0; i < used.size(); ++i) used_ids[i] = vertex_ids_[used[i]];
+    thread_local std::vector<double> used_xyz, used_jac;
+    used_xyz.resize(3 * used.size());
+    used_jac.resize(3 * used.size() * n);
+    evaluator_.VerticesAndJacobian(parameters[0], parameters[1], parameters[2],
+                                   parameters[3], used_ids, used_xyz.data(),
+                                   used_jac.data());
+    Eigen::MatrixXd jtj;
+    Eigen::VectorXd jtr;
+    normal.Accumulate(used_jac.data(), n, &jtj, &jtr);
+    WriteSquareRootForm(jtj, jtr, normal.squared_norm(), block_sizes_, residuals,
+                        jacobians);
     return true;
   }
 
  private:
-  // BilinearLookup's value and gradient in doubles (same cell and clamping).
-  static void BilinearWithGradient(const DistanceImage& image, const Eigen::Vector2d& uv,
-                                   double* f, double* dfdu, double* dfdv) {
-    using D = Dual<2>;
-    const D value = BilinearLookup(image, D(uv.x(), 0), D(uv.y(), 1));
-    *f = value.a;
-    *dfdu = value.v[0];
-    *dfdv = value.v[1];
-  }
-
-  MultiViewSilhouetteCost<kPoseDim, kNumBetas> functor_;
   const HandEvaluator& evaluator_;
   std::vector<int> vertex_ids_;
   const std::vector<SilhouetteView>& views_;
   double inv_sigma_;
+  std::vector<int> block_sizes_;
 };
 
 }  // namespace handlabel

@@ -20,14 +20,6 @@ bool NearOccluder(const MaskImage& occluder, int x, int y, int reach) {
 
 }  // namespace
 
-MaskImage HandOrOccluder(const MaskImage& hand, const MaskImage& occluder) {
-  MaskImage joined = hand;
-  for (Eigen::Index i = 0; i < joined.size(); ++i) {
-    if (occluder.data()[i] != 0) joined.data()[i] = 255;
-  }
-  return joined;
-}
-
 MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples,
                               const MaskImage* occluder, int occluder_reach_px) {
   const int h = static_cast<int>(mask.rows()), w = static_cast<int>(mask.cols());

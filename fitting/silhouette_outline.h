@@ -25,9 +25,6 @@ MaskOutline SampleMaskOutline(const MaskImage& mask, int max_samples,
                               const MaskImage* occluder = nullptr,
                               int occluder_reach_px = 2);
 
-// The hand mask joined with the occluder mask: what the hand may project onto.
-MaskImage HandOrOccluder(const MaskImage& hand, const MaskImage& occluder);
-
 // For every outline point, the index (into `projected`) of the nearest projected point;
 // entries with valid[i] == 0 are skipped. -1 if none is valid.
 std::vector<int> MatchOutlineToPoints(const MaskOutline& outline,

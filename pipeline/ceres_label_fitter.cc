@@ -183,32 +183,9 @@ std::optional<QualityReport> CeresLabelFitter::CheckSilhouettes(
   return report;
 }
 
-std::shared_ptr<const std::vector<PixelRays>> CeresLabelFitter::Rays(
-    const std::vector<KeypointView>& views) const {
-  std::vector<double> key;
-  for (const KeypointView& view : views) {
-    const Camera& camera = view.camera.camera;
-    key.insert(key.end(), {static_cast<double>(static_cast<int>(camera.model())),
-                           static_cast<double>(camera.width()),
-                           static_cast<double>(camera.height())});
-    key.insert(key.end(), camera.params().begin(), camera.params().end());
-  }
-  std::lock_guard<std::mutex> lock(rays_mutex_);
-  if (const auto it = rays_.find(key); it != rays_.end()) return it->second;
-  auto rays = std::make_shared<std::vector<PixelRays>>();
-  for (const KeypointView& view : views) rays->emplace_back(view.camera.camera);
-  if (rays_.size() < kMaxRigs) rays_.emplace(key, rays);
-  return rays;
-}
-
 LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
   std::string silhouettes, start;
   HandFitInput input = Evidence(request, &silhouettes);
-  std::shared_ptr<const std::vector<PixelRays>> rays;
-  if (!input.masks.empty()) {
-    rays = Rays(input.views);
-    input.pixel_rays = rays.get();
-  }
   const CeresHandFitter& fitter =
       !request.masks.empty() && network_mask_fitter_ ? *network_mask_fitter_ : fitter_;
   const HandParams init = Start(request, fitter, &input, &start);

@@ -18,9 +18,6 @@
 // when the check fails, the keypoints-only fit is the label. The report says which
 // (`used`: silhouettes | keypoints_only, `used_why`, `silhouette_check`).
 
-#include <map>
-#include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -74,20 +71,10 @@ class CeresLabelFitter : public LabelFitter {
   // check_silhouettes is set, `fit` becomes its keypoints-only result.
   std::optional<QualityReport> CheckSilhouettes(HandFitResult* fit) const;
 
-  // Pixel rays of the views' cameras, for the IoU of fits with silhouettes; computed
-  // once per set of cameras (a capture's rig) for up to kMaxRigs sets, then per fit.
-  std::shared_ptr<const std::vector<PixelRays>> Rays(
-      const std::vector<KeypointView>& views) const;
-  static constexpr size_t kMaxRigs = 4;
-
   CeresHandFitter fitter_;
   std::optional<CeresHandFitter> network_mask_fitter_;
   int num_vertices_;
   CeresLabelFitterOptions options_;
-  mutable std::mutex rays_mutex_;
-  // Cameras' model, size and parameters -> their rays.
-  mutable std::map<std::vector<double>, std::shared_ptr<const std::vector<PixelRays>>>
-      rays_;
 };
 
 }  // namespace handlabel

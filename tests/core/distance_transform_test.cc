@@ -49,5 +49,38 @@ TEST(DistanceTransformTest, SinglePixelAndEmpty) {
   EXPECT_DOUBLE_EQ(d(4, 6), 5.0);  // (3, 4) away
 }
 
+TEST(DistanceTransformTest, WindowMatchesTheWholeImageWhereTheNearestPixelIsInside) {
+  for (int trial = 0; trial < 5; ++trial) {
+    MaskImage mask(19, 25), also = MaskImage::Zero(19, 25);
+    const double density = testing::Uniform(0.02, 0.3);
+    for (int i = 0; i < mask.size(); ++i) {
+      mask.data()[i] = testing::Uniform(0, 1) < density;
+      also.data()[i] = testing::Uniform(0, 1) < 0.05 ? 255 : 0;
+    }
+    MaskImage joined = mask;
+    for (int i = 0; i < mask.size(); ++i) joined.data()[i] |= also.data()[i] != 0;
+    const DistanceImage full = DistanceToMask(joined);
+    const PixelWindow window{4, 3, 15, 11};
+    const DistanceImage part = DistanceToMaskInWindow(mask, window, &also);
+    ASSERT_EQ(part.rows(), 11);
+    ASSERT_EQ(part.cols(), 15);
+    int compared = 0;
+    for (int r = 0; r < part.rows(); ++r) {
+      for (int c = 0; c < part.cols(); ++c) {
+        const int to_edge =
+            std::min({r + 1, c + 1, int(part.rows()) - r, int(part.cols()) - c});
+        // Never below the whole image's; equal where the window cannot miss a nearer
+        // pixel.
+        EXPECT_GE(part(r, c), full(r + 3, c + 4) - 1e-12);
+        if (part(r, c) <= to_edge) {
+          EXPECT_NEAR(part(r, c), full(r + 3, c + 4), 1e-12);
+          ++compared;
+        }
+      }
+    }
+    EXPECT_GT(compared, 50);
+  }
+}
+
 }  // namespace
 }  // namespace handlabel

@@ -250,6 +250,25 @@ TEST(HandEvaluator, AnalyticKeypointJacobianMatchesDuals) {
       }
       EXPECT_THAT(keypoints, MatrixNear(expected_kp, 1e-12)) << "pca " << pca;
       EXPECT_THAT(jac, MatrixNear(expected_jac, 1e-10)) << "pca " << pca;
+
+      // Vertices (any ids, repeats allowed) the same way.
+      const std::vector<int> ids = {0, ev.num_vertices() - 1, ev.num_vertices() / 2, 0};
+      const int nr = 3 * static_cast<int>(ids.size());
+      std::vector<D> expected_v(nr);
+      ev.Vertices(xd.data(), xd.data() + 3, xd.data() + 3 + pd, xd.data() + 3 + pd + 10,
+                  ids, expected_v.data());
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> vjac(nr, np);
+      Eigen::VectorXd vertices(nr), expected_vertices(nr);
+      ev.VerticesAndJacobian(x.data(), x.data() + 3, x.data() + 3 + pd,
+                             x.data() + 3 + pd + 10, ids, vertices.data(), vjac.data());
+      Eigen::MatrixXd expected_vjac(nr, np);
+      for (int i = 0; i < nr; ++i) {
+        expected_vertices[i] = expected_v[i].a;
+        expected_vjac.row(i) = expected_v[i].v.head(np).transpose();
+      }
+      EXPECT_THAT(vertices, MatrixNear(expected_vertices, 1e-12)) << "pca " << pca;
+      EXPECT_THAT(Eigen::MatrixXd(vjac), MatrixNear(expected_vjac, 1e-10))
+          << "pca " << pca;
     }
   }
 }

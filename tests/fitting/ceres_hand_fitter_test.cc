@@ -139,7 +139,6 @@ struct SilhouetteScene {
     HandFitInput input;
     input.views = frame.views;
     input.masks = RenderMasks(model, frame, rays);
-    input.pixel_rays = &rays;
     return {frame, input};
   }
 };

@@ -66,6 +66,59 @@ void ExpectSameResidualsAndJacobians(const ceres::CostFunction& a,
   }
 }
 
+// Evaluates `cost` with Jacobians: residuals and the full Jacobian (all blocks side by
+// side).
+void EvaluateFull(const ceres::CostFunction& cost,
+                  const std::vector<const double*>& blocks, Eigen::VectorXd* residuals,
+                  Eigen::MatrixXd* jacobian) {
+  const int n = cost.num_residuals();
+  const std::vector<int32_t>& sizes = cost.parameter_block_sizes();
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+      parts(sizes.size());
+  std::vector<double*> pointers(sizes.size());
+  int total = 0;
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    parts[k].resize(n, sizes[k]);
+    pointers[k] = parts[k].data();
+    total += sizes[k];
+  }
+  residuals->resize(n);
+  ASSERT_TRUE(cost.Evaluate(blocks.data(), residuals->data(), pointers.data()));
+  jacobian->resize(n, total);
+  int offset = 0;
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    jacobian->middleCols(offset, sizes[k]) = parts[k];
+    offset += sizes[k];
+  }
+}
+
+// A term in square-root form (fitting/point_term_normal_equations.h) against the same
+// term with one row per residual: equal cost (with and without Jacobians), gradient
+// J^T r and Gauss-Newton matrix J^T J, each within `tolerance` of its largest entry.
+void ExpectSameGaussNewton(const ceres::CostFunction& rows,
+                           const ceres::CostFunction& square_root,
+                           const std::vector<const double*>& blocks,
+                           double tolerance = 1e-8) {
+  ASSERT_EQ(rows.parameter_block_sizes(), square_root.parameter_block_sizes());
+  Eigen::VectorXd r, r2;
+  Eigen::MatrixXd j, j2;
+  EvaluateFull(rows, blocks, &r, &j);
+  EvaluateFull(square_root, blocks, &r2, &j2);
+  ASSERT_EQ(r2.size(), j.cols() + 1);
+  EXPECT_GT(r.squaredNorm(), 0.0);
+  EXPECT_NEAR(r2.squaredNorm(), r.squaredNorm(), tolerance * r.squaredNorm());
+  Eigen::VectorXd cost_only(r2.size());
+  ASSERT_TRUE(square_root.Evaluate(blocks.data(), cost_only.data(), nullptr));
+  EXPECT_NEAR(cost_only.squaredNorm(), r.squaredNorm(), tolerance * r.squaredNorm());
+  const Eigen::VectorXd gradient = j.transpose() * r;
+  const Eigen::MatrixXd gauss_newton = j.transpose() * j;
+  EXPECT_THAT(Eigen::VectorXd(j2.transpose() * r2),
+              testing::MatrixNear(gradient, tolerance * gradient.cwiseAbs().maxCoeff()));
+  EXPECT_THAT(
+      Eigen::MatrixXd(j2.transpose() * j2),
+      testing::MatrixNear(gauss_newton, tolerance * gauss_newton.cwiseAbs().maxCoeff()));
+}
+
 // Central differences (step 1e-6) against the cost function's Jacobians, block by
 // block; tolerance `precision` relative to the largest entry of the column (plus the
 // same absolute amount).
@@ -160,6 +213,10 @@ TEST_F(CostGradientsTest, KeypointReprojectionAnalyticMatchesAutodiff) {
     Eigen::VectorXd rc(n);
     ASSERT_TRUE(analytic->Evaluate(params_.Blocks().data(), rc.data(), nullptr));
     EXPECT_THAT(rc, testing::MatrixNear(ra, 1e-9));
+    // The square-root form the fitter uses: the same Gauss-Newton data.
+    std::unique_ptr<ceres::CostFunction> square_root(
+        MultiViewKeypointSquareRootCost::Create(evaluator_, views, loss, 1.0));
+    ExpectSameGaussNewton(*autodiff, *square_root, params_.Blocks());
   }
 }
 
@@ -233,10 +290,10 @@ TEST_F(CostGradientsTest, Silhouette) {
   std::unique_ptr<ceres::CostFunction> cost(
       MultiViewSilhouetteCost<>::Create(evaluator_, ids, views, 2.0));
   ExpectGradientsMatch(*cost, params_.Blocks(), 1e-5);
-  // The analytic-projection version agrees with autodiff.
+  // The square-root form (analytic Jacobians) has autodiff's Gauss-Newton data.
   std::unique_ptr<ceres::CostFunction> fast(
-      MultiViewSilhouetteCostFunction<>::Create(evaluator_, ids, views, 2.0));
-  ExpectSameResidualsAndJacobians(*cost, *fast, params_.Blocks());
+      MultiViewSilhouetteSquareRootCost::Create(evaluator_, ids, views, 2.0));
+  ExpectSameGaussNewton(*cost, *fast, params_.Blocks());
 
   // One-sided views (unknown occluders): mesh -> mask residuals saturate, outline
   // residuals only where the hand falls short of the outline; both versions agree and
@@ -248,8 +305,8 @@ TEST_F(CostGradientsTest, Silhouette) {
   std::unique_ptr<ceres::CostFunction> one_sided(
       MultiViewSilhouetteCost<>::Create(evaluator_, ids, views, 2.0));
   std::unique_ptr<ceres::CostFunction> one_sided_fast(
-      MultiViewSilhouetteCostFunction<>::Create(evaluator_, ids, views, 2.0));
-  ExpectSameResidualsAndJacobians(*one_sided, *one_sided_fast, params_.Blocks());
+      MultiViewSilhouetteSquareRootCost::Create(evaluator_, ids, views, 2.0));
+  ExpectSameGaussNewton(*one_sided, *one_sided_fast, params_.Blocks());
   ExpectGradientsMatch(*one_sided, params_.Blocks(), 1e-5);
   one_sided->Evaluate(params_.Blocks().data(), one.data(), nullptr);
   const size_t per_view = ids.size() + 5;
@@ -263,6 +320,61 @@ TEST_F(CostGradientsTest, Silhouette) {
     kept += outline && two[r] < 0;
   }
   EXPECT_GT(kept, 0);  // the scene has outline samples the hand falls short of
+}
+
+TEST_F(CostGradientsTest, SilhouetteDistanceWindow) {
+  // The distance image of a window around the hand, smaller than the projected hand:
+  // vertices beyond it take the border value plus the distance to the border. The
+  // same checks as above (finite differences, square-root form), and the lookup
+  // equals the full image's inside the window.
+  const auto linear = [](double x, double y) {
+    return 0.02 * std::abs(x - 300.0) + 0.01 * std::abs(y - 200.0);
+  };
+  std::vector<SilhouetteView> views(2);
+  for (int v = 0; v < 2; ++v) {
+    views[v].camera = frame_.views[v].camera;
+    Eigen::Vector2d centre;
+    ASSERT_TRUE(
+        views[v].camera.ProjectWorld(frame_.mesh.vertices.row(0).transpose(), &centre));
+    views[v].distance_origin = (centre - Eigen::Vector2d(20, 15)).cast<int>();
+    views[v].distance_to_mask.resize(30, 40);
+    for (int y = 0; y < 30; ++y) {
+      for (int x = 0; x < 40; ++x) {
+        views[v].distance_to_mask(y, x) =
+            linear(x + views[v].distance_origin.x(), y + views[v].distance_origin.y());
+      }
+    }
+  }
+  const std::vector<int> ids = {0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20};
+  std::unique_ptr<ceres::CostFunction> cost(
+      MultiViewSilhouetteCost<>::Create(evaluator_, ids, views, 2.0));
+  ExpectGradientsMatch(*cost, params_.Blocks(), 1e-5);
+  std::unique_ptr<ceres::CostFunction> fast(
+      MultiViewSilhouetteSquareRootCost::Create(evaluator_, ids, views, 2.0));
+  ExpectSameGaussNewton(*cost, *fast, params_.Blocks());
+
+  const SilhouetteView& view = views[0];
+  const Eigen::Vector2d o = view.distance_origin.cast<double>();
+  Eigen::Vector2d gradient;
+  const Eigen::Vector2d inside = o + Eigen::Vector2d(10.3, 7.6);
+  EXPECT_NEAR(DistanceWithGradient(view, inside, &gradient),
+              linear(inside.x(), inside.y()), 1e-12);
+  EXPECT_NEAR(DistanceLookup(view, inside.x(), inside.y()),
+              linear(inside.x(), inside.y()), 1e-12);
+  // 5 px left of and 12 px below the window's lower-left corner: 13 px beyond it.
+  const Eigen::Vector2d beyond = o + Eigen::Vector2d(-5, 29 + 12);
+  const double corner = linear(o.x(), o.y() + 29);
+  EXPECT_NEAR(DistanceWithGradient(view, beyond, &gradient), corner + 13.0, 1e-12);
+  EXPECT_THAT(gradient, testing::MatrixNear(Eigen::Vector2d(-5, 12) / 13.0, 1e-12));
+  EXPECT_NEAR(DistanceLookup(view, beyond.x(), beyond.y()), corner + 13.0, 1e-12);
+  int outside = 0;  // the scene has vertices beyond the window
+  for (int i : ids) {
+    Eigen::Vector2d uv;
+    view.camera.ProjectWorld(frame_.mesh.vertices.row(i).transpose(), &uv);
+    const Eigen::Vector2d x = uv - o;
+    outside += x.x() < 0 || x.y() < 0 || x.x() > 39 || x.y() > 29;
+  }
+  EXPECT_GT(outside, 0);
 }
 
 TEST(AxisAngleManifoldTest, Invariants) {

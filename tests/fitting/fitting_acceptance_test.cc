@@ -99,7 +99,6 @@ Totals RunScenario(int frames, bool noisy, bool silhouettes, uint64_t seed,
     }
     if (!silhouettes) input.masks.clear();
     input.views = frame.views;
-    input.pixel_rays = &rays;
     const auto start = std::chrono::steady_clock::now();
     const HandFitResult r = fitter.Fit(input, fitter.InitFromViews(input.views));
     t.seconds +=
