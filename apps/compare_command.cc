@@ -19,6 +19,7 @@ struct CompareFlags {
   uint64_t seed = 0;
   std::string methods = "all";
   std::string ablation = "all";
+  std::string qa_selection;
   bool quiet = false;
   CompareOptions options;
 };
@@ -71,6 +72,7 @@ CompareOptions Options(const CompareFlags& f, const JobConfig& base) {
       o.methods.push_back(ParseCompareMethod(name, "command line", "--methods"));
   }
   o.ablation_views = AblationViews(f.ablation);
+  if (!f.qa_selection.empty()) o.qa_selection = SplitCommas(f.qa_selection);
   o.Check();
   return o;
 }
@@ -126,6 +128,10 @@ int RunCompare(int argc, char** argv) {
   app.add_option("--qa-error-mm", f.options.qa_error_mm,
                  "quality-check study: a network answer is bad above this MPJPE")
       ->capture_default_str();
+  app.add_option("--qa-selection", f.qa_selection,
+                 "quality-check study: earlier compare folders (DIR,DIR,...) whose "
+                 "network answers choose the thresholds; this run's frames are then "
+                 "all held out (default: choose on even, judge on odd positions)");
   app.add_flag("--quiet", f.quiet, "print only the table and errors");
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("compare", [&] {
@@ -140,7 +146,8 @@ int RunCompare(int argc, char** argv) {
     }
     QualityStudy qa;
     if (network) {
-      qa = StudyQualityChecks(*network, network->job.quality, options.qa_error_mm);
+      qa = StudyQualityChecks(*network, network->job.quality, options.qa_error_mm,
+                              options.qa_selection);
     } else {
       qa.why_not = "the network alone was not among the methods";
     }
@@ -156,7 +163,7 @@ int RunCompare(int argc, char** argv) {
                 << "thresholds, " << qa.after.kept_bad << "/" << qa.after.kept
                 << " with the chosen (reprojection " << qa.chosen.max_reprojection_px
                 << " px, view agreement " << qa.chosen.max_view_disagreement_mm
-                << " mm)\n";
+                << " mm, chosen on " << qa.selection_frames << " answers)\n";
     }
     std::cout << "report: " << files.html << "\njson: " << files.json
               << "\nmarkdown: " << files.markdown << "\ntime: " << seconds << " s\n";

@@ -33,6 +33,11 @@ int RunDetect(int argc, char** argv) {
   app.add_option("--capture", capture_dir, "native capture folder (multi-view)");
   app.add_flag("--overwrite", dc.overwrite,
                "with --capture: replace the detections the capture already has");
+  app.add_option(
+      "--overlays", dc.overlays_dir,
+      "with --capture: also write DIR/<frame>/<camera>.png, each view with its "
+      "palm boxes, ROI, keypoints (disc size = confidence) and the reason "
+      "when there is no hand");
   app.add_flag("--second-pass", dc.multiview.second_pass,
                "with --capture: redo every view from the triangulated keypoints");
   app.add_option("--min-presence-from-3d", dc.multiview.min_presence_from_3d,

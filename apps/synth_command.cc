@@ -23,6 +23,7 @@ int RunSynth(int argc, char** argv) {
       "synth");
   SynthCaptureOptions o;
   std::string out_dir, size, hand_model, side = "right", contact_sheet;
+  std::string appearance = "basic";
   bool objects = false, overwrite = false, no_detections = false, no_clutter = false;
   bool sheet_crop = false;
   app.add_option("--out", out_dir, "output folder (created)")->required();
@@ -55,6 +56,11 @@ int RunSynth(int argc, char** argv) {
   app.add_flag("--no-detections", no_detections, "do not write simulated detections");
   app.add_flag("--depth", o.write_depth, "also write 16-bit depth PNGs (0.1 mm units)");
   app.add_flag("--no-clutter", no_clutter, "plain grey backgrounds");
+  app.add_option("--appearance", appearance,
+                 "basic (the original look, what the shipped network saw) or realistic "
+                 "(skin shading, forearm, table, key + fill light, camera blur and "
+                 "noise: for real 2D detectors; docs/synth.md)")
+      ->capture_default_str();
   app.add_option("--hand-model", hand_model,
                  "model file or 'capsule'; default: $HANDLABEL_HAND_MODEL, then "
                  "<data dir>/models/open_hand_<side>.npz, then the open hand built "
@@ -85,6 +91,7 @@ int RunSynth(int argc, char** argv) {
     o.scene.objects = objects;
     o.write_detections = !no_detections;
     o.view.background.clutter = !no_clutter;
+    o.view.appearance = SynthAppearanceFromName(appearance, "--appearance", "value");
     o.Check();
     const ResolvedHandModel hand =
         ResolveHandModel(hand_model, side == "left" ? HandSide::kLeft : HandSide::kRight);

@@ -1,19 +1,38 @@
-// CPU cost of a POEM forward pass per multi-view frame, through the torch-free
-// HandMeshPredictor (random weights: timings do not depend on the values).
+// CPU cost of a POEM forward pass per multi-view frame (docs/speed.md).
 //
-//   ./build/bench/poem_bench [--benchmark_filter=Small]
-// Arguments: views, frames per batch, intra-op threads. Counters: frames_per_s.
-// Configs: "small" (half-width ResNet18, 128 crops, 1024 points, 3 blocks), the
-// released architecture (ResNet34, 256 crops, 4096 points, 6 blocks), and the shipped
-// models/poem_small_dexycb.pt (its own config, with the mask head if it has one).
+//   ./build/bench/poem_bench [--benchmark_filter=Released]
+//
+// - BM_Gemm: the machine's fp32 GEMM rate in this run, n x n x n through at::matmul
+//   (the system BLAS) and through InferenceLinear (oneDNN, the path the network's
+//   linear layers take at inference). Arguments: n, threads. Counter GFLOP_per_s.
+// - BM_Poem: frames per second through the torch-free HandMeshPredictor (random
+//   weights: timings do not depend on the values). Arguments: views, frames per
+//   batch, intra-op threads. Counter frames_per_s. The same benchmark exists at
+//   a7df249, so old and new builds can be compared name for name.
+// - BM_PoemStages: one forward pass of the model split into its stages (backbone,
+//   decoders, frustum points, point selection and sampling, kNN, every attention
+//   block), each with its counted FLOPs (multiply-adds of the convolutions and linear
+//   layers x 2; 8 per kNN distance) and achieved GFLOP/s; printed as a table on
+//   stderr. Arguments: views, threads.
+// Configs: the released architecture (ResNet34, 256 crops, 4096 points, 6 blocks),
+// "small", and the shipped models/poem_small_dexycb.pt (its own config).
 
+#include <ATen/Parallel.h>
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <map>
 #include <random>
 
 #include "core/rigid3.h"
 #include "network/hand_mesh_predictor.h"
+#include "network/poem_batch.h"
+#include "network/poem_checkpoint.h"
+#include "network/poem_model.h"
+#include "network/poem_modules.h"
 #include "pipeline/build_config.h"
 
 namespace handlabel {
@@ -44,11 +63,45 @@ std::vector<HandMeshInput> SyntheticFrames(int frames, int views, int crop) {
   return out;
 }
 
+std::string Shipped(const std::string& name) {
+  return std::string(HANDLABEL_SOURCE_DIR) + "/" + name;
+}
+
+bool IsFile(const std::string& config) { return config.find(".pt") != std::string::npos; }
+
+// ---- GEMM rate -------------------------------------------------------------------
+
+void BM_Gemm(benchmark::State& state, bool onednn) {
+  const int64_t n = state.range(0);
+  at::set_num_threads(static_cast<int>(state.range(1)));
+  torch::manual_seed(1);
+  const torch::Tensor a = torch::randn({n, n});
+  torch::nn::Linear layer(torch::nn::LinearOptions(n, n).bias(false));
+  torch::NoGradGuard no_grad;
+  const torch::Tensor b = layer->weight.t();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(onednn ? InferenceLinear(*layer, a) : torch::matmul(a, b));
+  }
+  state.counters["GFLOP_per_s"] = benchmark::Counter(
+      2.0 * n * n * n * 1e-9 * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK_CAPTURE(BM_Gemm, matmul, false)
+    ->Args({2048, 1})
+    ->Args({2048, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Gemm, onednn, true)
+    ->Args({2048, 1})
+    ->Args({2048, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// ---- End to end through the predictor ---------------------------------------------
+
 void BM_Poem(benchmark::State& state, const std::string& config) {
   HandMeshPredictorOptions o;
-  const std::string shipped = std::string(HANDLABEL_SOURCE_DIR) + "/" + config;
-  if (config.find(".pt") != std::string::npos) {
-    o.weights = shipped;
+  if (IsFile(config)) {
+    o.weights = Shipped(config);
   } else {
     o.config = config;
   }
@@ -83,6 +136,147 @@ BENCHMARK_CAPTURE(BM_Poem, Released, std::string("released-dexycb"))
     ->Args({8, 1, 1})
     ->Args({8, 1, 2})
     ->Iterations(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// ---- Stage profile -----------------------------------------------------------------
+
+double Conv(int64_t in, int64_t out, int64_t kernel, int64_t side) {
+  return 2.0 * in * out * kernel * kernel * side * side;
+}
+double Linear(int64_t rows, int64_t in, int64_t out) { return 2.0 * rows * in * out; }
+double TwoLayers(int64_t rows, int64_t in, int64_t hidden, int64_t out) {
+  return Linear(rows, in, hidden) + Linear(rows, hidden, out);
+}
+
+// Vector attention: per-point projections, then the MLPs on every (query, neighbour).
+double Attention(int64_t queries, int64_t points, int64_t k, int64_t dp, int64_t d,
+                 bool cross) {
+  const double projections =
+      cross ? Linear(queries, dp, d) + Linear(points, dp, d) + 2 * Linear(points, d, d)
+            : Linear(points, dp, d) + 3 * Linear(points, d, d);
+  return projections + TwoLayers(queries * k, 3, d, d) + TwoLayers(queries * k, d, d, d) +
+         Linear(queries, d, dp);
+}
+
+// Counted FLOPs of every stage named by the model's StageClock laps, for B frames.
+std::map<std::string, double> StageFlops(const PoemConfig& c, int64_t B) {
+  const int64_t N = c.num_views, S = c.crop_size, w = c.backbone_width, E = c.embed_dim;
+  const int64_t d = c.transformer_dim, H = c.heatmap_size(), D = c.depth_bins;
+  const int64_t Q = PoemConfig::kNumQueries, P = c.num_sampled_points;
+  std::map<std::string, double> f;
+  // Backbone per image: stem, then BasicBlocks (3x3, 3x3, 1x1 downsample).
+  double backbone = Conv(3, w, 7, S / 2);
+  const auto blocks = c.stage_blocks();
+  for (int s = 0; s < 4; ++s) {
+    const int64_t planes = w << s, side = S / 4 >> s;
+    const int64_t in = s == 0 ? w : planes / 2;
+    backbone += Conv(in, planes, 3, side) + Conv(planes, planes, 3, side);
+    if (s > 0) backbone += Conv(in, planes, 1, side);
+    backbone += (blocks[s] - 1) * 2 * Conv(planes, planes, 3, side);
+  }
+  const double udecoder = Conv(12 * w, 4 * w, 3, S / 16) + Conv(6 * w, 2 * w, 3, S / 8) +
+                          Conv(3 * w, w, 3, S / 4);
+  f["backbone"] = B * N * backbone;
+  f["feature decoder"] = B * N * (udecoder + Conv(w, 2 * w, 1, H));
+  if (c.mask_head)
+    f["feature decoder"] += B * N * (Conv(w, w, 3, S / 4) + Conv(w, 1, 1, S / 4));
+  f["heatmap decoder"] = B * N * (udecoder + Conv(w, PoemConfig::kNumJoints, 1, H));
+  f["soft-argmax + DLT + initial mesh"] =
+      B * 3 * Linear(1, PoemConfig::kNumJoints, PoemConfig::kNumVertices);
+  f["frustum points + embeddings"] =
+      B * N * (Conv(2 * w, E, 1, H) + Conv(3 * D, 2 * E, 1, H) + Conv(2 * E, E, 1, H)) +
+      N * Conv(3 * E / 2, E, 1, H);
+  auto merge = [&](int64_t rows) {
+    return TwoLayers(rows * N, E, E, E / 2) + TwoLayers(rows, E / 2, E / 2, E);
+  };
+  f["queries: sampling + merge"] =
+      B * 3 * TwoLayers(1, Q, Q, 1) + TwoLayers(Q, E, E, E) + B * merge(Q);
+  f["points: sampling + merge"] = B * merge(P);
+  f["kNN points"] = 8.0 * B * P * P;
+  f["point self-attention"] = B * Attention(P, P, c.point_neighbors, E, d, false);
+  for (int i = 0; i < c.num_decoder_blocks; ++i) {
+    const std::string block = "block " + std::to_string(i) + " ";
+    f[block + "kNN queries"] = 8.0 * B * Q * Q;
+    f[block + "query self-attention"] =
+        B * Attention(Q, Q, c.query_neighbors, E, d, false);
+    f[block + "kNN query-point"] = 8.0 * B * Q * P;
+    f[block + "cross-attention"] = B * Attention(Q, P, c.point_neighbors, E, d, true);
+    f[block + "regression"] = B * TwoLayers(Q, E, E, 3);
+  }
+  return f;
+}
+
+void BM_PoemStages(benchmark::State& state, const std::string& config) {
+  const int views = static_cast<int>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
+  at::set_num_threads(threads);
+  PoemModel model = IsFile(config)
+                        ? LoadPoemCheckpoint(Shipped(config))
+                        : MakeRandomPoemModel(PoemConfigByName(config, views), 1);
+  model->eval();
+  const PoemConfig& c = model->config();
+  const PoemBatch batch =
+      MakePoemBatch(SyntheticFrames(1, c.num_views, c.crop_size), 0, 1, c);
+  torch::NoGradGuard no_grad;
+  model->forward(batch);  // warm-up: oneDNN kernels are generated on first use
+  PoemStageTimes times;
+  model->stage_times = &times;
+  double total = 0;
+  const std::clock_t cpu_start = std::clock();
+  PoemOutputs fast;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    fast = model->forward(batch);
+    total +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  // Process CPU time (all threads): on a shared machine the wall time includes waiting.
+  const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  model->stage_times = nullptr;
+  // Exactness: the same frame through the autograd path (plain ATen, the code before
+  // the inference kernels), largest coordinate difference over all decoder layers.
+  torch::Tensor reference;
+  {
+    torch::AutoGradMode with_grad(true);
+    reference = model->forward(batch).layer_coords.detach();
+  }
+  const double max_diff = (fast.layer_coords - reference).abs().max().item<double>();
+  const double n = static_cast<double>(state.iterations());
+  const auto flops = StageFlops(c, 1);
+  double frame_flops = 0;
+  for (const auto& [stage, f] : flops) frame_flops += f;
+  std::fprintf(
+      stderr,
+      "\n%s, %d views, %d thread(s): %.1f ms per frame, %.1f GFLOP, %.1f GFLOP/s\n",
+      config.c_str(), c.num_views, threads, 1e3 * total / n, frame_flops * 1e-9,
+      frame_flops * 1e-9 / (total / n));
+  std::fprintf(stderr, "  process CPU time per frame: %.1f ms\n", 1e3 * cpu / n);
+  std::fprintf(stderr, "  largest difference to the autograd path: %.3g m\n", max_diff);
+  std::fprintf(stderr, "  %-36s %10s %8s %10s\n", "stage", "ms", "GFLOP", "GFLOP/s");
+  for (const auto& [stage, seconds] : times.seconds) {
+    const double f = flops.count(stage) ? flops.at(stage) : 0.0;
+    std::fprintf(stderr, "  %-36s %10.2f %8.3f %10.1f\n", stage.c_str(),
+                 1e3 * seconds / n, f * 1e-9, f > 0 ? f * 1e-9 / (seconds / n) : 0.0);
+  }
+  state.counters["GFLOP_per_frame"] = frame_flops * 1e-9;
+  state.counters["max_diff_m"] = max_diff;
+  state.counters["cpu_ms_per_frame"] = 1e3 * cpu / n;
+  state.counters["GFLOP_per_s"] =
+      benchmark::Counter(frame_flops * 1e-9 * n, benchmark::Counter::kIsRate);
+  state.counters["frames_per_s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
+}
+
+BENCHMARK_CAPTURE(BM_PoemStages, Released, std::string("released-dexycb"))
+    ->Args({8, 1})
+    ->Args({8, 2})
+    ->Iterations(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_PoemStages, Shipped, std::string("models/poem_small_dexycb.pt"))
+    ->Args({8, 1})
+    ->Args({8, 2})
+    ->Iterations(10)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

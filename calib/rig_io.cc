@@ -7,15 +7,10 @@
 #include "calib/colmap_rig.h"
 #include "calib/dataset_calib.h"
 #include "core/errors.h"
+#include "core/text.h"
 
 namespace handlabel {
 namespace {
-
-std::string Join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
 
 bool Contains(const std::vector<std::string>& items, const std::string& s) {
   return std::find(items.begin(), items.end(), s) != items.end();

@@ -23,6 +23,10 @@
 
 namespace handlabel {
 
+// Where imported images go, relative to the capture folder.
+inline constexpr char kImportImagePattern[] = "images/{camera}/{frame}.png";
+inline constexpr char kImportImagesFolder[] = "images";
+
 struct CaptureInitOptions {
   // Which hand the recording shows ("right" or "left"); labeling jobs build the hand
   // model for it.

@@ -23,7 +23,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-enum Stream : uint64_t { kSceneStream = 1, kBackgroundStream = 2, kDetectionStream = 3 };
+enum Stream : uint64_t {
+  kSceneStream = 1,
+  kBackgroundStream = 2,
+  kDetectionStream = 3,
+  kAppearanceStream = 4,  // the realistic look's own draws (the scene stays the same)
+};
 
 // Frame files are plain writes (no fsync): the manifest, written atomically last,
 // is what marks a capture complete.
@@ -78,6 +83,10 @@ SynthFrame SynthGenerator::Generate(int index) const {
   std::mt19937_64 scene_rng(MixSeed(options_.seed, index, kSceneStream));
   frame.scene =
       SampleSynthScene(model_, anatomy_, limits_, rig_, options_.scene, scene_rng);
+  if (options_.view.appearance == SynthAppearance::kRealistic) {
+    std::mt19937_64 look_rng(MixSeed(options_.seed, index, kAppearanceStream));
+    ApplyRealisticLook(model_, options_.view.realistic, look_rng, &frame.scene);
+  }
   for (size_t c = 0; c < rig_.size(); ++c) {
     std::mt19937_64 bg_rng(MixSeed(options_.seed, index, kBackgroundStream + 16 * c));
     frame.views.push_back(
@@ -128,6 +137,11 @@ nlohmann::json SynthOptionsToJson(const SynthCaptureOptions& o) {
                {"max_shapes", o.view.background.max_shapes},
                {"max_noise", o.view.background.max_noise},
                {"self_occlusion_tolerance", o.view.self_occlusion_tolerance}};
+  // Recorded only when not the default, so that basic captures stay byte-identical
+  // to those made before the option existed (absent = basic).
+  if (o.view.appearance != SynthAppearance::kBasic) {
+    j["view"]["appearance"] = SynthAppearanceName(o.view.appearance);
+  }
   const DetectionNoiseOptions& d = o.detections;
   j["detections"] = {{"enabled", o.write_detections},
                      {"keypoint_sigma_px", d.keypoint_sigma_px},

@@ -30,7 +30,7 @@ namespace handlabel {
 struct SynthCaptureOptions {
   RigPresetOptions rig;              // which cameras
   SynthSceneOptions scene;           // poses, shapes, objects
-  SynthViewOptions view;             // backgrounds, visibility
+  SynthViewOptions view;             // backgrounds, visibility, the look (appearance)
   DetectionNoiseOptions detections;  // simulated detector
   int num_frames = 10;               // >= 1
   uint64_t seed = 0;                 // everything random derives from it

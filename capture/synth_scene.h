@@ -75,6 +75,9 @@ struct SynthScene {
   Eigen::Vector3f skin = Eigen::Vector3f::Ones();
   ShadingOptions lighting;
   std::vector<SynthObject> objects;
+  // Drawn besides the hand and the objects (the realistic look's forearm and table,
+  // capture/synth_appearance.h): occludes like an object, in no mask. Empty otherwise.
+  std::vector<RenderMesh> scenery;
   int cameras_seeing_hand = 0;  // cameras with all 21 keypoints inside the image
 };
 

@@ -11,6 +11,7 @@ void SynthViewOptions::Check() const {
     throw InputError("synthetic view options", "self_occlusion_tolerance", "> 0",
                      std::to_string(self_occlusion_tolerance));
   }
+  realistic.Check();
   if (background.max_shapes < 0 || !(background.max_noise >= 0)) {
     throw InputError("synthetic view options", "background",
                      "max_shapes, max_noise >= 0");
@@ -33,9 +34,23 @@ SynthView RenderSynthView(const SynthScene& scene, const RigCamera& camera,
                   rays, &buffer);
     meshes.push_back(&scene.objects[i].mesh);
   }
+  // Scenery after the objects: ids above every object id, in no mask.
+  const int first_scenery = static_cast<int>(meshes.size());
+  for (const RenderMesh& mesh : scene.scenery) {
+    RasterizeMesh(mesh, static_cast<int>(meshes.size()), camera.cam_from_world, rays,
+                  &buffer);
+    meshes.push_back(&mesh);
+  }
 
-  view.rgb = MakeBackground(w, h, options.background, background_rng);
+  const bool realistic = options.appearance == SynthAppearance::kRealistic;
+  view.rgb = realistic ? MakeWallBackground(w, h, background_rng)
+                       : MakeBackground(w, h, options.background, background_rng);
   ShadeVisible(meshes, buffer, camera.cam_from_world, rays, scene.lighting, &view.rgb);
+  if (realistic) {
+    const double noise = std::uniform_real_distribution<double>(
+        1.0, options.realistic.max_noise)(background_rng);
+    ApplyCameraBlurAndNoise(options.realistic.blur, noise, background_rng, &view.rgb);
+  }
   view.hand_mask = ImageU8(w, h, 1);
   view.object_mask = ImageU8(w, h, 1);
   for (size_t i = 0; i < buffer.mesh_id.size(); ++i) {
@@ -43,7 +58,7 @@ SynthView RenderSynthView(const SynthScene& scene, const RigCamera& camera,
     if (m == 0) {
       view.hand_mask.data[i] = 255;
       ++view.hand_pixels;
-    } else if (m > 0) {
+    } else if (m > 0 && m < first_scenery) {
       view.object_mask.data[i] = static_cast<uint8_t>(m);
     }
   }

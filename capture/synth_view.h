@@ -5,7 +5,8 @@
 //
 // Keypoint visibility (COCO-like codes):
 //   0 kOutOfFrame  the projection falls outside the image (or behind the camera)
-//   1 kOccluded    inside the image, but an object is nearer at that pixel, or the hand
+//   1 kOccluded    inside the image, but an object (or scenery: the realistic look's
+//                  forearm or table) is nearer at that pixel, or the hand
 //                  surface there is more than `self_occlusion_tolerance` in front of
 //                  the keypoint (joints lie inside the finger, so a small margin is
 //                  normal)
@@ -22,6 +23,7 @@
 #include <random>
 #include <string>
 
+#include "capture/synth_appearance.h"
 #include "capture/synth_background.h"
 #include "capture/synth_scene.h"
 #include "core/image.h"
@@ -39,6 +41,11 @@ struct SynthViewOptions {
   double self_occlusion_tolerance = 0.025;
   // Whether to keep the depth image in the result.
   bool depth = true;
+  // The look (capture/synth_appearance.h): kRealistic draws a wall instead of the
+  // procedural background and adds the camera's blur and noise; the scene's scenery is
+  // drawn in both.
+  SynthAppearance appearance = SynthAppearance::kBasic;
+  RealisticLookOptions realistic;
   void Check() const;
 };
 

@@ -271,6 +271,7 @@ void ShadeVisible(const std::vector<const RenderMesh*>& meshes,
     to_light.push_back((-(r * l.direction_in_world.normalized())).cast<float>());
   }
   const Eigen::Matrix3f rf = r.cast<float>();
+  const bool soft = !options.wrap.isZero() || options.specular > 0;
   for (int y = 0; y < buffer.height; ++y) {
     for (int x = 0; x < buffer.width; ++x) {
       const size_t idx = buffer.index(x, y);
@@ -305,11 +306,31 @@ void ShadeVisible(const std::vector<const RenderMesh*>& meshes,
         albedo = albedo.cwiseProduct(SampleTexture(*mesh.texture, uv.x(), uv.y()));
       }
       Eigen::Vector3f light = options.ambient;
-      for (size_t l = 0; l < to_light.size(); ++l) {
-        light += options.lights[l].color * std::max(0.0f, n.dot(to_light[l]));
+      Eigen::Vector3f highlight = Eigen::Vector3f::Zero();
+      if (soft) {
+        const Eigen::Vector3f to_eye =
+            -Eigen::Vector3f(static_cast<float>(ray[0]), static_cast<float>(ray[1]), 1.0f)
+                 .normalized();
+        for (size_t l = 0; l < to_light.size(); ++l) {
+          const float d = n.dot(to_light[l]);
+          for (int c = 0; c < 3; ++c) {
+            const float w = options.wrap[c];
+            light[c] += options.lights[l].color[c] * std::max(0.0f, (d + w) / (1 + w));
+          }
+          const float nh = std::max(0.0f, n.dot((to_light[l] + to_eye).normalized()));
+          if (d > 0)
+            highlight += options.lights[l].color * std::pow(nh, options.shininess);
+        }
+        highlight *= options.specular;
+      } else {
+        for (size_t l = 0; l < to_light.size(); ++l) {
+          light += options.lights[l].color * std::max(0.0f, n.dot(to_light[l]));
+        }
       }
       for (int c = 0; c < 3; ++c) {
-        const float value = 255.0f * albedo[c] * light[c];
+        // (The Lambert-only form keeps its original evaluation order: same bytes.)
+        const float value = soft ? 255.0f * (albedo[c] * light[c] + highlight[c])
+                                 : 255.0f * albedo[c] * light[c];
         rgb->at(x, y, c) = static_cast<uint8_t>(std::clamp(std::lround(value), 0L, 255L));
       }
     }

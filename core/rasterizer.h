@@ -109,12 +109,19 @@ struct DirectionalLight {
 struct ShadingOptions {
   Eigen::Vector3f ambient = Eigen::Vector3f(0.35f, 0.35f, 0.35f);  // per channel
   std::vector<DirectionalLight> lights = {DirectionalLight()};
+  // Soft (wrap) diffuse per channel: max(0, (n.l + w) / (1 + w)) instead of max(0, n.l),
+  // light reaching past the terminator as it does under skin. 0 = Lambert.
+  Eigen::Vector3f wrap = Eigen::Vector3f::Zero();
+  // Blinn-Phong highlight: specular * light * max(0, n.h)^shininess (0 = none).
+  float specular = 0.0f;
+  float shininess = 24.0f;
 };
 
 // Shades every pixel whose mesh_id >= 0 into `rgb` (3 channels, camera size); pixels of
 // the background are left as they are. meshes[id] is the mesh drawn with that id.
 // colour = albedo * (ambient + sum_lights color * max(0, n . -direction)), with n
-// facing the camera (two-sided), clamped to [0, 255].
+// facing the camera (two-sided), clamped to [0, 255]; with `wrap` or `specular` set,
+// the soft diffuse and the highlight of ShadingOptions.
 void ShadeVisible(const std::vector<const RenderMesh*>& meshes,
                   const VisibilityBuffer& buffer, const Rigid3& cam_from_world,
                   const PixelRays& rays, const ShadingOptions& options, ImageU8* rgb);

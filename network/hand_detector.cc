@@ -276,6 +276,7 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
   for (int v = 0; v < n; ++v) {
     palms[v] = detector.DetectPalms(images[v]);
     frame.views[v].palm_candidates = static_cast<int>(palms[v].size());
+    frame.views[v].palms = palms[v];
     frame.views[v].reason = "no_hand_in_frame";
   }
   const PalmHypothesis best = BestPalmHypothesis(rig, images, palms, options);
@@ -306,6 +307,16 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
   frame.found = frame.keypoint3d_valid[0];
   if (!frame.found) {
     VoteSide(&frame);
+    // Fewer than two views agree on the keypoints: no view's hand can be checked
+    // against the others (step 5), and one view alone leaves its depth unknown (a fit
+    // from it lands metres off). Dropped, with the reason.
+    for (ViewHandResult& r : frame.views) {
+      if (!r.detected) continue;
+      r.detected = false;
+      r.reason = "unconfirmed_by_other_views";
+      r.source.clear();
+      r.keypoints = Keypoints2d();
+    }
     return frame;
   }
 

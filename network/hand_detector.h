@@ -69,11 +69,14 @@ struct ViewHandResult {
   // Why there is no detection: "no_hand_in_frame" (no palms agreed in enough views),
   // "hand_outside_view" (the 3D hand projects mostly outside the image or behind the
   // camera), "low_presence" (the landmark model found no hand in the ROI),
-  // "inconsistent_with_3d_hand" (its keypoints disagree with the triangulated hand).
+  // "inconsistent_with_3d_hand" (its keypoints disagree with the triangulated hand),
+  // "unconfirmed_by_other_views" (a hand in this view, but in no other: no 3D hand to
+  // check it against, and one view leaves its depth unknown).
   std::string reason;
-  int palm_candidates = 0;  // palms the view's palm detection found
-  HandLandmarks hand;       // valid when detected
-  Keypoints2d keypoints;    // distorted pixels, confidence per header rule; 0 = missing
+  int palm_candidates = 0;           // palms the view's palm detection found
+  std::vector<PalmDetection> palms;  // those palms (normalised to the image), best first
+  HandLandmarks hand;                // valid when detected
+  Keypoints2d keypoints;  // distorted pixels, confidence per header rule; 0 = missing
   double median_reprojection_px = -1;  // against the triangulated keypoints; -1 unknown
 };
 

@@ -1,6 +1,12 @@
 #include "network/poem_model.h"
 
+#include <ATen/Parallel.h>
+
+#include <chrono>
+#include <cmath>
+
 #include "core/errors.h"
+#include "core/stopwatch.h"
 #include "network/poem_geometry.h"
 #include "network/point_ops.h"
 
@@ -35,9 +41,55 @@ void ExpectShape(const torch::Tensor& t, const std::vector<int64_t>& shape,
   }
 }
 
+// Inference kernel of SampleViews: the same bilinear sampling (align_corners=false,
+// zero padding) from channels-last features, written straight into (B, P, N, C) rows
+// (grid_sample's (B*N, C, P) result would need a transposing copy of that size).
+torch::Tensor SampleViewsAsRows(const torch::Tensor& features, const torch::Tensor& grid,
+                                int64_t B, int64_t N) {
+  const int64_t C = features.size(1), H = features.size(2), W = features.size(3);
+  const int64_t P = grid.size(1);
+  const torch::Tensor f = features.permute({0, 2, 3, 1}).contiguous();  // (BN, H, W, C)
+  const torch::Tensor g = grid.contiguous();
+  torch::Tensor out = torch::zeros({B, P, N, C}, features.options());
+  const float* fd = f.data_ptr<float>();
+  const float* gd = g.data_ptr<float>();
+  float* od = out.data_ptr<float>();
+  at::parallel_for(0, B * P, 64, [&](int64_t begin, int64_t end) {
+    for (int64_t bp = begin; bp < end; ++bp) {
+      const int64_t b = bp / P, p = bp % P;
+      for (int64_t n = 0; n < N; ++n) {
+        const int64_t image = b * N + n;
+        const float* uv = gd + (image * P + p) * 2;
+        // Unnormalise as grid_sample: ((u + 1) * W - 1) / 2.
+        const float ix = ((uv[0] + 1) * W - 1) / 2;
+        const float iy = ((uv[1] + 1) * H - 1) / 2;
+        // Far outside (or NaN): every corner is padding, the row stays zero.
+        if (!(ix > -2 && ix < W + 1 && iy > -2 && iy < H + 1)) continue;
+        const float x0 = std::floor(ix), y0 = std::floor(iy);
+        const float weights[4] = {(x0 + 1 - ix) * (y0 + 1 - iy),
+                                  (ix - x0) * (y0 + 1 - iy), (x0 + 1 - ix) * (iy - y0),
+                                  (ix - x0) * (iy - y0)};
+        float* o = od + (bp * N + n) * C;
+        for (int corner = 0; corner < 4; ++corner) {
+          const int64_t x = static_cast<int64_t>(x0) + corner % 2;
+          const int64_t y = static_cast<int64_t>(y0) + corner / 2;
+          if (x < 0 || x >= W || y < 0 || y >= H) continue;
+          const float* v = fd + ((image * H + y) * W + x) * C;
+          const float w = weights[corner];
+          for (int64_t c = 0; c < C; ++c) o[c] += v[c] * w;
+        }
+      }
+    }
+  });
+  return out;
+}
+
 torch::Tensor SampleViews(const torch::Tensor& features, const torch::Tensor& grid,
                           int64_t B, int64_t N) {
   // features (B*N, C, H, W), grid (B*N, P, 1, 2) -> (B, P, N, C)
+  if (UseInferenceKernels() && features.scalar_type() == torch::kFloat32) {
+    return SampleViewsAsRows(features, grid, B, N);
+  }
   const torch::Tensor s = F::grid_sample(features, grid,
                                          F::GridSampleFuncOptions()
                                              .mode(torch::kBilinear)
@@ -47,7 +99,32 @@ torch::Tensor SampleViews(const torch::Tensor& features, const torch::Tensor& gr
   return s.squeeze(-1).reshape({B, N, C, P}).permute({0, 3, 1, 2});
 }
 
+// Adds the time since the previous lap to a stage (nothing when times is null).
+class StageClock {
+ public:
+  explicit StageClock(PoemStageTimes* times) : times_(times) {}
+  void Lap(const std::string& stage) {
+    if (!times_) return;
+    times_->Add(stage, SecondsSince(last_));
+    last_ = std::chrono::steady_clock::now();
+  }
+
+ private:
+  PoemStageTimes* times_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
 }  // namespace
+
+void PoemStageTimes::Add(const std::string& stage, double s) {
+  for (auto& [name, total] : seconds) {
+    if (name == stage) {
+      total += s;
+      return;
+    }
+  }
+  seconds.emplace_back(stage, s);
+}
 
 torch::Tensor PoemOutputs::joints() const {
   return layer_coords[-1].index({Slice(), Slice(0, PoemConfig::kNumJoints)});
@@ -59,13 +136,13 @@ torch::Tensor PoemOutputs::vertices() const {
 
 torch::Tensor MergeViews(const torch::Tensor& f, torch::nn::ModuleList& merge_net) {
   const torch::Tensor master_raw = f.index({Slice(), Slice(), 0});
-  const torch::Tensor e = merge_net[0]->as<torch::nn::Sequential>()->forward(f);
+  const torch::Tensor e = RunMlp(*merge_net[0]->as<torch::nn::Sequential>(), f);
   const torch::Tensor master = e.index({Slice(), Slice(), 0});
   const torch::Tensor others =
       e.index({Slice(), Slice(), Slice(1, torch::indexing::None)});
   const torch::Tensor s = torch::matmul(others, master.unsqueeze(-1));  // (B, P, N-1, 1)
   const torch::Tensor agg = torch::matmul(others.transpose(2, 3), s).squeeze(-1);
-  return master_raw + merge_net[1]->as<torch::nn::Sequential>()->forward(agg);
+  return master_raw + RunMlp(*merge_net[1]->as<torch::nn::Sequential>(), agg);
 }
 
 PointDecoderImpl::PointDecoderImpl(const PoemConfig& c)
@@ -87,19 +164,29 @@ torch::Tensor PointDecoderImpl::forward(const torch::Tensor& point_xyz,
                                         torch::Tensor query_xyz,
                                         torch::Tensor query_features,
                                         torch::nn::ModuleList& reg_branches) {
-  point_features = feats_self_attn->SelfAttention(
-      point_xyz, point_features, KnnIndices(point_xyz, point_xyz, point_neighbors));
+  StageClock clock(stage_times);
+  const torch::Tensor point_knn = KnnIndices(point_xyz, point_xyz, point_neighbors);
+  clock.Lap("kNN points");
+  point_features = feats_self_attn->SelfAttention(point_xyz, point_features, point_knn);
+  clock.Lap("point self-attention");
   std::vector<torch::Tensor> layers;
   for (size_t i = 0; i < query_self_attn->size(); ++i) {
+    const std::string block = "block " + std::to_string(i) + " ";
+    const torch::Tensor query_knn = KnnIndices(query_xyz, query_xyz, query_neighbors);
+    clock.Lap(block + "kNN queries");
     query_features = query_self_attn[i]->as<VectorAttention>()->SelfAttention(
-        query_xyz, query_features, KnnIndices(query_xyz, query_xyz, query_neighbors));
+        query_xyz, query_features, query_knn);
+    clock.Lap(block + "query self-attention");
+    const torch::Tensor cross_knn = KnnIndices(query_xyz, point_xyz, point_neighbors);
+    clock.Lap(block + "kNN query-point");
     query_features = query_feats_cross_attn[i]->as<VectorAttention>()->CrossAttention(
-        query_xyz, query_features, point_xyz, point_features,
-        KnnIndices(query_xyz, point_xyz, point_neighbors));
+        query_xyz, query_features, point_xyz, point_features, cross_knn);
+    clock.Lap(block + "cross-attention");
     const torch::Tensor delta =
-        reg_branches[i]->as<torch::nn::Sequential>()->forward(query_features);
+        RunMlp(*reg_branches[i]->as<torch::nn::Sequential>(), query_features);
     query_xyz = torch::sigmoid(delta + InverseSigmoid(query_xyz));
     layers.push_back(query_xyz);
+    clock.Lap(block + "regression");
   }
   return torch::stack(layers);
 }
@@ -140,6 +227,7 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
   const int64_t B = image_features.size(0), N = image_features.size(1);
   const int64_t Hf = image_features.size(3), E = c.embed_dim;
   const double zmin = c.position_range[2], zmax = c.position_range[5];
+  StageClock clock(stage_times);
 
   // Image features with the frustum-coordinate and sine position embeddings.
   torch::Tensor x = input_proj(image_features.flatten(0, 1));  // (BN, E, H, W)
@@ -153,20 +241,22 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
       adapt_pos3d(sine).repeat({B, 1, 1, 1});  // (BN, E, H, W)
   const torch::Tensor pos_embed = sin_embed + coords_embed;
   x = x + pos_embed;
+  clock.Lap("frustum points + embeddings");
 
   // Ball centre: mesh mean shifted by a learnt function of the whole mesh.
   const torch::Tensor shift =
-      center_shift_layer->forward(mesh.transpose(1, 2)).transpose(1, 2);  // (B, 1, 3)
+      RunMlp(*center_shift_layer, mesh.transpose(1, 2)).transpose(1, 2);  // (B, 1, 3)
   const torch::Tensor center = mesh.mean(1, /*keepdim=*/true) + 0.01 * shift;
   out->ball_center = center.squeeze(1);
 
   // Queries: learnt per-vertex embedding + features sampled where the mesh projects.
   const torch::Tensor query_embeds =
-      query_embedding->forward(reference_embed->weight).unsqueeze(0).expand({B, -1, -1});
+      RunMlp(*query_embedding, reference_embed->weight).unsqueeze(0).expand({B, -1, -1});
   const torch::Tensor mesh_grid =
       ProjectToGrid(mesh, batch.intrinsics, cam_from_master, c.crop_size);
   const torch::Tensor query_feat =
       MergeViews(SampleViews(x, mesh_grid, B, N), merge_net_query_feature);
+  clock.Lap("queries: sampling + merge");
 
   // Deterministic point selection inside the ball (point_ops.h).
   const torch::Tensor frustum_flat = frustum.reshape({B, -1, 3});
@@ -176,6 +266,7 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
                              c.num_sampled_points, &out->points_inside_ball);
   }
   out->point_index = index;
+  clock.Lap("point selection");
   const torch::Tensor points =
       GatherNeighbors(frustum_flat, index.unsqueeze(-1)).squeeze(2);  // (B, K, 3)
   out->sampled_points = points;
@@ -184,13 +275,16 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
   const torch::Tensor point_feat =
       MergeViews(SampleViews(x, point_grid, B, N), merge_net_feature);
   const torch::Tensor point_embed = SampleViews(pos_embed, point_grid, B, N).sum(2);
+  clock.Lap("points: sampling + merge");
 
   const torch::Tensor coords_out = transformer->forward(
       NormalizePositions(points, c.position_range), point_feat + point_embed,
       NormalizePositions(mesh, c.position_range), query_feat + query_embeds,
       reg_branches);
+  clock = StageClock(stage_times);
   out->layer_coords =
       DenormalizePositions(torch::nan_to_num(coords_out), c.position_range);
+  clock.Lap("outputs");
 }
 
 PoemModelImpl::PoemModelImpl(const PoemConfig& config) : config_(config) {
@@ -251,8 +345,12 @@ PoemOutputs PoemModelImpl::forward(const PoemBatch& batch) {
   const int64_t B = batch.images.size(0), N = c.num_views, J = PoemConfig::kNumJoints;
   const int64_t S = c.crop_size, H = c.heatmap_size();
   PoemOutputs out;
+  ptEmb_head->stage_times = stage_times;
+  ptEmb_head->transformer->stage_times = stage_times;
+  StageClock clock(stage_times);
 
   const auto f = img_backbone->forward(batch.images.reshape({B * N, 3, S, S}));
+  clock.Lap("backbone");
   const torch::Tensor feat_full = UDecodeBeforePool(feat_delayer, f);  // (BN, w, 2H, 2W)
   const torch::Tensor feat =
       feat_in(F::max_pool2d(feat_full, F::MaxPool2dFuncOptions(2).stride(2)));
@@ -260,8 +358,10 @@ PoemOutputs PoemModelImpl::forward(const PoemBatch& batch) {
     const int64_t M = c.mask_size();
     out.mask_logits = mask_head->forward(feat_full).view({B, N, M, M});
   }
+  clock.Lap("feature decoder");
   const torch::Tensor heatmaps = torch::sigmoid(uv_out(UDecode(uv_delayer, f)));
   out.heatmaps = heatmaps.view({B, N, J, H, H});
+  clock.Lap("heatmap decoder");
   out.joints_2d = SoftArgmax2d(heatmaps, S).view({B, N, J, 2});
 
   const torch::Tensor cam_from_master = torch::linalg_inv(batch.master_from_cam);
@@ -277,6 +377,7 @@ PoemOutputs PoemModelImpl::forward(const PoemBatch& batch) {
   const torch::Tensor rel = out.triangulated_joints - root;
   const torch::Tensor verts = linear_inv_skin(rel.transpose(1, 2)).transpose(1, 2) + root;
   out.initial_mesh = torch::cat({out.triangulated_joints, verts}, 1);
+  clock.Lap("soft-argmax + DLT + initial mesh");
 
   ptEmb_head->forward(feat.view({B, N, feat.size(1), H, H}), out.initial_mesh, batch,
                       cam_from_master, &out);

@@ -45,6 +45,13 @@ struct PoemOutputs {
   torch::Tensor vertices() const;  // (B, 778, 3) last layer
 };
 
+// Wall time of each forward-pass stage, summed over calls, in order of first
+// appearance (bench/poem_bench.cc). Collected only when set on a model.
+struct PoemStageTimes {
+  std::vector<std::pair<std::string, double>> seconds;
+  void Add(const std::string& stage, double s);
+};
+
 // The decoder `PtEmbedTRv2` (keys feats_self_attn, query_self_attn.i,
 // query_feats_cross_attn.i).
 struct PointDecoderImpl : torch::nn::Module {
@@ -56,6 +63,7 @@ struct PointDecoderImpl : torch::nn::Module {
   VectorAttention feats_self_attn{nullptr};
   torch::nn::ModuleList query_self_attn{nullptr}, query_feats_cross_attn{nullptr};
   int point_neighbors, query_neighbors;
+  PoemStageTimes* stage_times = nullptr;  // set by PoemModelImpl::forward
 };
 TORCH_MODULE(PointDecoder);
 
@@ -77,6 +85,7 @@ struct PoemHeadImpl : torch::nn::Module {
   torch::nn::Linear layer_global_feat{nullptr};  // unused; kept for checkpoint keys
   PointDecoder transformer{nullptr};
   PoemConfig config;
+  PoemStageTimes* stage_times = nullptr;  // set by PoemModelImpl::forward
 };
 TORCH_MODULE(PoemHead);
 
@@ -90,6 +99,8 @@ struct PoemModelImpl : torch::nn::Module {
   torch::Tensor MaskLogitsOnFrozenFeatures(const torch::Tensor& images);
 
   const PoemConfig& config() const { return config_; }
+  // Optional: every forward() adds its stage times here (not owned; null = off).
+  PoemStageTimes* stage_times = nullptr;
 
   ResNet img_backbone{nullptr};
   torch::nn::ModuleList uv_delayer{nullptr}, feat_delayer{nullptr};

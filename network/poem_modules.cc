@@ -2,7 +2,12 @@
 
 #include "network/point_ops.h"
 
+#include <ATen/Parallel.h>
+
+#include <algorithm>
 #include <cmath>
+
+#include "core/errors.h"
 
 namespace handlabel {
 
@@ -149,6 +154,45 @@ torch::nn::Sequential Mlp(int64_t in, int64_t hidden, int64_t out) {
                                torch::nn::Linear(hidden, out));
 }
 
+bool UseInferenceKernels() { return !torch::GradMode::is_enabled(); }
+
+torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
+                              const torch::Tensor& x) {
+  const int64_t out = layer.weight.size(0), in = layer.weight.size(1);
+  HL_CHECK(x.size(-1) == in, "InferenceLinear: input width differs from the layer's");
+  std::vector<int64_t> shape = x.sizes().vec();
+  shape.back() = out;
+  const torch::Tensor rows = x.reshape({-1, in}).contiguous();
+  const int64_t m = rows.size(0);
+  if (m == 0) return torch::empty(shape, x.options());
+  // Row-major (m, in) is a (1, in, m, 1) image in channels-last layout: no copy, and
+  // oneDNN writes the (1, out, m, 1) result channels-last, i.e. row-major (m, out).
+  const torch::Tensor image = rows.as_strided({1, in, m, 1}, {m * in, 1, in, in});
+  const torch::Tensor y = at::mkldnn_convolution(
+      image, layer.weight.view({out, in, 1, 1}),
+      layer.bias.defined() ? c10::optional<torch::Tensor>(layer.bias) : c10::nullopt,
+      {0, 0}, {1, 1}, {1, 1}, 1);
+  return y.permute({0, 2, 3, 1}).reshape(shape);
+}
+
+torch::Tensor InferenceMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {
+  torch::Tensor y = x;
+  for (const auto& child : mlp.children()) {
+    if (const auto* linear = child->as<torch::nn::Linear>()) {
+      y = InferenceLinear(*linear, y);
+    } else {
+      HL_CHECK(child->as<torch::nn::ReLU>() != nullptr,
+               "InferenceMlp: only Linear and ReLU modules");
+      y = torch::relu_(y);
+    }
+  }
+  return y;
+}
+
+torch::Tensor RunMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {
+  return UseInferenceKernels() ? InferenceMlp(mlp, x) : mlp.forward(x);
+}
+
 VectorAttentionImpl::VectorAttentionImpl(int64_t d_points, int64_t d_model_in, bool cross)
     : d_model(d_model_in) {
   fc1 = register_module("fc1", torch::nn::Linear(d_points, d_model));
@@ -172,9 +216,72 @@ torch::Tensor VectorAttentionImpl::Attend(const torch::Tensor& q, const torch::T
   return (attn * (v + pos)).sum(2);  // (B, Q, d)
 }
 
+namespace {
+
+// Gathered rows per chunk of the attention kernel: its temporaries (a few chunk x d
+// floats each) stay in the cache instead of B x Q x k x d tensors in fresh pages.
+constexpr int64_t kAttentionChunkRows = 2048;
+
+// Splits n queries of k rows each into chunks of about kAttentionChunkRows rows, the
+// chunk count a multiple of the thread count so that the threads get equal shares.
+int64_t QueriesPerChunk(int64_t n, int64_t k) {
+  const int64_t threads = std::max(1, at::get_num_threads());
+  int64_t chunks =
+      std::max<int64_t>(1, (n * k + kAttentionChunkRows - 1) / kAttentionChunkRows);
+  chunks = (chunks + threads - 1) / threads * threads;
+  return std::max<int64_t>(1, (n + chunks - 1) / chunks);
+}
+
+}  // namespace
+
+torch::Tensor VectorAttentionImpl::AttendChunked(
+    const torch::Tensor& q, const torch::Tensor& k, const torch::Tensor& v,
+    const torch::Tensor& query_xyz, const torch::Tensor& point_xyz,
+    const torch::Tensor& knn, const torch::Tensor& residual) {
+  const int64_t B = q.size(0), Q = q.size(1), P = k.size(1), K = knn.size(2);
+  const int64_t d = d_model;
+  // Everything flattened over the batch; neighbour indices into the flattened points.
+  const torch::Tensor qf = q.reshape({B * Q, d}).contiguous();
+  const torch::Tensor kf = k.reshape({B * P, d}).contiguous();
+  const torch::Tensor vf = v.reshape({B * P, d}).contiguous();
+  const torch::Tensor qxyz = query_xyz.reshape({B * Q, 3}).contiguous();
+  const torch::Tensor pxyz = point_xyz.reshape({B * P, 3}).contiguous();
+  const torch::Tensor offset = torch::arange(B, knn.options()).mul_(P).view({B, 1, 1});
+  const torch::Tensor index = (knn + offset).reshape({B * Q, K});
+  const double scale = std::sqrt(static_cast<double>(d));
+  torch::Tensor agg = torch::empty({B * Q, d}, q.options());
+  const int64_t per_chunk = QueriesPerChunk(B * Q, K);
+  const int64_t chunks = (B * Q + per_chunk - 1) / per_chunk;
+  // One chunk per task; inside a task every ATen and oneDNN call runs single-threaded.
+  at::parallel_for(0, chunks, 1, [&](int64_t begin, int64_t end) {
+    for (int64_t c = begin; c < end; ++c) {
+      const int64_t q0 = c * per_chunk, n = std::min(per_chunk, B * Q - q0);
+      const torch::Tensor idx = index.narrow(0, q0, n).reshape({-1});
+      // The same element-wise operations, in the same order, as Attend().
+      const torch::Tensor rel =
+          qxyz.narrow(0, q0, n).unsqueeze(1) - pxyz.index_select(0, idx).view({n, K, 3});
+      const torch::Tensor pos = InferenceMlp(*fc_delta, rel);  // (n, K, d)
+      const torch::Tensor logits = InferenceMlp(
+          *fc_gamma,
+          (qf.narrow(0, q0, n).unsqueeze(1) - kf.index_select(0, idx).view({n, K, d}))
+              .add_(pos));
+      const torch::Tensor attn = torch::softmax(logits.div_(scale), 1);
+      const torch::Tensor values = vf.index_select(0, idx).view({n, K, d}).add_(pos);
+      torch::Tensor out = agg.narrow(0, q0, n);
+      torch::sum_out(out, attn.mul_(values), at::IntArrayRef{1});
+    }
+  });
+  return InferenceLinear(*fc2, agg.view({B, Q, d})) + residual;
+}
+
 torch::Tensor VectorAttentionImpl::SelfAttention(const torch::Tensor& xyz,
                                                  const torch::Tensor& features,
                                                  const torch::Tensor& knn) {
+  if (UseInferenceKernels()) {
+    const torch::Tensor x = InferenceLinear(*fc1, features);
+    return AttendChunked(InferenceLinear(*w_qs, x), InferenceLinear(*w_ks, x),
+                         InferenceLinear(*w_vs, x), xyz, xyz, knn, features);
+  }
   const torch::Tensor x = fc1(features);
   const torch::Tensor q = w_qs(x);
   const torch::Tensor k = GatherNeighbors(w_ks(x), knn);
@@ -188,6 +295,12 @@ torch::Tensor VectorAttentionImpl::CrossAttention(const torch::Tensor& query_xyz
                                                   const torch::Tensor& point_xyz,
                                                   const torch::Tensor& point_features,
                                                   const torch::Tensor& knn) {
+  if (UseInferenceKernels()) {
+    const torch::Tensor x = InferenceLinear(*fc1, point_features);
+    return AttendChunked(InferenceLinear(*w_qs, query_features),
+                         InferenceLinear(*w_ks, x), InferenceLinear(*w_vs, x), query_xyz,
+                         point_xyz, knn, query_features);
+  }
   const torch::Tensor q = w_qs(query_features);
   // fc1, w_ks and w_vs are linear, so they run on the P points before the gather
   // instead of on the Q*k gathered rows (same result, fewer FLOPs when P < Q*k).

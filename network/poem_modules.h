@@ -63,6 +63,18 @@ torch::nn::ModuleList MakeUDecoder(int width);
 // Linear(in, hidden), ReLU, Linear(hidden, out) as a Sequential (keys 0, 2).
 torch::nn::Sequential Mlp(int64_t in, int64_t hidden, int64_t out);
 
+// Inference kernels (docs/speed.md). They run when no gradient is recorded
+// (NoGradGuard / inference): the same math as the modules' autograd path, evaluated
+// with oneDNN instead of the system BLAS (on Debian a serial, generic OpenBLAS kernel)
+// and in cache-sized chunks; results differ from the autograd path by rounding only.
+bool UseInferenceKernels();
+// x (..., in) -> (..., out): layer(x) as a oneDNN 1x1 convolution on channels-last rows.
+torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer, const torch::Tensor& x);
+// A Sequential of Linear and ReLU modules (Mlp), each Linear through InferenceLinear.
+torch::Tensor InferenceMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x);
+// mlp(x) through InferenceMlp when UseInferenceKernels(), else the modules' forward.
+torch::Tensor RunMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x);
+
 // Point Transformer vector attention without heads (keys fc1, fc2, fc_delta, fc_gamma,
 // w_qs, w_ks, w_vs). Self-attention: neighbours among the same points. Cross
 // attention: queries attend to point features (fc1 applies to the point features, w_qs
@@ -87,6 +99,12 @@ struct VectorAttentionImpl : torch::nn::Module {
  private:
   torch::Tensor Attend(const torch::Tensor& q, const torch::Tensor& k,
                        const torch::Tensor& v, const torch::Tensor& rel_xyz);
+  // The inference kernel of Attend + fc2 + residual, without B x Q x k x d temporaries:
+  // q (B, Q, d), k and v (B, P, d) per point (not gathered), xyz as in CrossAttention.
+  torch::Tensor AttendChunked(const torch::Tensor& q, const torch::Tensor& k,
+                              const torch::Tensor& v, const torch::Tensor& query_xyz,
+                              const torch::Tensor& point_xyz, const torch::Tensor& knn,
+                              const torch::Tensor& residual);
 };
 TORCH_MODULE(VectorAttention);
 

@@ -2,7 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.h"
 
 namespace handlabel {
 namespace {
@@ -95,6 +101,7 @@ void PrecisionRecall(const std::vector<Answer>& answers, const std::string& chec
 KeptShare Share(const std::vector<Answer>& answers, const QualityThresholds& t,
                 double error_mm) {
   KeptShare s;
+  s.answers = static_cast<int>(answers.size());
   for (const Answer& a : answers) {
     if (!Kept(a, t.max_reprojection_px, t.max_view_disagreement_mm)) continue;
     ++s.kept;
@@ -103,51 +110,102 @@ KeptShare Share(const std::vector<Answer>& answers, const QualityThresholds& t,
   return s;
 }
 
+// A network label's recorded checks (nullopt without checks) with its error.
+std::optional<Answer> AnswerOf(const std::optional<LabelRecord>& label, double error_mm) {
+  if (!label || label->quality.flags.empty()) return std::nullopt;
+  Answer a;
+  a.error_mm = error_mm;
+  for (const QualityFlag& flag : label->quality.flags) {
+    if (flag.name == "reprojection") {
+      a.reprojection_px = flag.value;
+    } else if (flag.name == "view_agreement") {
+      a.view_agreement_mm = flag.value;
+    } else if (!flag.passed) {
+      a.fixed_checks_pass = false;
+    }
+  }
+  return a;
+}
+
 std::vector<Answer> ReadAnswers(const MethodRun& network) {
   std::vector<Answer> answers;
   const MethodScores& s = network.scores;
   for (size_t f = 0; f < s.frames.size(); ++f) {
-    const std::optional<LabelRecord> label = MethodLabel(network, s.frames[f]);
-    if (!label || label->quality.flags.empty()) continue;
-    Answer a;
-    a.error_mm = 1000 * s.per_frame[f].mpjpe;
-    for (const QualityFlag& flag : label->quality.flags) {
-      if (flag.name == "reprojection") {
-        a.reprojection_px = flag.value;
-      } else if (flag.name == "view_agreement") {
-        a.view_agreement_mm = flag.value;
-      } else if (!flag.passed) {
-        a.fixed_checks_pass = false;
-      }
-    }
-    answers.push_back(a);
+    const std::optional<Answer> a =
+        AnswerOf(MethodLabel(network, s.frames[f]), 1000 * s.per_frame[f].mpjpe);
+    if (a) answers.push_back(*a);
   }
   return answers;
+}
+
+// An earlier comparison's network answers: per-frame MPJPE from its compare.json,
+// checks from its labels in methods/network/.
+std::vector<Answer> ReadAnswers(const std::string& compare_dir) {
+  namespace fs = std::filesystem;
+  const std::string path = (fs::path(compare_dir) / "compare.json").string();
+  std::ifstream in(path);
+  if (!in) throw InputError("--qa-selection", path, "a compare.json (compare --out)");
+  nlohmann::json compare;
+  try {
+    compare = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw InputError(path, "(file)", "JSON", e.what());
+  }
+  MethodRun network;
+  network.method = CompareMethod::kNetwork;
+  network.output_dir = (fs::path(compare_dir) / "methods" / "network").string();
+  for (const nlohmann::json& m : compare.value("methods", nlohmann::json::array())) {
+    if (m.value("method", "") != "network" || !m.value("ran", false) ||
+        !m.contains("per_frame_mpjpe_mm")) {
+      continue;
+    }
+    std::vector<Answer> answers;
+    for (const auto& [frame, mm] : m.at("per_frame_mpjpe_mm").items()) {
+      const std::optional<Answer> a =
+          AnswerOf(MethodLabel(network, frame), mm.get<double>());
+      if (a) answers.push_back(*a);
+    }
+    return answers;
+  }
+  throw InputError(path, "methods",
+                   "a network row that ran with ground truth (compare with the network "
+                   "method and weights)");
 }
 
 }  // namespace
 
 QualityStudy StudyQualityChecks(const MethodRun& network,
-                                const QualityThresholds& current, double error_mm) {
+                                const QualityThresholds& current, double error_mm,
+                                const std::vector<std::string>& selection_dirs) {
   QualityStudy study;
   study.error_mm = error_mm;
   study.current = current;
   study.chosen = current;
+  study.selection_dirs = selection_dirs;
   if (network.method != CompareMethod::kNetwork || !network.why_not.empty()) {
     study.why_not = "the network alone did not run" +
                     (network.why_not.empty() ? "" : ": " + network.why_not);
     return study;
   }
   const std::vector<Answer> answers = ReadAnswers(network);
-  if (answers.size() < 4) {
-    study.why_not = "fewer than 4 network answers with ground truth";
+  std::vector<Answer> selection, held_out;
+  if (selection_dirs.empty()) {
+    for (size_t i = 0; i < answers.size(); ++i)
+      (i % 2 == 0 ? selection : held_out).push_back(answers[i]);
+  } else {
+    held_out = answers;
+    for (const std::string& dir : selection_dirs) {
+      const std::vector<Answer> more = ReadAnswers(dir);
+      selection.insert(selection.end(), more.begin(), more.end());
+    }
+  }
+  if (selection.size() < 2 || held_out.size() < 2) {
+    study.why_not = "fewer than 4 network answers with ground truth (" +
+                    std::to_string(selection.size()) + " to choose on, " +
+                    std::to_string(held_out.size()) + " held out)";
     return study;
   }
-  std::vector<Answer> selection, held_out;
-  for (size_t i = 0; i < answers.size(); ++i) {
-    (i % 2 == 0 ? selection : held_out).push_back(answers[i]);
-    study.bad_frames += answers[i].error_mm > error_mm;
-  }
+  for (const Answer& a : answers) study.bad_frames += a.error_mm > error_mm;
   study.frames = static_cast<int>(answers.size());
   study.selection_frames = static_cast<int>(selection.size());
   study.held_out_frames = static_cast<int>(held_out.size());

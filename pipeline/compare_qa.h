@@ -6,11 +6,13 @@
 //  - ROC per tunable check (reprojection, view_agreement): flagging "value >
 //    threshold" as a detector of bad answers, over every threshold.
 //  - Precision / recall of the current threshold.
-//  - Thresholds chosen on one half of the frames (even positions in frame order: the
-//    selection set) by Youden's J (true-positive rate - false-positive rate; the
-//    current threshold stays unless one does strictly better), and
-//    judged on the other half (odd positions: held out): the share of kept answers
-//    (every check passes) that are bad, before (current thresholds) and after.
+//  - Thresholds chosen on a selection set by Youden's J (true-positive rate -
+//    false-positive rate; the current threshold stays unless one does strictly
+//    better), and judged on held-out answers: the share of kept answers (every check
+//    passes) that are bad, before (current thresholds) and after. The selection set is
+//    either this run's frames at even positions in frame order (held out: the odd
+//    ones), or the network answers of earlier comparisons (`compare --qa-selection
+//    DIR,...`; held out: every answer of this run, frames never used for choosing).
 // finite, range and enough_views are kept as they are (what they test is not a matter
 // of degree); their recorded pass/fail enters "kept" unchanged.
 
@@ -42,24 +44,32 @@ struct CheckStudy {
 };
 
 struct KeptShare {
-  int kept = 0;      // held-out answers passing every check
-  int kept_bad = 0;  // of those, MPJPE > error_mm
+  int answers = 0;   // held-out answers
+  int kept = 0;      // of those, passing every check
+  int kept_bad = 0;  // of the kept, MPJPE > error_mm
   double Share() const { return kept > 0 ? double(kept_bad) / kept : 0.0; }
+  double KeptFraction() const { return answers > 0 ? double(kept) / answers : 0.0; }
 };
 
 struct QualityStudy {
   std::string why_not;  // non-empty: no study (no network, no truth), and why
   double error_mm = 8;
+  // The compare folders whose network answers were the selection set; empty: the
+  // even positions of this run.
+  std::vector<std::string> selection_dirs;
   int frames = 0, selection_frames = 0, held_out_frames = 0;
-  int bad_frames = 0;  // over all frames
+  int bad_frames = 0;  // over this run's frames
   std::vector<CheckStudy> checks;
   QualityThresholds current, chosen;
   KeptShare before, after;  // held-out frames
 };
 
 // `network`: the comparison's network run (refine off). `current`: the thresholds
-// its labels were checked with.
+// its labels were checked with. `selection_dirs`: earlier `compare` output folders
+// (their compare.json and methods/network/labels) to choose on; throws InputError
+// naming the folder when one has no network row.
 QualityStudy StudyQualityChecks(const MethodRun& network,
-                                const QualityThresholds& current, double error_mm);
+                                const QualityThresholds& current, double error_mm,
+                                const std::vector<std::string>& selection_dirs = {});
 
 }  // namespace handlabel

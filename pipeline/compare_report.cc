@@ -108,9 +108,13 @@ nlohmann::json QaJson(const QualityStudy& qa) {
                            {"recall_chosen", c.recall_chosen}});
   }
   auto share = [](const KeptShare& s) {
-    return nlohmann::json{
-        {"kept", s.kept}, {"kept_bad", s.kept_bad}, {"share", s.Share()}};
+    return nlohmann::json{{"answers", s.answers},
+                          {"kept", s.kept},
+                          {"kept_bad", s.kept_bad},
+                          {"share", s.Share()},
+                          {"kept_fraction", s.KeptFraction()}};
   };
+  j["selection_dirs"] = qa.selection_dirs;
   j["held_out_before"] = share(qa.before);
   j["held_out_after"] = share(qa.after);
   return j;
@@ -551,12 +555,13 @@ HtmlTable QaTable(const QualityStudy& qa) {
 HtmlTable QaShareTable(const QualityStudy& qa) {
   HtmlTable t;
   t.id = "qa_share";
-  t.header = {"thresholds", "kept answers",
+  t.header = {"thresholds", "kept answers", "kept of all",
               "kept with MPJPE > " + Number(qa.error_mm, 0) + " mm", "share"};
   auto row = [](const char* name, const KeptShare& s, const std::string& key) {
     return std::vector<HtmlCell>{
         {name},
         {std::to_string(s.kept), "qa." + key + ".kept", 0},
+        {Number(s.KeptFraction(), 3), "qa." + key + ".kept_fraction", 3},
         {std::to_string(s.kept_bad), "qa." + key + ".kept_bad", 0},
         {Number(s.Share(), 3), "qa." + key + ".share", 3}};
   };
@@ -609,6 +614,32 @@ std::string VersionsText() {
 
 }  // namespace
 
+nlohmann::json MethodJson(const MethodRun& run) {
+  nlohmann::json m = {{"method", ToString(run.method)},
+                      {"title", Describe(run.method)},
+                      {"ran", Ran(run)},
+                      {"why_not", run.why_not},
+                      {"evidence", run.evidence},
+                      {"output_dir", run.output_dir},
+                      {"labelled", run.ok},
+                      {"failed", run.failed},
+                      {"wall_seconds", run.wall_seconds},
+                      {"by_path", run.by_path}};
+  for (const auto& [key, value] : RowValues(run))
+    m["metrics"][key] = JsonNumberOrNull(value);
+  if (!run.has_truth) return m;
+  m["pck_thresholds_mm"] = Mm(run.scores.joint_pck.thresholds);
+  m["joint_pck"] = run.scores.joint_pck.pck;
+  if (HasVertices(run)) m["vertex_pck"] = run.scores.vertex_pck.pck;
+  const Eigen::VectorXd per_joint = 1000 * run.scores.joint_errors.colwise().mean();
+  m["per_keypoint_mm"] =
+      std::vector<double>(per_joint.data(), per_joint.data() + per_joint.size());
+  for (size_t f = 0; f < run.scores.frames.size(); ++f) {
+    m["per_frame_mpjpe_mm"][run.scores.frames[f]] = 1000 * run.scores.per_frame[f].mpjpe;
+  }
+  return m;
+}
+
 nlohmann::json CompareToJson(const JobConfig& base, const CompareResult& r,
                              const QualityStudy& qa) {
   nlohmann::json j;
@@ -625,33 +656,7 @@ nlohmann::json CompareToJson(const JobConfig& base, const CompareResult& r,
   for (const Column& c : kColumns)
     j["columns"].push_back(
         {{"key", c.key}, {"title", c.title}, {"decimals", c.decimals}});
-  for (const MethodRun& run : r.methods) {
-    nlohmann::json m = {{"method", ToString(run.method)},
-                        {"title", Describe(run.method)},
-                        {"ran", Ran(run)},
-                        {"why_not", run.why_not},
-                        {"evidence", run.evidence},
-                        {"output_dir", run.output_dir},
-                        {"labelled", run.ok},
-                        {"failed", run.failed},
-                        {"wall_seconds", run.wall_seconds},
-                        {"by_path", run.by_path}};
-    for (const auto& [key, value] : RowValues(run))
-      m["metrics"][key] = JsonNumberOrNull(value);
-    if (run.has_truth) {
-      m["pck_thresholds_mm"] = Mm(run.scores.joint_pck.thresholds);
-      m["joint_pck"] = run.scores.joint_pck.pck;
-      if (HasVertices(run)) m["vertex_pck"] = run.scores.vertex_pck.pck;
-      const Eigen::VectorXd per_joint = 1000 * run.scores.joint_errors.colwise().mean();
-      m["per_keypoint_mm"] =
-          std::vector<double>(per_joint.data(), per_joint.data() + per_joint.size());
-      for (size_t f = 0; f < run.scores.frames.size(); ++f) {
-        m["per_frame_mpjpe_mm"][run.scores.frames[f]] =
-            1000 * run.scores.per_frame[f].mpjpe;
-      }
-    }
-    j["methods"].push_back(m);
-  }
+  for (const MethodRun& run : r.methods) j["methods"].push_back(MethodJson(run));
   j["ablation"] = nlohmann::json::array();
   for (const AblationCell& c : r.ablation) {
     j["ablation"].push_back({{"method", ToString(c.method)},
@@ -734,12 +739,21 @@ CompareReportFiles WriteCompareReport(const JobConfig& base, const CompareResult
     page.Paragraph("No study: " + qa.why_not);
     md += "No study: " + qa.why_not + "\n\n";
   } else {
-    const std::string text =
-        std::to_string(qa.frames) + " network answers, " + std::to_string(qa.bad_frames) +
-        " with MPJPE > " + Number(qa.error_mm, 0) +
-        " mm. Thresholds chosen by Youden's J on " + std::to_string(qa.selection_frames) +
-        " frames (even positions), judged on the " + std::to_string(qa.held_out_frames) +
-        " held-out frames (odd positions).";
+    std::string chosen_on =
+        std::to_string(qa.selection_frames) + " frames (even positions), judged on the " +
+        std::to_string(qa.held_out_frames) + " held-out frames (odd positions).";
+    if (!qa.selection_dirs.empty()) {
+      std::string dirs;
+      for (const std::string& d : qa.selection_dirs)
+        dirs += (dirs.empty() ? "" : ", ") + d;
+      chosen_on = std::to_string(qa.selection_frames) + " network answers of " + dirs +
+                  ", judged on all " + std::to_string(qa.held_out_frames) +
+                  " answers of this run (held out).";
+    }
+    const std::string text = std::to_string(qa.frames) + " network answers, " +
+                             std::to_string(qa.bad_frames) + " with MPJPE > " +
+                             Number(qa.error_mm, 0) +
+                             " mm. Thresholds chosen by Youden's J on " + chosen_on;
     page.Paragraph(text);
     const HtmlTable checks = QaTable(qa), share = QaShareTable(qa);
     page.Table(checks);

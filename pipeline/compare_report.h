@@ -22,6 +22,11 @@ struct CompareReportFiles {
   std::string json, markdown, html, pictures_dir;
 };
 
+// One method's row as JSON: its metrics by column key (mm, AUC; null where there is
+// none), PCK curves, per-keypoint and per-frame errors, how it ran. compare.json's
+// "methods" entries and `eval-network --capture --json` (one writer for both).
+nlohmann::json MethodJson(const MethodRun& run);
+
 // The result as JSON (the numbers the report shows).
 nlohmann::json CompareToJson(const JobConfig& base, const CompareResult& result,
                              const QualityStudy& qa);

@@ -150,6 +150,12 @@ void CompareOptions::Check() const {
     throw InputError(cli, "--worst-frames", ">= 0", std::to_string(worst_frames));
   if (!(qa_error_mm > 0))
     throw InputError(cli, "--qa-error-mm", "> 0", std::to_string(qa_error_mm));
+  for (const std::string& dir : qa_selection) {
+    if (!fs::exists(fs::path(dir) / "compare.json")) {
+      throw InputError(cli, "--qa-selection", "compare output folders (compare.json)",
+                       dir);
+    }
+  }
 }
 
 JobConfig CompareCaptureJob(const std::string& capture_dir, const std::string& weights,

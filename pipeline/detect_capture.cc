@@ -8,8 +8,10 @@
 #include "capture/capture_reader.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/image_file.h"
 #include "core/json_util.h"
 #include "core/stopwatch.h"
+#include "pipeline/detect_overlay.h"
 
 namespace handlabel {
 namespace {
@@ -26,6 +28,19 @@ void ListDetections(const CaptureReader& capture) {
   manifest.files[kFileDetections] = kDetectionsPattern;
   WriteFileAtomically(capture.dir() + "/capture.json",
                       ManifestToJson(manifest).dump(2) + "\n");
+}
+
+// One picture per view: the image with the view's detection drawn on it.
+void WriteDetectionOverlays(const std::string& dir, const std::string& frame,
+                            const std::vector<std::string>& cameras,
+                            const FrameHandResult& result, std::vector<ImageU8> images) {
+  const std::filesystem::path frame_dir = std::filesystem::path(dir) / frame;
+  std::filesystem::create_directories(frame_dir);
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    DrawHandDetection(result.views[c], &images[c]);
+    WriteFileAtomically((frame_dir / (cameras[c] + ".png")).string(),
+                        EncodePng(images[c]));
+  }
 }
 
 }  // namespace
@@ -100,6 +115,10 @@ DetectCaptureSummary DetectCapture(const std::string& capture_dir,
     const FrameHandResult result =
         DetectHandMultiView(detector, capture.rig(), images, options.multiview);
     const std::string id = capture.frame_id(f);
+    if (!options.overlays_dir.empty()) {
+      WriteDetectionOverlays(options.overlays_dir, id, capture.manifest().cameras, result,
+                             std::move(images));
+    }
     WriteFileAtomically(
         capture_dir + "/" + ExpandPattern(kDetectionsPattern, "", id),
         FrameDetectionsJson(id, capture.manifest().cameras, result).dump(1) + "\n");

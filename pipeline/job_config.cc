@@ -159,6 +159,25 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
   job->object_masks = object_masks == "files";
   evidence.Read("ignore_views", &job->ignore_views);
   evidence.Read("detections", &job->detections);
+  evidence.Read("detector_model", &job->detector_model);
+  if (job->detector_model != "full" && job->detector_model != "lite") {
+    throw InputError(path, evidence.Name("detector_model"), "full | lite",
+                     "'" + job->detector_model + "'");
+  }
+  if (keypoints != "network" && keypoints != "files" && keypoints != "both" &&
+      keypoints != "detector") {
+    throw InputError(path, evidence.Name("keypoints_2d"),
+                     "network | files | both | detector", "'" + keypoints + "'");
+  }
+  if (keypoints == "detector") {
+    keypoints = "files";  // the detector's 2D is file-like evidence from here on
+    job->keypoints_from_detector = true;
+    if (!job->detections.empty()) {
+      throw InputError(path, evidence.Name("detections"),
+                       "empty with keypoints_2d: detector (one source of 2D)",
+                       "'" + job->detections + "'");
+    }
+  }
   if (!(job->network_mask_sigma_px >= 0)) {
     throw InputError(path, evidence.Name("network_mask_sigma_px"),
                      "> 0 pixels, or 0 for the default",

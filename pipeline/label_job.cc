@@ -154,6 +154,7 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   if (!job.fit.IsDefault()) extra["fit"] = FitSettingsJson(job.fit);
   if (!job.object_masks) extra["object_masks"] = "none";
   if (!job.detections.empty()) extra["detections"] = job.detections;
+  if (job.keypoints_from_detector) extra["detector"] = job.detector_model;
   if (!extra.empty()) j["added"] = extra;
   return Sha256Hex(j.dump());
 }

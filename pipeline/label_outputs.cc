@@ -26,6 +26,28 @@ std::string TemporaryTarget(const std::string& file_name) {
   return at == std::string::npos ? "" : file_name.substr(0, at);
 }
 
+// What the shards' summaries say the 2D keypoints were (every shard of a job has the
+// same); "" when no shard has written its summary yet.
+std::string KeypointsSourceOfShards(const std::string& output_dir) {
+  const fs::path shards = fs::path(output_dir) / "shards";
+  if (!fs::is_directory(shards)) return "";
+  for (const auto& entry : fs::directory_iterator(shards)) {
+    const std::string name = entry.path().filename().string();
+    const std::string suffix = ".summary.json";
+    if (name.size() <= suffix.size() ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
+      continue;
+    }
+    std::ifstream in(entry.path());
+    const nlohmann::json j =
+        nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (j.is_object() && j.value("keypoints_2d_source", "") != "") {
+      return j["keypoints_2d_source"].get<std::string>();
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string ShardLogPath(const std::string& output_dir, const ShardSpec& shard) {
@@ -142,7 +164,9 @@ LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string&
     entries.push_back(entry);
   }
   LabelSummary summary = Summarize(frames, records);
-  summary.keypoints_2d_source = keypoints_2d_source;
+  summary.keypoints_2d_source = keypoints_2d_source.empty()
+                                    ? KeypointsSourceOfShards(output_dir)
+                                    : keypoints_2d_source;
   const nlohmann::json manifest = {{"format", "handlabel-manifest"},
                                    {"format_version", 1},
                                    {"job", job_name},

@@ -42,7 +42,8 @@ void CheckOutputsBelongToJob(const std::string& output_dir, const std::string& j
 // missing frame with why ("f7 (not yet run)"). Writes manifest.json (frames, status,
 // path, label file, reason: nothing run-dependent, so it is identical however the job was
 // sharded), summary.json and summary.md, each atomically, and returns the summary.
-// `keypoints_2d_source` (FrameSource::KeypointsSource) is stated in the summary.
+// `keypoints_2d_source` (FrameSource::KeypointsSource) is stated in the summary; ""
+// takes it from the shards' summaries (what `merge` knows).
 LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string& job_name,
                                const std::string& job_hash,
                                const std::vector<std::string>& frames,

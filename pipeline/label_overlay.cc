@@ -8,6 +8,7 @@
 #include "core/hand_skeleton.h"
 #include "core/image_file.h"
 #include "core/rasterizer.h"
+#include "pipeline/detect_overlay.h"
 #include "pipeline/label_outputs.h"
 
 namespace handlabel {
@@ -77,6 +78,8 @@ ImageU8 OverlayBackground(const std::string& path, const RigCamera& camera) {
 
 void RasterOverlayWriter::Write(const std::string& output_dir, const FrameInput& frame,
                                 const LabelRecord& label) const {
+  const std::optional<FrameHandResult> detection =
+      detections_ ? detections_->Take(frame.id) : std::nullopt;
   for (size_t v = 0; v < frame.rig.size(); ++v) {
     const RigCamera& camera = frame.rig[v];
     // Grey only for a view without an image file; a file that cannot be read or does
@@ -86,6 +89,9 @@ void RasterOverlayWriter::Write(const std::string& output_dir, const FrameInput&
       rgb = OverlayBackground(frame.image_paths[v], camera);
     }
     DrawLabelOverlay(camera, label, faces_, &rgb);
+    if (detection && v < detection->views.size()) {
+      DrawHandDetection(detection->views[v], &rgb);
+    }
     WriteFileAtomically(OverlayPath(output_dir, frame.id, camera.name), EncodePng(rgb));
   }
 }

@@ -2,12 +2,15 @@
 // Overlay pictures of a label: on every view's image, the label's mesh (shaded,
 // half transparent, drawn with the real camera model, distortion included) and its 21
 // keypoints with the hand skeleton, one colour per finger. Written atomically as
-// <output.dir>/overlays/<frame>/<camera>.png.
+// <output.dir>/overlays/<frame>/<camera>.png. When the job's 2D came from the hand
+// detector, its palms, ROI, keypoints and per-view reason are drawn too.
 
+#include <memory>
 #include <string>
 
 #include "core/hand_model.h"
 #include "core/image.h"
+#include "pipeline/detect_frame_source.h"
 #include "pipeline/label_job.h"
 
 namespace handlabel {
@@ -18,7 +21,12 @@ void DrawLabelOverlay(const RigCamera& camera, const LabelRecord& label,
 
 class RasterOverlayWriter : public OverlayWriter {
  public:
-  explicit RasterOverlayWriter(const HandModel& model) : faces_(model.faces) {}
+  // `detections`: the detector's answers when the job's 2D comes from it
+  // (evidence.keypoints_2d: detector); each view then also shows its detection
+  // (pipeline/detect_overlay.h). Null: the label only.
+  explicit RasterOverlayWriter(const HandModel& model,
+                               std::shared_ptr<DetectionStore> detections = nullptr)
+      : faces_(model.faces), detections_(std::move(detections)) {}
   // Reads each view's image (a grey picture for a view without an image file), draws,
   // writes. An image that cannot be read or has another size than its camera throws
   // (the frame fails naming the file): never a grey overlay over a broken capture.
@@ -27,6 +35,7 @@ class RasterOverlayWriter : public OverlayWriter {
 
  private:
   Faces faces_;
+  std::shared_ptr<DetectionStore> detections_;
 };
 
 }  // namespace handlabel

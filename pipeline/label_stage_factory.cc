@@ -7,6 +7,7 @@
 #include "capture/oakink_frame_source.h"
 #include "core/errors.h"
 #include "pipeline/ceres_label_fitter.h"
+#include "pipeline/detect_frame_source.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/network_stage.h"
@@ -79,7 +80,8 @@ std::unique_ptr<FrameSource> BuildCaptureSource(const JobConfig& job,
 
 }  // namespace
 
-std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
+std::unique_ptr<FrameSource> BuildFrameSource(
+    const JobConfig& job, std::shared_ptr<DetectionStore> detections) {
   std::optional<Rig> cameras;
   if (job.cameras_source == "file")
     cameras = ReadCamerasFile(job.cameras_file, job.source_file);
@@ -87,6 +89,12 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
   if (!job.detections.empty()) {
     source = std::make_unique<DetectionsFrameSource>(
         std::move(source), job.detections, job.source_file + ": evidence.detections");
+  }
+  if (job.keypoints_from_detector) {
+    DetectCaptureOptions detect;
+    detect.hands.model = job.detector_model;
+    source = std::make_unique<DetectorFrameSource>(std::move(source), detect,
+                                                   std::move(detections));
   }
   // A dataset without 2D keypoints gives the network nothing to crop on and the fit
   // nothing to fit: the job must name its 2D.
@@ -103,7 +111,13 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job) {
 
 BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   BuiltLabelStages built;
-  built.source = BuildFrameSource(job);
+  // The detector's answers, for overlays that show them (evidence.keypoints_2d:
+  // detector).
+  std::shared_ptr<DetectionStore> detections;
+  if (job.keypoints_from_detector && job.overlays) {
+    detections = std::make_shared<DetectionStore>();
+  }
+  built.source = BuildFrameSource(job, detections);
   const HandSide side = built.source->side().value_or(HandSide::kRight);
   ResolvedHandModel hand = ResolveHandModel(job.hand_model, side);
   built.hand_model = std::move(hand.model);
@@ -123,8 +137,9 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
     built.fitter =
         std::make_unique<CeresLabelFitter>(built.hand_model, FitterOptions(job));
   }
-  if (job.overlays)
-    built.overlays = std::make_unique<RasterOverlayWriter>(built.hand_model);
+  if (job.overlays) {
+    built.overlays = std::make_unique<RasterOverlayWriter>(built.hand_model, detections);
+  }
   return built;
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/hand_model.h"
+#include "pipeline/detect_frame_source.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"
 
@@ -28,7 +29,10 @@ struct BuiltLabelStages {
 // Throws InputError naming the job file and the field whose stage cannot be built.
 BuiltLabelStages BuildLabelStages(const JobConfig& job);
 
-// Only the frame source (what `handlabel merge` needs to list the job's frames).
-std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job);
+// Only the frame source (what `handlabel merge` needs to list the job's frames). With
+// evidence.keypoints_2d: detector, the detector's answers go into `detections` when
+// given.
+std::unique_ptr<FrameSource> BuildFrameSource(
+    const JobConfig& job, std::shared_ptr<DetectionStore> detections = nullptr);
 
 }  // namespace handlabel

@@ -131,17 +131,48 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   return r;
 }
 
-void WritePckPlot(const NetworkEvalResult& r, const std::string& png_path,
-                  const std::string& title) {
-  auto mm = [](std::vector<double> v) {
-    for (double& x : v) x *= 1000;
-    return v;
-  };
+void CaptureNetworkEvalOptions::Check() const {
+  const char* cli = "command line";
+  if (capture.empty()) throw InputError(cli, "--capture", "a capture folder");
+  if (weights.empty()) throw InputError(cli, "--weights", "a checkpoint");
+  if (out_dir.empty()) throw InputError(cli, "--out", "an output folder");
+  if (max_frames < 0)
+    throw InputError(cli, "--max-frames", ">= 0", std::to_string(max_frames));
+  if (threads < 0) throw InputError(cli, "--threads", ">= 0", std::to_string(threads));
+  if (auc_max_mm < 0)
+    throw InputError(cli, "--auc-max-mm", ">= 0", std::to_string(auc_max_mm));
+}
+
+CompareResult EvaluateNetworkOnCapture(const CaptureNetworkEvalOptions& o,
+                                       std::ostream* log) {
+  o.Check();
+  JobConfig base =
+      CompareCaptureJob(o.capture, o.weights, o.frames, o.max_frames, o.threads, o.seed);
+  base.hand_model = o.hand_model;
+  CompareOptions compare;
+  compare.out_dir = o.out_dir;
+  compare.methods = {CompareMethod::kNetwork};
+  compare.auc_max_mm = o.auc_max_mm;
+  return RunComparison(base, compare, log);
+}
+
+namespace {
+
+std::vector<double> Mm(std::vector<double> v) {
+  for (double& x : v) x *= 1000;
+  return v;
+}
+
+void WritePckCurves(const PckCurve& joints, const PckCurve* vertices,
+                    const std::string& png_path, const std::string& title) {
   char jn[64], vn[64];
-  std::snprintf(jn, sizeof(jn), "joints AUC %.3f", r.joint_pck.auc);
-  std::snprintf(vn, sizeof(vn), "vertices AUC %.3f", r.vertex_pck.auc);
-  PlotSeries joints{jn, mm(r.joint_pck.thresholds), r.joint_pck.pck, PlotColor(0)};
-  PlotSeries verts{vn, mm(r.vertex_pck.thresholds), r.vertex_pck.pck, PlotColor(1)};
+  std::snprintf(jn, sizeof(jn), "joints AUC %.3f", joints.auc);
+  std::vector<PlotSeries> series = {
+      {jn, Mm(joints.thresholds), joints.pck, PlotColor(0)}};
+  if (vertices) {
+    std::snprintf(vn, sizeof(vn), "vertices AUC %.3f", vertices->auc);
+    series.push_back({vn, Mm(vertices->thresholds), vertices->pck, PlotColor(1)});
+  }
   PlotOptions o;
   o.width = 640;
   o.height = 420;
@@ -150,7 +181,20 @@ void WritePckPlot(const NetworkEvalResult& r, const std::string& png_path,
   o.y_label = "PCK";
   o.y_min = 0;
   o.y_max = 1;
-  WritePng(png_path, DrawLinePlot({joints, verts}, o));
+  WritePng(png_path, DrawLinePlot(series, o));
+}
+
+}  // namespace
+
+void WritePckPlot(const NetworkEvalResult& r, const std::string& png_path,
+                  const std::string& title) {
+  WritePckCurves(r.joint_pck, &r.vertex_pck, png_path, title);
+}
+
+void WritePckPlot(const MethodScores& s, const std::string& png_path,
+                  const std::string& title) {
+  WritePckCurves(s.joint_pck, s.vertex_errors.cols() > 0 ? &s.vertex_pck : nullptr,
+                 png_path, title);
 }
 
 }  // namespace handlabel

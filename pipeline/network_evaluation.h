@@ -1,8 +1,13 @@
 #pragma once
-// Accuracy of POEM weights on held-out synthetic frames (`handlabel eval-network`):
-// frames from the synthetic generator with a chosen seed, plain crops around the true
-// 2D keypoint box (no augmentation), one forward pass per batch, and the POEM paper's
-// metrics (core/metrics.h) on the last decoder layer in the master frame.
+// Accuracy of POEM weights (`handlabel eval-network`), two ways:
+//  - on held-out synthetic frames (EvaluatePoemOnSynth): frames from the synthetic
+//    generator with a chosen seed, plain crops around the true 2D keypoint box (no
+//    augmentation), one forward pass per batch, and the POEM paper's metrics
+//    (core/metrics.h) on the last decoder layer in the master frame;
+//  - on a capture's frames (EvaluateNetworkOnCapture, `--capture`): the labeling
+//    job's network stage (its detector boxes and crops) on the capture's frames,
+//    scored against the capture's truth. This is `compare`'s `network` row run alone
+//    (pipeline/compare_run.h): one code path, so the numbers are that row's.
 
 #include <cstdint>
 #include <functional>
@@ -11,6 +16,7 @@
 #include "capture/synth_capture.h"
 #include "core/hand_model.h"
 #include "core/metrics.h"
+#include "pipeline/compare_run.h"
 #include "pipeline/training_samples.h"
 
 namespace handlabel {
@@ -50,8 +56,32 @@ struct NetworkEvalResult {
 NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOptions& o,
                                       const std::function<void(int, int)>& progress = {});
 
+// `eval-network --capture`: the base job `compare --capture` builds (the same
+// frames, seed, threads and hand model give the same job), run as compare's network
+// row only (no other method, no ablation).
+struct CaptureNetworkEvalOptions {
+  std::string capture;     // native capture folder with ground truth
+  std::string weights;     // network checkpoint
+  std::string frames;      // 'all', 'a:b' or 'id,id,...'; empty = all
+  int max_frames = 0;      // the first N of `frames`; 0 = all
+  int threads = 0;         // the job's worker threads; 0 = all cores
+  uint64_t seed = 0;       // the job's seed (recorded in every label)
+  std::string hand_model;  // model file or 'capsule'; empty = the shipped open hand
+  std::string out_dir;     // the network's label job goes to <out_dir>/methods/network
+  double auc_max_mm = 0;   // PCK / AUC range; 0 = 50 for HO3D-like input, else 20
+  // Throws InputError naming the flag.
+  void Check() const;
+};
+
+// The comparison with the network row alone (result.methods has one entry).
+CompareResult EvaluateNetworkOnCapture(const CaptureNetworkEvalOptions& options,
+                                       std::ostream* log);
+
 // PNG of the joint and vertex PCK curves (threshold in mm).
 void WritePckPlot(const NetworkEvalResult& result, const std::string& png_path,
+                  const std::string& title);
+// The same for a scored method (vertices only where it has them).
+void WritePckPlot(const MethodScores& scores, const std::string& png_path,
                   const std::string& title);
 
 }  // namespace handlabel

@@ -66,12 +66,16 @@ void ReadData(Section data, TrainConfig* c) {
   data.Read("max_objects", &c->synth.scene.max_objects);
   data.Read("object_probability", &c->synth.scene.object_probability);
   data.Read("clutter", &clutter);
+  std::string appearance = SynthAppearanceName(c->synth.view.appearance);
+  data.Read("appearance", &appearance);
   data.Read("frame_reuse", &c->samples.frame_reuse);
   data.Read("box_scale", &c->samples.box_scale);
   data.Read("generator_threads", &c->synth.num_threads);
   data.RejectUnknownKeys();
   c->synth.scene.objects = objects;
   c->synth.view.background.clutter = clutter;
+  c->synth.view.appearance =
+      SynthAppearanceFromName(appearance, c->source_file, data.Name("appearance"));
 }
 
 // augment.*

@@ -143,6 +143,67 @@ TEST_F(CompareCommand, NetworkRowsEqualLabelJobs) {
   }
 }
 
+// eval-network --capture is compare's network row run alone: the same numbers, every
+// column and every frame.
+TEST_F(CompareCommand, NetworkRowEqualsEvalNetworkOnTheCapture) {
+  ASSERT_EQ(result_->status, 0) << result_->err;
+  const nlohmann::json c = ReadJson(*dir_ + "/compare/compare.json");
+  const nlohmann::json& row = Method(c, "network");
+  std::vector<std::string> args = {"eval-network",
+                                   "--capture",
+                                   *dir_ + "/capture",
+                                   "--weights",
+                                   *dir_ + "/tiny.pt",
+                                   "--hand-model",
+                                   "capsule",
+                                   "--threads",
+                                   "2",
+                                   "--seed",
+                                   "3"};
+  args.insert(args.end(), {"--json", *dir_ + "/eval_all.json"});
+  const auto eval = RunHandlabelCommand(args);
+  ASSERT_EQ(eval.status, 0) << eval.err;
+  EXPECT_THAT(eval.out, HasSubstr("RR-J"));
+  const nlohmann::json e = ReadJson(*dir_ + "/eval_all.json").at("method");
+  EXPECT_EQ(e.at("method"), "network");
+  for (const auto& [key, value] : row.at("metrics").items()) {
+    if (key == "seconds_per_frame") continue;  // a timing
+    const nlohmann::json& other = e.at("metrics").at(key);
+    if (value.is_null()) {
+      EXPECT_TRUE(other.is_null()) << key;
+    } else {
+      EXPECT_NEAR(other.get<double>(), value.get<double>(), 1e-9) << key;
+    }
+  }
+  EXPECT_EQ(e.at("metrics").at("frames").get<int>(), 3);
+  for (size_t i = 0; i < row.at("joint_pck").size(); ++i) {
+    EXPECT_NEAR(e.at("joint_pck")[i].get<double>(), row.at("joint_pck")[i].get<double>(),
+                1e-12);
+  }
+  const nlohmann::json& per_frame = e.at("per_frame_mpjpe_mm");
+  ASSERT_EQ(per_frame.size(), 3u);
+  for (const auto& [frame, mm] : per_frame.items()) {
+    EXPECT_NEAR(mm.get<double>(), row.at("per_frame_mpjpe_mm").at(frame).get<double>(),
+                1e-9)
+        << frame;
+  }
+}
+
+TEST(EvalNetworkCapture, SyntheticFlagsAreRefusedNamingTheFlag) {
+  const std::string dir = testing::ScratchDir();
+  auto r = RunHandlabelCommand(
+      {"eval-network", "--weights", dir + "/w.pt", "--capture", dir, "--preset", "ho3d"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_THAT(r.err, HasSubstr("--preset"));
+  r = RunHandlabelCommand({"eval-network", "--weights", dir + "/w.pt", "--json", "x"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_THAT(r.err, HasSubstr("--json"));
+  r = RunHandlabelCommand(
+      {"eval-network", "--weights", dir + "/w.pt", "--frames", "0:3"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_THAT(r.err, HasSubstr("--frames"));
+}
+
 // RR-J computed here from the label files and the capture's truth, the plain way.
 TEST_F(CompareCommand, RootRelativeErrorsFromTheLabels) {
   ASSERT_EQ(result_->status, 0) << result_->err;

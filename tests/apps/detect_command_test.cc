@@ -6,6 +6,10 @@
 
 #include "capture/capture_reader.h"
 #include "core/data_dir.h"
+#include "core/image_file.h"
+#include "pipeline/detect_overlay.h"
+#include "pipeline/job_config.h"
+#include "pipeline/label_stage_factory.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 
@@ -98,6 +102,75 @@ TEST(DetectCommand, CaptureViewsGetDetectionsOrReasons) {
     std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
     EXPECT_LT(errors[errors.size() / 2], 25.0) << "camera " << c;
   }
+}
+
+// A job file for the capture in `capture` whose 2D is `keypoints_2d` (fit-only).
+void WriteFitOnlyJob(const std::string& path, const std::string& capture,
+                     const std::string& keypoints_2d, const std::string& out) {
+  std::ofstream(path) << "name: t\nseed: 3\ninput:\n  format: native\n  path: " << capture
+                      << "\nnetwork:\n  weights: \"\"\nrefine:\n  mode: always\n"
+                      << "evidence:\n  keypoints_2d: " << keypoints_2d
+                      << "\n  masks: none\noutput:\n  dir: " << out
+                      << "\n  meshes: []\n  overlays: true\n  evaluate: true\n";
+}
+
+// `evidence.keypoints_2d: detector` runs the detector inside the job: its 2D is what
+// `handlabel detect` + `keypoints_2d: files` gives, bit for bit, so the labels agree too;
+// its overlays show the detections.
+TEST(DetectCommand, LabelJobWithDetectorGivesTheSame2dAsDetectThenFiles) {
+  if (!ModelsPresent()) {
+    GTEST_SKIP() << "MediaPipe models absent: run scripts/fetch-mediapipe-models";
+  }
+  namespace fs = std::filesystem;
+  const std::string dir = testing::ScratchDir();
+  ASSERT_EQ(RunHandlabelCommand({"synth", "--preset", "dexycb", "--frames", "1", "--seed",
+                                 "3", "--no-detections", "--out", dir + "/cap"})
+                .status,
+            0);
+  fs::copy(dir + "/cap", dir + "/detected", fs::copy_options::recursive);
+  ASSERT_EQ(RunHandlabelCommand({"detect", "--capture", dir + "/detected"}).status, 0);
+  WriteFitOnlyJob(dir + "/detector.yaml", dir + "/cap", "detector", dir + "/labels_a");
+  WriteFitOnlyJob(dir + "/files.yaml", dir + "/detected", "files", dir + "/labels_b");
+
+  const auto in_job = BuildFrameSource(LoadJobConfig(dir + "/detector.yaml"));
+  const auto from_files = BuildFrameSource(LoadJobConfig(dir + "/files.yaml"));
+  EXPECT_NE(in_job->KeypointsSource().find("detector"), std::string::npos);
+  const FrameInput a = in_job->Load("000000"), b = from_files->Load("000000");
+  ASSERT_EQ(a.keypoints_2d.size(), b.keypoints_2d.size());
+  int known = 0;
+  for (size_t c = 0; c < a.keypoints_2d.size(); ++c) {
+    ASSERT_TRUE(a.keypoints_2d[c] && b.keypoints_2d[c]) << "camera " << c;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      EXPECT_EQ(a.keypoints_2d[c]->confidence(k), b.keypoints_2d[c]->confidence(k));
+      EXPECT_EQ(a.keypoints_2d[c]->uv_px(k, 0), b.keypoints_2d[c]->uv_px(k, 0));
+      EXPECT_EQ(a.keypoints_2d[c]->uv_px(k, 1), b.keypoints_2d[c]->uv_px(k, 1));
+      known += a.keypoints_2d[c]->confidence(k) > 0;
+    }
+  }
+  EXPECT_GE(known, 6 * kNumHandKeypoints / 2);  // the hand was found in several views
+
+  const testing::CommandResult ra =
+      RunHandlabelCommand({"label", "--job", dir + "/detector.yaml"});
+  ASSERT_EQ(ra.status, 0) << ra.err;
+  const testing::CommandResult rb =
+      RunHandlabelCommand({"label", "--job", dir + "/files.yaml"});
+  ASSERT_EQ(rb.status, 0) << rb.err;
+  const nlohmann::json la = ReadJson(dir + "/labels_a/labels/000000.json");
+  const nlohmann::json lb = ReadJson(dir + "/labels_b/labels/000000.json");
+  EXPECT_EQ(la["mano"].dump(), lb["mano"].dump());
+  EXPECT_EQ(la["keypoints_3d"].dump(), lb["keypoints_3d"].dump());
+  // The detector job's overlays carry the detections: the palm-box or ROI colours.
+  const ImageU8 overlay = ReadImageFile(dir + "/labels_a/overlays/000000/cam00.png");
+  const ImageU8 plain = ReadImageFile(dir + "/labels_b/overlays/000000/cam00.png");
+  int roi_pixels = 0, plain_roi_pixels = 0;
+  for (size_t p = 0; p + 2 < overlay.data.size(); p += 3) {
+    const Rgb a_px = {overlay.data[p], overlay.data[p + 1], overlay.data[p + 2]};
+    const Rgb b_px = {plain.data[p], plain.data[p + 1], plain.data[p + 2]};
+    roi_pixels += a_px == kRoiColor || a_px == kNoHandColor;
+    plain_roi_pixels += b_px == kRoiColor || b_px == kNoHandColor;
+  }
+  EXPECT_GT(roi_pixels, 100);
+  EXPECT_EQ(plain_roi_pixels, 0);
 }
 
 }  // namespace

@@ -1,9 +1,7 @@
 // End-to-end tests of `handlabel label` / `handlabel merge` on a synthetic capture with
 // the real fitter: kill -9 at random moments and resume, shards and merge, usage.
 
-#include <fcntl.h>
 #include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gmock/gmock.h>
@@ -29,32 +27,8 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using testing::RunHandlabelCommand;
 
-std::string Binary() { return std::string(HANDLABEL_BINARY_DIR) + "/apps/handlabel"; }
-
-// Starts the real binary; output goes to `log`.
-pid_t Spawn(const std::vector<std::string>& args, const std::string& log) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    std::vector<char*> argv;
-    std::string binary = Binary();
-    argv.push_back(binary.data());
-    std::vector<std::string> copy = args;
-    for (std::string& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(binary.c_str(), argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-int Wait(pid_t pid) {
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
-}
+using testing::SpawnHandlabel;
+using testing::WaitForExit;
 
 // Nothing half-written: every label on disk parses completely, every mesh has all
 // its vertex and face lines, and every frame the log calls finished has its label.
@@ -96,7 +70,8 @@ TEST(LabelCommand,
       testing::WriteTestJob(dir, "killed", "capture", "killed");
 
   const auto start = std::chrono::steady_clock::now();
-  ASSERT_EQ(Wait(Spawn({"label", "--job", reference_job}, dir + "/ref.log")), 0)
+  ASSERT_EQ(
+      WaitForExit(SpawnHandlabel({"label", "--job", reference_job}, dir + "/ref.log")), 0)
       << testing::ReadFileBytes(dir + "/ref.log");
   const double full_run_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -107,20 +82,21 @@ TEST(LabelCommand,
   int finished_before = 0, killed_mid_run = 0;
   for (int round = 0; round < rounds; ++round) {
     const pid_t pid =
-        Spawn({"label", "--job", killed_job, "--resume"}, dir + "/killed.log");
+        SpawnHandlabel({"label", "--job", killed_job, "--resume"}, dir + "/killed.log");
     // Round 0 kills well inside the run's time, so at least one kill lands mid-run.
     const double kill_after_s = round == 0 ? testing::Uniform(0.2, 0.6) * full_run_s
                                            : testing::Uniform(0.0, full_run_s);
     std::this_thread::sleep_for(std::chrono::duration<double>(kill_after_s));
     kill(pid, SIGKILL);
-    killed_mid_run += Wait(pid) == -SIGKILL;
+    killed_mid_run += WaitForExit(pid) == -SIGKILL;
     ExpectConsistent(dir + "/killed");
     const int finished = FinishedFrames(dir + "/killed");
     EXPECT_GE(finished, finished_before)
         << "a finished frame was lost in round " << round;
     finished_before = finished;
   }
-  ASSERT_EQ(Wait(Spawn({"label", "--job", killed_job, "--resume"}, dir + "/killed.log")),
+  ASSERT_EQ(WaitForExit(SpawnHandlabel({"label", "--job", killed_job, "--resume"},
+                                       dir + "/killed.log")),
             0)
       << testing::ReadFileBytes(dir + "/killed.log");
   RecordProperty("kill_rounds", rounds);
@@ -169,6 +145,10 @@ TEST(LabelCommand, ShardsFromFlagOrEnvironmentMergeToTheSingleProcessResult) {
   const auto merged = RunHandlabelCommand({"merge", "--job", sharded});
   ASSERT_EQ(merged.status, 0) << merged.err;
   EXPECT_THAT(merged.out, HasSubstr("5 frames: 5 labelled"));
+  // merge states where the 2D came from, as the shards did.
+  EXPECT_THAT(merged.out, HasSubstr("2D keypoints: "));
+  EXPECT_THAT(testing::ReadFileBytes(dir + "/sharded/summary.md"),
+              HasSubstr("2D keypoints: "));
   EXPECT_EQ(testing::FilesUnder(dir + "/sharded/labels"),
             testing::FilesUnder(dir + "/single/labels"));
   EXPECT_EQ(testing::ReadFileBytes(dir + "/sharded/manifest.json"),

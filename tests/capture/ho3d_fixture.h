@@ -34,7 +34,7 @@ struct Ho3dFixture {
 };
 
 inline std::string Fid(int frame) {
-  char text[8];
+  char text[16];
   std::snprintf(text, sizeof(text), "%04d", frame);
   return text;
 }

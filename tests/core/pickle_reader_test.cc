@@ -251,7 +251,9 @@ TEST(PickleReader, FuzzCorpusSmoke) {
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     const std::string bytes = testing::ReadFileBytes(entry.path().string());
     const std::string error = PickleError(bytes);
-    if (entry.path().extension() == ".pkl") EXPECT_EQ(error, "") << entry.path();
+    if (entry.path().extension() == ".pkl") {
+      EXPECT_EQ(error, "") << entry.path();
+    }
     ++inputs;
     for (int trial = 0; trial < 20 && !bytes.empty(); ++trial) {
       std::string bad = bytes;

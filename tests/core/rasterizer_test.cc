@@ -246,7 +246,9 @@ TEST(Rasterizer, SphereSilhouetteMatchesTheAnalyticSphere) {
         const double t = c.dot(d) - std::sqrt(radius * radius - dist * dist);
         EXPECT_NEAR(buffer.depth[buffer.index(x, y)], t * d.z(), 1e-3);
       }
-      if (dist > radius * 1.01) EXPECT_FALSE(drawn);
+      if (dist > radius * 1.01) {
+        EXPECT_FALSE(drawn);
+      }
     }
   }
 }

@@ -87,7 +87,9 @@ TEST_P(ZipRoundTrip, ReaderReturnsWhatWriterWrote) {
     EXPECT_EQ(zip.Read(e), files[i].second) << e.name;
     if (GetParam().alignment > 1 && e.method == 0) {
       const size_t data_start = bytes.find(files[i].second, e.local_header_offset + 30);
-      if (!files[i].second.empty()) EXPECT_EQ(data_start % GetParam().alignment, 0u);
+      if (!files[i].second.empty()) {
+        EXPECT_EQ(data_start % GetParam().alignment, 0u);
+      }
     }
   }
   if (GetParam().method == ZipMethod::kDeflate) {

@@ -4,7 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
+#include "core/errors.h"
 #include "pipeline/compare_qa.h"
+#include "pipeline/compare_report.h"
 #include "pipeline/label_record.h"
 #include "tests/test_util.h"
 
@@ -72,6 +77,46 @@ TEST(CompareQa, FindsThePerfectCheckAndKeepsFewerBadAnswers) {
   // The uninformative check keeps its threshold (J = 0 everywhere) or any value:
   // it must not flag good answers more than bad ones.
   EXPECT_LE(s.checks[1].roc_auc, 0.5 + 1e-12);
+}
+
+// Thresholds chosen on an earlier comparison's answers (its compare.json and labels,
+// written here as compare writes them), judged on every answer of this run.
+TEST(CompareQa, ChoosesOnEarlierComparisonsAndHoldsOutThisRun) {
+  QualityThresholds loose;
+  loose.max_reprojection_px = 40;
+  const std::string scratch = testing::ScratchDir();  // one per test: call once
+  const std::string selection_dir = scratch + "/selection";
+  MethodRun selection = NetworkRun(selection_dir + "/methods/network", 20, loose);
+  selection.has_truth = true;  // 2 .. 21 mm
+  {
+    std::ofstream out(selection_dir + "/compare.json");
+    out << nlohmann::json{{"methods", {MethodJson(selection)}}}.dump();
+  }
+  ASSERT_TRUE(std::filesystem::exists(selection_dir + "/compare.json"));
+  const MethodRun run = NetworkRun(scratch + "/run", 10, loose);  // 2 .. 11 mm
+  const QualityStudy s = StudyQualityChecks(run, loose, 8.0, {selection_dir});
+  ASSERT_TRUE(s.why_not.empty()) << s.why_not;
+  EXPECT_EQ(s.selection_frames, 20);
+  EXPECT_EQ(s.held_out_frames, 10);
+  // All 20 selection answers separate 8 mm (16 px) from 9 mm (18 px).
+  EXPECT_GE(s.chosen.max_reprojection_px, 16.0);
+  EXPECT_LT(s.chosen.max_reprojection_px, 18.0);
+  // Every answer of this run is held out: before, all 10 kept (9, 10, 11 mm bad);
+  // after, 2 .. 8 mm kept, none bad.
+  EXPECT_EQ(s.before.answers, 10);
+  EXPECT_EQ(s.before.kept, 10);
+  EXPECT_EQ(s.before.kept_bad, 3);
+  EXPECT_EQ(s.after.kept, 7);
+  EXPECT_EQ(s.after.kept_bad, 0);
+  EXPECT_DOUBLE_EQ(s.after.KeptFraction(), 0.7);
+  // A folder without compare.json is named in the error.
+  try {
+    StudyQualityChecks(run, loose, 8.0, {selection_dir + "/nothing"});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nothing/compare.json"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(CompareQa, NoStudyWithoutTheNetworkRow) {

@@ -93,6 +93,29 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
               "evidence.network_mask_sigma_px", "> 0 pixels");
 }
 
+// evidence.keypoints_2d: detector: the detector's 2D counts as file evidence, with the
+// model size; it cannot be combined with a detections folder.
+TEST(JobConfig, KeypointsFromTheDetector) {
+  const std::string base = "input: {path: c}\noutput: {dir: o}\nrefine: {mode: always}\n";
+  const JobConfig plain =
+      LoadJobConfig(WriteJob(base + "evidence: {keypoints_2d: files}\n"));
+  EXPECT_FALSE(plain.keypoints_from_detector);
+  const JobConfig job = LoadJobConfig(
+      WriteJob(base + "evidence: {keypoints_2d: detector, detector_model: lite}\n"));
+  EXPECT_TRUE(job.keypoints_from_detector);
+  EXPECT_EQ(job.keypoints, KeypointSource::kFiles);
+  EXPECT_EQ(job.detector_model, "lite");
+  EXPECT_EQ(LoadJobConfig(WriteJob(base + "evidence: {keypoints_2d: detector}\n"))
+                .detector_model,
+            "full");
+  ExpectError(base + "evidence: {keypoints_2d: detector, detector_model: huge}\n",
+              "evidence.detector_model", "full | lite");
+  ExpectError(base + "evidence: {keypoints_2d: detector, detections: d}\n",
+              "evidence.detections", "empty with keypoints_2d: detector");
+  ExpectError(base + "evidence: {keypoints_2d: mediapipe}\n", "evidence.keypoints_2d",
+              "network | files | both | detector");
+}
+
 // The fields `handlabel fit` sets: unset fitter fields stay unset (the fitter's
 // defaults), set ones are read and checked naming the field.
 TEST(JobConfig, FitSectionAndFileEvidence) {

@@ -1,0 +1,59 @@
+#pragma once
+// Internal to capture_import.cc: reading a frame of a camera's recording as RGB, from an
+// image folder or a video.
+
+#include <exception>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "capture/capture_import_sources.h"
+#include "core/image.h"
+
+namespace handlabel {
+
+// A video ended before the frame asked for (containers may declare more frames than
+// they hold): the import stops there.
+struct VideoEnded : std::exception {
+  VideoEnded(int c, int n) : camera(c), frames_read(n) {}
+  const char* what() const noexcept override { return "video ended"; }
+  int camera;
+  int frames_read;
+};
+
+// Reads frame `index` of camera `camera` as RGB; Where() names it in messages.
+class FrameReader {
+ public:
+  virtual ~FrameReader() = default;
+  virtual ImageU8 Read(int camera, int index) = 0;
+  virtual std::string Where(int camera, int index) const = 0;
+};
+
+// Images by their position in the camera's sorted folder.
+std::unique_ptr<FrameReader> MakeImageFolderReader(
+    const std::vector<CameraSource>& cameras);
+
+// Decodes each video forward only (grab() up to the wanted frame): exact for every
+// codec, unlike seeking. Throws InputError for a video OpenCV's FFmpeg backend cannot
+// open.
+class VideoReader : public FrameReader {
+ public:
+  explicit VideoReader(const std::vector<CameraSource>& cameras);
+  ~VideoReader() override;
+  // Frame count the container declares; -1 if it declares none.
+  int DeclaredCount(int camera) const;
+  // Size the stream declares (width, height).
+  std::pair<int, int> DeclaredSize(int camera) const;
+  // Counts by decoding on a second handle (for containers that declare no count).
+  int CountByDecoding(int camera) const;
+  ImageU8 Read(int camera, int index) override;
+  std::string Where(int camera, int index) const override;
+
+ private:
+  struct Stream;
+  std::vector<CameraSource> cameras_;  // a copy: the reader may outlive the caller's list
+  std::vector<std::unique_ptr<Stream>> streams_;
+};
+
+}  // namespace handlabel

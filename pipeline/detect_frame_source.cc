@@ -1,0 +1,99 @@
+#include "pipeline/detect_frame_source.h"
+
+#include "core/errors.h"
+#include "core/image_file.h"
+
+namespace handlabel {
+namespace {
+
+// The view's image as RGB of its camera's size (grey replicated, alpha dropped).
+ImageU8 ReadViewImage(const std::string& path, const RigCamera& camera) {
+  const ImageU8 image = ReadImageFile(path);
+  if (image.width != camera.camera.width() || image.height != camera.camera.height()) {
+    throw InputError(path, "image size",
+                     std::to_string(camera.camera.width()) + "x" +
+                         std::to_string(camera.camera.height()) + " (camera " +
+                         camera.name + ")",
+                     std::to_string(image.width) + "x" + std::to_string(image.height));
+  }
+  if (image.channels == 3) return image;
+  ImageU8 rgb(image.width, image.height, 3);
+  for (size_t p = 0; p < size_t(image.width) * image.height; ++p) {
+    for (int c = 0; c < 3; ++c) {
+      rgb.data[3 * p + c] = image.data[p * image.channels + (image.channels < 3 ? 0 : c)];
+    }
+  }
+  return rgb;
+}
+
+}  // namespace
+
+void DetectionStore::Put(const std::string& frame, FrameHandResult result) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  results_[frame] = std::move(result);
+}
+
+std::optional<FrameHandResult> DetectionStore::Take(const std::string& frame) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = results_.find(frame);
+  if (it == results_.end()) return std::nullopt;
+  FrameHandResult result = std::move(it->second);
+  results_.erase(it);
+  return result;
+}
+
+std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
+    const FrameHandResult& result) {
+  std::vector<std::optional<Keypoints2d>> out;
+  for (const ViewHandResult& view : result.views) {
+    Keypoints2d keypoints;  // every view has an entry, as in a detections file
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      const double confidence = view.keypoints.confidence(k);
+      if (!(confidence > 0) || !view.keypoints.uv_px.row(k).allFinite()) continue;
+      keypoints.uv_px.row(k) = view.keypoints.uv_px.row(k);
+      keypoints.confidence(k) = confidence;
+    }
+    out.push_back(keypoints);
+  }
+  return out;
+}
+
+DetectorFrameSource::DetectorFrameSource(std::unique_ptr<FrameSource> inner,
+                                         const DetectCaptureOptions& options,
+                                         std::shared_ptr<DetectionStore> store)
+    : inner_(std::move(inner)), options_(options), store_(std::move(store)) {
+  options_.Check("evidence.keypoints_2d: detector");
+  detector_ = std::make_unique<MediapipeHands>(options_.hands);
+}
+
+FrameInput DetectorFrameSource::Load(const std::string& id) const {
+  FrameInput frame = inner_->Load(id);
+  if (frame.image_paths.size() != frame.rig.size()) {
+    throw InputError(Describe(), "images", "one image per camera for the detector",
+                     std::to_string(frame.image_paths.size()) + " for " +
+                         std::to_string(frame.rig.size()) + " cameras");
+  }
+  std::vector<ImageU8> images;
+  for (size_t c = 0; c < frame.rig.size(); ++c) {
+    images.push_back(ReadViewImage(frame.image_paths[c], frame.rig[c]));
+  }
+  FrameHandResult result;
+  {
+    // One frame at a time: the models are shared, and they use the cores themselves.
+    std::lock_guard<std::mutex> lock(detect_mutex_);
+    result = DetectHandMultiView(*detector_, frame.rig, images, options_.multiview);
+  }
+  frame.keypoints_2d = KeypointsFromDetection(result);
+  if (store_) store_->Put(id, std::move(result));
+  return frame;
+}
+
+std::string DetectorFrameSource::Describe() const {
+  return inner_->Describe() + "; 2D keypoints from " + KeypointsSource();
+}
+
+std::string DetectorFrameSource::KeypointsSource() const {
+  return "detector (MediaPipe Hands, model " + options_.hands.model + ")";
+}
+
+}  // namespace handlabel

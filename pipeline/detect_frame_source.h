@@ -1,0 +1,65 @@
+#pragma once
+// A label job's `evidence.keypoints_2d: detector` (docs/labeling-jobs.md): the frames of
+// any capture reader with their 2D keypoints from MediaPipe Hands, run on the frame's
+// images as it is loaded (multi-view hand finding, network/hand_detector.h), exactly as
+// `handlabel detect --capture` would write them (pipeline/detect_capture.h): a
+// keypoint with confidence 0 is unknown (position 0), a view without a detection has
+// none. The detector's full answer per frame stays available to the overlay writer
+// (DetectionStore), which draws it (pipeline/detect_overlay.h).
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "capture/frame_source.h"
+#include "network/hand_detector.h"
+#include "pipeline/detect_capture.h"
+
+namespace handlabel {
+
+// The detector's answers per frame id, filled by DetectorFrameSource; thread-safe.
+class DetectionStore {
+ public:
+  void Put(const std::string& frame, FrameHandResult result);
+  // The frame's answer, removed from the store (each is drawn once: a long job does
+  // not keep them all); nullopt when the frame was not detected (yet).
+  std::optional<FrameHandResult> Take(const std::string& frame);
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, FrameHandResult> results_;
+};
+
+// The 2D keypoints of one frame's detection in rig order, as the detections file of
+// `handlabel detect` gives them to a job (unknown keypoints: confidence 0, position 0;
+// views without a detection: nullopt).
+std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
+    const FrameHandResult& result);
+
+class DetectorFrameSource : public FrameSource {
+ public:
+  // Loads the models (InputError naming the file when one is missing). `store` may be
+  // null (nothing kept).
+  DetectorFrameSource(std::unique_ptr<FrameSource> inner,
+                      const DetectCaptureOptions& options,
+                      std::shared_ptr<DetectionStore> store);
+  std::vector<std::string> FrameIds() const override { return inner_->FrameIds(); }
+  // Reads the frame's images (InputError naming a file that cannot be read or does not
+  // fit its camera) and detects; frames are detected one at a time.
+  FrameInput Load(const std::string& id) const override;
+  std::string Describe() const override;
+  std::string KeypointsSource() const override;
+  std::optional<HandSide> side() const override { return inner_->side(); }
+
+ private:
+  std::unique_ptr<FrameSource> inner_;
+  DetectCaptureOptions options_;
+  std::unique_ptr<MediapipeHands> detector_;
+  std::shared_ptr<DetectionStore> store_;
+  mutable std::mutex detect_mutex_;
+};
+
+}  // namespace handlabel
