@@ -95,7 +95,7 @@ int RunCamerasCompare(int argc, char** argv) {
   return RunReportingErrors("cameras compare", [&] {
     const Rig rig_a = ReadRig(ParseRigSpec(a, "rig"));
     const Rig rig_b = ReadRig(ParseRigSpec(b, "reference_rig"));
-    std::cout << RigDifferenceTable(CompareRigs(rig_a, rig_b, reference));
+    std::cout << RigDifferenceTable(CompareRigs(rig_a, rig_b, reference, a, b));
     return 0;
   });
 }

@@ -8,24 +8,24 @@
 
 namespace handlabel {
 
-RigDifference CompareRigs(const Rig& a_in, const Rig& b_in,
-                          const std::string& reference) {
-  if (b_in.empty()) throw InputError("rig compare", "cameras", "a non-empty rig");
+RigDifference CompareRigs(const Rig& a_in, const Rig& b_in, const std::string& reference,
+                          const std::string& a_name, const std::string& b_name) {
+  if (b_in.empty()) throw InputError(b_name, "cameras", "a non-empty rig");
   RigDifference out;
   out.reference = reference.empty() ? b_in[0].name : reference;
   Rig a = a_in, b = b_in;
   const int ia = a.IndexOf(out.reference), ib = b.IndexOf(out.reference);
   if (ia < 0 || ib < 0) {
-    throw InputError("rig compare", "reference camera", "a camera in both rigs",
-                     "'" + out.reference + "'");
+    throw InputError(ia < 0 ? a_name : b_name, "reference camera",
+                     "a camera in both rigs", "no camera '" + out.reference + "'");
   }
   a.SetWorldToCamera(ia);
   b.SetWorldToCamera(ib);
   out.worst.name = "max";
   for (const RigCamera& cb : b.cameras()) {
     if (a.IndexOf(cb.name) < 0) {
-      throw InputError("rig compare", "camera '" + cb.name + "'",
-                       "the same camera names in both rigs", "only in the second rig");
+      throw InputError(a_name, "camera '" + cb.name + "'",
+                       "the same camera names in both rigs", "only in " + b_name);
     }
     const RigCamera& ca = a.Find(cb.name);
     CameraDifference d;

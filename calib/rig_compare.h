@@ -25,9 +25,12 @@ struct RigDifference {
   CameraDifference worst;                 // per-column maxima, name "max"
 };
 
-// Throws InputError naming a camera of b that a lacks, or an unknown reference.
+// Throws InputError naming a camera of b that a lacks, or an unknown reference, with
+// the rig (`a_name`, `b_name`: e.g. their files) it is missing from.
 // `reference` "" = b's first camera.
-RigDifference CompareRigs(const Rig& a, const Rig& b, const std::string& reference = "");
+RigDifference CompareRigs(const Rig& a, const Rig& b, const std::string& reference = "",
+                          const std::string& a_name = "the first rig",
+                          const std::string& b_name = "the second rig");
 
 std::string RigDifferenceTable(const RigDifference& difference);
 

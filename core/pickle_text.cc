@@ -1,6 +1,7 @@
 // Protocol 0's text arguments: decimal integers, Python str reprs and
 // raw-unicode-escape text.
 #include <cctype>
+#include <limits>
 
 #include "core/pickle_machine.h"
 #include "core/utf8.h"
@@ -10,17 +11,26 @@ namespace handlabel::pickle {
 int64_t PickleMachine::ParseDecimal(std::string s, const char* what) {
   if (!s.empty() && s.back() == 'L') s.pop_back();
   if (s.empty()) Fail(std::string(what) + " digits", "nothing");
-  size_t i = s[0] == '-' || s[0] == '+' ? 1 : 0;
+  const bool negative = s[0] == '-';
+  size_t i = negative || s[0] == '+' ? 1 : 0;
   if (i == s.size()) Fail(std::string(what) + " digits", "'" + s + "'");
+  // The magnitude int64_t holds: 2^63 for a negative number, 2^63 - 1 otherwise.
+  const uint64_t limit = (uint64_t{1} << 63) - (negative ? 0 : 1);
   uint64_t v = 0;
   for (; i < s.size(); ++i) {
     if (!std::isdigit(static_cast<unsigned char>(s[i]))) {
       Fail(std::string(what) + " digits", "'" + s.substr(0, 40) + "'");
     }
-    if (v > (uint64_t{1} << 62)) Fail("an integer that fits 64 bits", "a larger one");
-    v = v * 10 + (s[i] - '0');
+    const uint64_t digit = static_cast<uint64_t>(s[i] - '0');
+    if (v > (limit - digit) / 10) {
+      Fail("an integer that fits 64 bits", "'" + s.substr(0, 40) + "'");
+    }
+    v = v * 10 + digit;
   }
-  return s[0] == '-' ? -static_cast<int64_t>(v) : static_cast<int64_t>(v);
+  if (!negative) return static_cast<int64_t>(v);
+  // -2^63 has no positive int64_t to negate.
+  return v == (uint64_t{1} << 63) ? std::numeric_limits<int64_t>::min()
+                                  : -static_cast<int64_t>(v);
 }
 
 int PickleMachine::HexDigit(char c) {

@@ -31,6 +31,9 @@ constexpr uint32_t kZip64LocatorSig = 0x07064b50;
 constexpr size_t kEndSize = 22;
 constexpr size_t kCentralHeaderSize = 46;
 constexpr size_t kLocalHeaderSize = 30;
+// Deflate's largest expansion: a 258-byte match coded in 2 bits, 1032 bytes out per byte
+// in. A larger declared size is impossible, and refused before we allocate for it.
+constexpr uint64_t kMaxDeflateRatio = 1032;
 
 class MemorySource : public ZipReader::ByteSource {
  public:
@@ -318,6 +321,13 @@ std::string ZipReader::Read(const ZipEntry& e) const {
   if (data_offset > file_size || e.compressed_size > file_size - data_offset) {
     throw InputError(source_, field, std::to_string(e.compressed_size) + " bytes of data",
                      "truncated archive");
+  }
+  if (e.method == 8 && e.uncompressed_size / kMaxDeflateRatio > e.compressed_size) {
+    throw InputError(source_, field,
+                     "an uncompressed size deflate can reach from " +
+                         std::to_string(e.compressed_size) + " bytes (at most " +
+                         std::to_string(kMaxDeflateRatio) + " times as many)",
+                     std::to_string(e.uncompressed_size) + " bytes declared");
   }
   std::string out;
   if (e.method == 0) {

@@ -65,6 +65,21 @@ Points3dTargets NetworkTargets(const MeshPrediction& net, int num_vertices) {
   return targets;
 }
 
+// A mask file (hand or object labels) of one view, read and checked against the camera's
+// image size, so that a mismatch names the file and the camera (the fitter knows
+// neither).
+MaskImage ReadViewMask(const std::string& path, const RigCamera& camera, bool objects) {
+  MaskImage mask = objects ? ReadObjectMaskPng(path) : ReadMaskPng(path);
+  if (mask.cols() != camera.camera.width() || mask.rows() != camera.camera.height()) {
+    throw InputError(path, "image size",
+                     std::to_string(camera.camera.width()) + "x" +
+                         std::to_string(camera.camera.height()) + " (camera " +
+                         camera.name + ")",
+                     std::to_string(mask.cols()) + "x" + std::to_string(mask.rows()));
+  }
+  return mask;
+}
+
 }  // namespace
 
 CeresLabelFitter::CeresLabelFitter(const HandModel& model,
@@ -109,7 +124,7 @@ HandFitInput CeresLabelFitter::Evidence(const LabelFitRequest& request,
       input.masks.push_back(!frame.masks.empty() ? frame.masks[v]
                             : frame.mask_paths[v].empty()
                                 ? MaskImage()
-                                : ReadMaskPng(frame.mask_paths[v]));
+                                : ReadViewMask(frame.mask_paths[v], frame.rig[v], false));
     }
     if (!options_.use_object_masks && options_.one_sided_without_object_masks) {
       *silhouettes = "files+one_sided";
@@ -125,8 +140,8 @@ HandFitInput CeresLabelFitter::Evidence(const LabelFitRequest& request,
           continue;
         }
         const std::string& path = frame.object_mask_paths[v];
-        input.occluder_masks.push_back(path.empty() ? MaskImage()
-                                                    : ReadObjectMaskPng(path));
+        input.occluder_masks.push_back(
+            path.empty() ? MaskImage() : ReadViewMask(path, frame.rig[v], true));
       }
     }
   }
