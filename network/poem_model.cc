@@ -1,9 +1,6 @@
 #include "network/poem_model.h"
 
-#include <ATen/Parallel.h>
-
 #include <chrono>
-#include <cmath>
 
 #include "core/errors.h"
 #include "core/stopwatch.h"
@@ -41,55 +38,9 @@ void ExpectShape(const torch::Tensor& t, const std::vector<int64_t>& shape,
   }
 }
 
-// Inference kernel of SampleViews: the same bilinear sampling (align_corners=false,
-// zero padding) from channels-last features, written straight into (B, P, N, C) rows
-// (grid_sample's (B*N, C, P) result would need a transposing copy of that size).
-torch::Tensor SampleViewsAsRows(const torch::Tensor& features, const torch::Tensor& grid,
-                                int64_t B, int64_t N) {
-  const int64_t C = features.size(1), H = features.size(2), W = features.size(3);
-  const int64_t P = grid.size(1);
-  const torch::Tensor f = features.permute({0, 2, 3, 1}).contiguous();  // (BN, H, W, C)
-  const torch::Tensor g = grid.contiguous();
-  torch::Tensor out = torch::zeros({B, P, N, C}, features.options());
-  const float* fd = f.data_ptr<float>();
-  const float* gd = g.data_ptr<float>();
-  float* od = out.data_ptr<float>();
-  at::parallel_for(0, B * P, 64, [&](int64_t begin, int64_t end) {
-    for (int64_t bp = begin; bp < end; ++bp) {
-      const int64_t b = bp / P, p = bp % P;
-      for (int64_t n = 0; n < N; ++n) {
-        const int64_t image = b * N + n;
-        const float* uv = gd + (image * P + p) * 2;
-        // Unnormalise as grid_sample: ((u + 1) * W - 1) / 2.
-        const float ix = ((uv[0] + 1) * W - 1) / 2;
-        const float iy = ((uv[1] + 1) * H - 1) / 2;
-        // Far outside (or NaN): every corner is padding, the row stays zero.
-        if (!(ix > -2 && ix < W + 1 && iy > -2 && iy < H + 1)) continue;
-        const float x0 = std::floor(ix), y0 = std::floor(iy);
-        const float weights[4] = {(x0 + 1 - ix) * (y0 + 1 - iy),
-                                  (ix - x0) * (y0 + 1 - iy), (x0 + 1 - ix) * (iy - y0),
-                                  (ix - x0) * (iy - y0)};
-        float* o = od + (bp * N + n) * C;
-        for (int corner = 0; corner < 4; ++corner) {
-          const int64_t x = static_cast<int64_t>(x0) + corner % 2;
-          const int64_t y = static_cast<int64_t>(y0) + corner / 2;
-          if (x < 0 || x >= W || y < 0 || y >= H) continue;
-          const float* v = fd + ((image * H + y) * W + x) * C;
-          const float w = weights[corner];
-          for (int64_t c = 0; c < C; ++c) o[c] += v[c] * w;
-        }
-      }
-    }
-  });
-  return out;
-}
-
 torch::Tensor SampleViews(const torch::Tensor& features, const torch::Tensor& grid,
                           int64_t B, int64_t N) {
   // features (B*N, C, H, W), grid (B*N, P, 1, 2) -> (B, P, N, C)
-  if (UseInferenceKernels() && features.scalar_type() == torch::kFloat32) {
-    return SampleViewsAsRows(features, grid, B, N);
-  }
   const torch::Tensor s = F::grid_sample(features, grid,
                                          F::GridSampleFuncOptions()
                                              .mode(torch::kBilinear)
