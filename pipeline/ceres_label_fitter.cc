@@ -6,6 +6,7 @@
 #include "core/errors.h"
 #include "core/json_util.h"
 #include "core/mask_image.h"
+#include "core/view_image.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/label_record.h"
 
@@ -70,13 +71,7 @@ Points3dTargets NetworkTargets(const MeshPrediction& net, int num_vertices) {
 // neither).
 MaskImage ReadViewMask(const std::string& path, const RigCamera& camera, bool objects) {
   MaskImage mask = objects ? ReadObjectMaskPng(path) : ReadMaskPng(path);
-  if (mask.cols() != camera.camera.width() || mask.rows() != camera.camera.height()) {
-    throw InputError(path, "image size",
-                     std::to_string(camera.camera.width()) + "x" +
-                         std::to_string(camera.camera.height()) + " (camera " +
-                         camera.name + ")",
-                     std::to_string(mask.cols()) + "x" + std::to_string(mask.rows()));
-  }
+  CheckViewImageSize(path, mask.cols(), mask.rows(), camera);
   return mask;
 }
 

@@ -2,31 +2,9 @@
 
 #include "core/errors.h"
 #include "core/image_file.h"
+#include "core/view_image.h"
 
 namespace handlabel {
-namespace {
-
-// The view's image as RGB of its camera's size (grey replicated, alpha dropped).
-ImageU8 ReadViewImage(const std::string& path, const RigCamera& camera) {
-  const ImageU8 image = ReadImageFile(path);
-  if (image.width != camera.camera.width() || image.height != camera.camera.height()) {
-    throw InputError(path, "image size",
-                     std::to_string(camera.camera.width()) + "x" +
-                         std::to_string(camera.camera.height()) + " (camera " +
-                         camera.name + ")",
-                     std::to_string(image.width) + "x" + std::to_string(image.height));
-  }
-  if (image.channels == 3) return image;
-  ImageU8 rgb(image.width, image.height, 3);
-  for (size_t p = 0; p < size_t(image.width) * image.height; ++p) {
-    for (int c = 0; c < 3; ++c) {
-      rgb.data[3 * p + c] = image.data[p * image.channels + (image.channels < 3 ? 0 : c)];
-    }
-  }
-  return rgb;
-}
-
-}  // namespace
 
 void DetectionStore::Put(const std::string& frame, FrameHandResult result) {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -75,7 +53,7 @@ FrameInput DetectorFrameSource::Load(const std::string& id) const {
   }
   std::vector<ImageU8> images;
   for (size_t c = 0; c < frame.rig.size(); ++c) {
-    images.push_back(ReadViewImage(frame.image_paths[c], frame.rig[c]));
+    images.push_back(ReadViewImageRgb(frame.image_paths[c], frame.rig[c]));
   }
   FrameHandResult result;
   {

@@ -8,6 +8,7 @@
 #include "core/hand_skeleton.h"
 #include "core/image_file.h"
 #include "core/rasterizer.h"
+#include "core/view_image.h"
 #include "pipeline/detect_overlay.h"
 #include "pipeline/label_outputs.h"
 
@@ -51,31 +52,6 @@ void DrawLabelOverlay(const RigCamera& camera, const LabelRecord& label,
   }
 }
 
-namespace {
-
-// The view's image as 3-channel RGB (grey replicated, alpha dropped); throws InputError
-// naming the file when its size is not the camera's.
-ImageU8 OverlayBackground(const std::string& path, const RigCamera& camera) {
-  const ImageU8 image = ReadImageFile(path);
-  if (image.width != camera.camera.width() || image.height != camera.camera.height()) {
-    throw InputError(path, "image size",
-                     std::to_string(camera.camera.width()) + "x" +
-                         std::to_string(camera.camera.height()) + " (camera " +
-                         camera.name + ")",
-                     std::to_string(image.width) + "x" + std::to_string(image.height));
-  }
-  if (image.channels == 3) return image;
-  ImageU8 rgb(image.width, image.height, 3, 0);
-  for (size_t p = 0; p < size_t(image.width) * image.height; ++p) {
-    for (int c = 0; c < 3; ++c) {
-      rgb.data[3 * p + c] = image.data[p * image.channels + (image.channels < 3 ? 0 : c)];
-    }
-  }
-  return rgb;
-}
-
-}  // namespace
-
 void RasterOverlayWriter::Write(const std::string& output_dir, const FrameInput& frame,
                                 const LabelRecord& label) const {
   const std::optional<FrameHandResult> detection =
@@ -86,7 +62,7 @@ void RasterOverlayWriter::Write(const std::string& output_dir, const FrameInput&
     // not fit the camera fails the frame (the error names it), never a grey overlay.
     ImageU8 rgb(camera.camera.width(), camera.camera.height(), 3, 96);
     if (v < frame.image_paths.size() && !frame.image_paths[v].empty()) {
-      rgb = OverlayBackground(frame.image_paths[v], camera);
+      rgb = ReadViewImageRgb(frame.image_paths[v], camera);
     }
     DrawLabelOverlay(camera, label, faces_, &rgb);
     if (detection && v < detection->views.size()) {

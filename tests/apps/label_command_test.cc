@@ -49,8 +49,9 @@ void ExpectConsistent(const std::string& out) {
     }
   }
   for (const auto& [frame, record] : ReadShardLogs(out)) {
-    if (record.status == "ok")
+    if (record.status == "ok") {
       EXPECT_TRUE(fs::exists(LabelFilePath(out, frame))) << frame;
+    }
   }
 }
 

@@ -60,7 +60,9 @@ TEST(SynthAppearance, RealisticKeepsTheSceneAndTheGroundTruth) {
       EXPECT_GT(scenery_pixels, 0);
       for (int k = 0; k < kNumHandKeypoints; ++k) {
         // Scenery can only hide keypoints.
-        if (va.visibility[k] != kVisible) EXPECT_NE(vb.visibility[k], kVisible);
+        if (va.visibility[k] != kVisible) {
+          EXPECT_NE(vb.visibility[k], kVisible);
+        }
       }
     }
   }

@@ -4,7 +4,7 @@
 // silhouettes help noisy keypoints. The enabled tests use 1-2 frames at half
 // resolution to stay fast; the 50-frame report
 // runs with
-//   build/tests/fitting_tests --gtest_also_run_disabled_tests \
+//   build/tests/fitting_tests --gtest_also_run_disabled_tests
 //       --gtest_filter='FittingAcceptance.DISABLED_*'
 // and prints the numbers written in docs/fitting.md.
 
