@@ -291,11 +291,7 @@ class MultiViewKeypointSquareRootCost : public ceres::CostFunction {
     for (size_t i = 0; i < used.size(); ++i) {
       std::copy_n(kp_jac.data() + 3 * used[i] * n, 3 * n, used_jac.data() + 3 * i * n);
     }
-    Eigen::MatrixXd jtj;
-    Eigen::VectorXd jtr;
-    normal.Accumulate(used_jac.data(), n, &jtj, &jtr);
-    WriteSquareRootForm(jtj, jtr, normal.squared_norm(), block_sizes_, residuals,
-                        jacobians);
+    normal.WriteCeresOutput(used_jac.data(), n, block_sizes_, residuals, jacobians);
     return true;
   }
 

@@ -93,4 +93,14 @@ void WriteCostOnly(double squared_norm, int num_residuals, double* residuals) {
   residuals[0] = std::sqrt(squared_norm);
 }
 
+void PointTermNormalEquations::WriteCeresOutput(const double* point_jacobians, int n,
+                                                const std::vector<int>& block_sizes,
+                                                double* residuals,
+                                                double** jacobians) const {
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd jtr;
+  Accumulate(point_jacobians, n, &jtj, &jtr);
+  WriteSquareRootForm(jtj, jtr, squared_norm_, block_sizes, residuals, jacobians);
+}
+
 }  // namespace handlabel

@@ -42,6 +42,10 @@ class PointTermNormalEquations {
   // 3 x n row-major blocks, one per entry of UsedPoints(), in that order.
   void Accumulate(const double* point_jacobians, int n, Eigen::MatrixXd* jtj,
                   Eigen::VectorXd* jtr) const;
+  // Accumulate, then WriteSquareRootForm (below): a cost function's whole output.
+  void WriteCeresOutput(const double* point_jacobians, int n,
+                        const std::vector<int>& block_sizes, double* residuals,
+                        double** jacobians) const;
 
  private:
   std::vector<Eigen::Matrix3d> h_;

@@ -364,11 +364,7 @@ class MultiViewSilhouetteSquareRootCost : public ceres::CostFunction {
     evaluator_.VerticesAndJacobian(parameters[0], parameters[1], parameters[2],
                                    parameters[3], used_ids, used_xyz.data(),
                                    used_jac.data());
-    Eigen::MatrixXd jtj;
-    Eigen::VectorXd jtr;
-    normal.Accumulate(used_jac.data(), n, &jtj, &jtr);
-    WriteSquareRootForm(jtj, jtr, normal.squared_norm(), block_sizes_, residuals,
-                        jacobians);
+    normal.WriteCeresOutput(used_jac.data(), n, block_sizes_, residuals, jacobians);
     return true;
   }
 
