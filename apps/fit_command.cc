@@ -42,6 +42,7 @@ struct FitFlags {
   double keypoint_sigma = HandFitOptions().keypoint_sigma_px;
   double silhouette_sigma = HandFitOptions().silhouette_sigma_px;
   int silhouette_rounds = HandFitOptions().silhouette_rounds;
+  double mask_margin = HandFitOptions().mask_margin_max_px;
   int pca = HandFitConfig().pose_pca_comps;
   std::string unknown_occluders = "two_sided";
   bool no_silhouettes = false, no_limits = false, fixed_shape = false;
@@ -88,6 +89,10 @@ void AddFitterFlags(CLI::App& app, FitFlags* f) {
   app.add_option("--silhouette-rounds", f->silhouette_rounds,
                  "outline re-matching rounds with silhouettes (0 = keypoints only)")
       ->capture_default_str();
+  app.add_option("--mask-margin", f->mask_margin,
+                 "largest per-view mask margin (masks uniformly too fat or too thin) "
+                 "estimated and taken out, pixels; 0 = off")
+      ->capture_default_str();
   app.add_option("--pca", f->pca,
                  "pose as PCA coefficients: 0 (45 axis-angle values), 12 or 45")
       ->capture_default_str();
@@ -127,6 +132,7 @@ FitCaptureOptions ToOptions(const CLI::App& app, const FitFlags& f) {
   SetIfGiven(app, "--keypoint-sigma", f.keypoint_sigma, &o.fit.keypoint_sigma_px);
   SetIfGiven(app, "--silhouette-sigma", f.silhouette_sigma, &o.fit.silhouette_sigma_px);
   SetIfGiven(app, "--silhouette-rounds", f.silhouette_rounds, &o.fit.silhouette_rounds);
+  SetIfGiven(app, "--mask-margin", f.mask_margin, &o.fit.mask_margin_px);
   SetIfGiven(app, "--pca", f.pca, &o.fit.pose_pca_comps);
   if (f.unknown_occluders != "one_sided" && f.unknown_occluders != "two_sided") {
     throw InputError("command line", "--unknown-occluders", "one_sided | two_sided",

@@ -214,6 +214,7 @@ void HandFitOptions::Check() const {
   RequireNonNegative(occluder_reach_px, "occluder_reach_px");
   RequireNonNegative(silhouette_window_margin_px, "silhouette_window_margin_px");
   RequirePositive(unknown_occluder_cap_px, "unknown_occluder_cap_px");
+  RequireNonNegative(mask_margin_max_px, "mask_margin_max_px");
   RequireNonNegative(rigid_iterations, "rigid_iterations");
   RequireNonNegative(keypoint_iterations, "keypoint_iterations");
   RequireNonNegative(init_iterations, "init_iterations");
@@ -434,6 +435,7 @@ class FitRun {
     }
     std::vector<SilhouetteView> sil_views;
     std::vector<MaskOutline> outlines;
+    std::vector<size_t> sil_view_input;  // index into input.views
     Points3d keypoint_stage_vertices;
     if (use_sil) {
       keypoint_stage_vertices.resize(evaluator_.num_vertices(), 3);
@@ -464,8 +466,10 @@ class FitRun {
                                              options_.silhouette_outline_samples,
                                              occluder, options_.occluder_reach_px));
         sil_views.push_back(std::move(view));
+        sil_view_input.push_back(v);
       }
     }
+    result.view_mask_margin_px.assign(input.views.size(), kNaN);
     if (!sil_views.empty()) result.keypoints_only = Evaluate(input, FromBlocks(b));
     for (int round = 0; !sil_views.empty() && round < options_.silhouette_rounds;
          ++round) {
@@ -490,6 +494,14 @@ class FitRun {
         sil_views[v].outline_px = outlines[v].points;
         sil_views[v].outline_normal = outlines[v].normals;
         sil_views[v].outline_vertex = MatchOutlineToPoints(outlines[v], uv, valid);
+        if (options_.mask_margin_max_px > 0 && !sil_views[v].one_sided) {
+          const double margin =
+              std::clamp(EstimateMaskMargin(outlines[v], sil_views[v].outline_vertex, uv),
+                         -options_.mask_margin_max_px, options_.mask_margin_max_px);
+          sil_views[v].outline_px = ShiftedOutline(outlines[v], margin);
+          sil_views[v].inside_px = 0.5 + std::max(0.0, -margin);
+          result.view_mask_margin_px[sil_view_input[v]] = margin;
+        }
       }
       StageProblem problem(&b);
       full_problem(&problem);

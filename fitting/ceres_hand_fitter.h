@@ -93,6 +93,12 @@ struct HandFitOptions {
   // Views whose occluders are unknown (HandFitInput::unknown_occluders): the mesh ->
   // mask distance saturates at this many pixels (fitting/silhouette_cost.h), > 0.
   double unknown_occluder_cap_px = 3.0;
+  // Per-view mask margin: masks are often uniformly too fat or too thin (a detector's,
+  // a segmenter's). Before each silhouette round every two-sided view's margin is
+  // estimated from the current fit (EstimateMaskMargin, fitting/silhouette_outline.h),
+  // clamped to +-this many pixels, and taken out: outline samples move inwards by it,
+  // and an eroded mask's vertices may lie that far outside it. 0 = off; >= 0.
+  double mask_margin_max_px = 3.0;
   // Ceres iterations per stage (silhouette: per round).
   int rigid_iterations = 20;
   int keypoint_iterations = 60;
@@ -156,6 +162,9 @@ struct HandFitResult {
   // fitted mesh and the mask (NaN without a mask).
   std::vector<double> view_rms_px;
   std::vector<double> view_iou;
+  // Per view: the mask margin taken out in the last silhouette round
+  // (HandFitOptions::mask_margin_max_px), pixels; NaN where no silhouette was fitted.
+  std::vector<double> view_mask_margin_px;
   int iterations = 0;  // Ceres iterations over all stages
   double seconds = 0.0;
   bool converged = false;  // the last stage met a Ceres convergence tolerance

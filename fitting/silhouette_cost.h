@@ -7,8 +7,9 @@
 //                  nearest mask pixel centre (core/distance_transform.h), bilinearly
 //                  interpolated; the 0.5 px allows for vertices on the true outline,
 //                  which lies between the last inside and the first outside pixel
-//                  centre. Alone this term would shrink the hand (a smaller hand lies
-//                  inside the mask just as well).
+//                  centre (SilhouetteView::inside_px: more for eroded masks, see
+//                  HandFitOptions::mask_margin_max_px). Alone this term would shrink the
+//                  hand (a smaller hand lies inside the mask just as well).
 //   mask -> mesh   every sampled outline point p of the mask (moved half a pixel
 //                  outwards onto the pixel edge) must be reached by the projected hand:
 //                  r = n . (uv_c - p) / sigma_px, with n the outline's outward normal
@@ -72,6 +73,7 @@ struct SilhouetteView {
   std::vector<int> outline_vertex;  // per outline sample: index into vertex_ids
   bool one_sided = false;           // unknown occluders: see the header comment
   double cap_px = 3.0;              // mesh -> mask saturation of one-sided views (> 0)
+  double inside_px = 0.5;           // mesh -> mask distance that costs nothing
 };
 
 // Bilinear lookup with clamping at the border; T may be a Jet (the weights carry the
@@ -226,8 +228,8 @@ class MultiViewSilhouetteCost {
         T r = T(0.0);
         if (valid[i]) {
           const T d = DistanceLookup(view, uv[2 * i], uv[2 * i + 1]);
-          if (d > T(0.5)) {
-            const T x = d - 0.5;
+          if (d > T(view.inside_px)) {
+            const T x = d - view.inside_px;
             r = (view.one_sided ? view.cap_px * x / (view.cap_px + x) : x) * inv_sigma_;
           }
         }
@@ -330,8 +332,8 @@ class MultiViewSilhouetteSquareRootCost : public ceres::CostFunction {
         if (!valid[i]) continue;
         Eigen::Vector2d gradient;
         const double d = DistanceWithGradient(view, uv[i], &gradient);
-        if (!(d > 0.5)) continue;
-        const double x = d - 0.5, cap = view.cap_px;
+        if (!(d > view.inside_px)) continue;
+        const double x = d - view.inside_px, cap = view.cap_px;
         // d r / d x: 1, or (cap / (cap + x))^2 when saturated.
         const double slope = view.one_sided ? std::pow(cap / (cap + x), 2) : 1.0;
         const double r = (view.one_sided ? cap * x / (cap + x) : x) * inv_sigma_;

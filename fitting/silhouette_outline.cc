@@ -1,5 +1,6 @@
 #include "fitting/silhouette_outline.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -75,6 +76,26 @@ std::vector<int> MatchOutlineToPoints(const MaskOutline& outline,
     }
   }
   return match;
+}
+
+double EstimateMaskMargin(const MaskOutline& outline, const std::vector<int>& matched,
+                          const std::vector<Eigen::Vector2d>& projected) {
+  std::vector<double> gaps;
+  for (size_t s = 0; s < outline.points.size() && s < matched.size(); ++s) {
+    if (matched[s] < 0) continue;
+    gaps.push_back(outline.normals[s].dot(outline.points[s] - projected[matched[s]]));
+  }
+  if (gaps.empty()) return 0.0;
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  return gaps[gaps.size() / 2];
+}
+
+std::vector<Eigen::Vector2d> ShiftedOutline(const MaskOutline& outline,
+                                            double margin_px) {
+  std::vector<Eigen::Vector2d> out(outline.points.size());
+  for (size_t s = 0; s < out.size(); ++s)
+    out[s] = outline.points[s] - margin_px * outline.normals[s];
+  return out;
 }
 
 }  // namespace handlabel

@@ -31,4 +31,15 @@ std::vector<int> MatchOutlineToPoints(const MaskOutline& outline,
                                       const std::vector<Eigen::Vector2d>& projected,
                                       const std::vector<char>& valid);
 
+// How far the mask's outline lies outside the projected hand's, in pixels (positive:
+// the mask is larger, e.g. dilated; negative: eroded): the median over the matched
+// outline samples (`matched` from MatchOutlineToPoints) of n . (p - projected[c]).
+// 0 when no sample is matched. Segmentation masks are often uniformly too fat or too
+// thin; the median ignores the samples where the fit or the mask is locally off.
+double EstimateMaskMargin(const MaskOutline& outline, const std::vector<int>& matched,
+                          const std::vector<Eigen::Vector2d>& projected);
+
+// The outline moved inwards by `margin_px` along its normals (outwards if negative).
+std::vector<Eigen::Vector2d> ShiftedOutline(const MaskOutline& outline, double margin_px);
+
 }  // namespace handlabel

@@ -230,6 +230,7 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
   }
   if (silhouettes != "none") {
     out.report["silhouette_sigma_px"] = fitter.options().silhouette_sigma_px;
+    out.report["view_mask_margin_px"] = fit.view_mask_margin_px;
   }
   return out;
 }

@@ -65,6 +65,10 @@ void CheckFitSettings(const FitSettings& fit, const std::string& f) {
       throw InputError(f, field, "> 0", std::to_string(**value));
     }
   }
+  if (fit.mask_margin_px && !(*fit.mask_margin_px >= 0 && *fit.mask_margin_px <= 50)) {
+    throw InputError(f, "fit.mask_margin_px", "0..50 (pixels)",
+                     std::to_string(*fit.mask_margin_px));
+  }
   if (fit.silhouette_rounds && *fit.silhouette_rounds < 0) {
     throw InputError(f, "fit.silhouette_rounds", ">= 0",
                      std::to_string(*fit.silhouette_rounds));
@@ -116,6 +120,7 @@ void ReadFitSection(Section& top, JobConfig* job) {
   ReadOptional(fit, "keypoint_sigma_px", &s.keypoint_sigma_px);
   ReadOptional(fit, "silhouette_sigma_px", &s.silhouette_sigma_px);
   ReadOptional(fit, "silhouette_rounds", &s.silhouette_rounds);
+  ReadOptional(fit, "mask_margin_px", &s.mask_margin_px);
   ReadOptional(fit, "pose_pca_comps", &s.pose_pca_comps);
   ReadOptional(fit, "joint_limits", &s.joint_limits);
   ReadOptional(fit, "optimise_shape", &s.optimise_shape);
@@ -205,7 +210,7 @@ bool FitSettings::IsDefault() const {
   return init == "triangulate" && !keypoint_loss && !keypoint_loss_scale &&
          !keypoint_sigma_px && !silhouette_sigma_px && !silhouette_rounds &&
          !pose_pca_comps && !joint_limits && !optimise_shape && !silhouette_check &&
-         !unknown_occluders;
+         !unknown_occluders && !mask_margin_px;
 }
 
 std::string ToString(RefineMode mode) {

@@ -50,9 +50,12 @@ struct FitSettings {
   std::optional<double> keypoint_sigma_px;    // keypoint error per residual unit, > 0
   std::optional<double> silhouette_sigma_px;  // silhouette error per residual unit, > 0
   std::optional<int> silhouette_rounds;       // outline re-matching rounds, >= 0
-  std::optional<int> pose_pca_comps;          // 0 (45 axis-angle values), 12 or 45
-  std::optional<bool> joint_limits;           // anatomical joint limits
-  std::optional<bool> optimise_shape;         // false: betas stay at the start's
+  // Largest per-view mask margin taken out (HandFitOptions::mask_margin_max_px), px,
+  // >= 0 (0 = off).
+  std::optional<double> mask_margin_px;
+  std::optional<int> pose_pca_comps;   // 0 (45 axis-angle values), 12 or 45
+  std::optional<bool> joint_limits;    // anatomical joint limits
+  std::optional<bool> optimise_shape;  // false: betas stay at the start's
   // Keep a silhouette fit only if it agrees with the keypoints-only fit (quality check
   // silhouette conflict, pipeline/quality_checks.h); false: always keep it.
   std::optional<bool> silhouette_check;

@@ -125,6 +125,7 @@ nlohmann::json FitSettingsJson(const FitSettings& f) {
   if (f.silhouette_check || f.unknown_occluders) {
     j.push_back({Optional(f.silhouette_check), Optional(f.unknown_occluders)});
   }
+  if (f.mask_margin_px) j.push_back({{"mask_margin_px", *f.mask_margin_px}});
   return j;
 }
 

@@ -33,6 +33,7 @@ CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
   o.fit.keypoint_sigma_px = s.keypoint_sigma_px.value_or(o.fit.keypoint_sigma_px);
   o.fit.silhouette_sigma_px = s.silhouette_sigma_px.value_or(o.fit.silhouette_sigma_px);
   o.fit.silhouette_rounds = s.silhouette_rounds.value_or(o.fit.silhouette_rounds);
+  o.fit.mask_margin_max_px = s.mask_margin_px.value_or(o.fit.mask_margin_max_px);
   o.config.pose_pca_comps = s.pose_pca_comps.value_or(o.config.pose_pca_comps);
   o.config.use_joint_limits = s.joint_limits.value_or(o.config.use_joint_limits);
   o.config.optimise_shape = s.optimise_shape.value_or(o.config.optimise_shape);

@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -79,6 +80,43 @@ TEST(FitCommand, SilhouetteCheckFlagsMapToJobFields) {
   EXPECT_EQ(record.fit.at("silhouettes"), "files+one_sided");
   EXPECT_EQ(record.fit.at("used"), "silhouettes");
   EXPECT_EQ(record.fit.at("silhouette_check").size(), 2u);
+}
+
+// --mask-margin is fit.mask_margin_px; the label records the margin taken out per view,
+// within the limit.
+TEST(FitCommand, MaskMarginFlagMapsToTheJobFieldAndIsRecorded) {
+  const std::string dir = testing::ScratchDir();
+  testing::WriteTestCapture(dir + "/capture", 1, 6);
+  const CommandResult fit = RunHandlabelCommand(
+      {"fit", "--capture", dir + "/capture", "--out", dir + "/fit", "--hand-model",
+       "capsule", "--silhouette-rounds", "1", "--mask-margin", "1.5"});
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  const std::string job = dir + "/job.yaml";
+  std::ofstream(job) << "hand_model: capsule\n"
+                     << "input: {format: native, path: capture}\n"
+                     << "refine: {mode: always}\n"
+                     << "evidence: {keypoints_2d: files, masks: files}\n"
+                     << "fit: {silhouette_rounds: 1, mask_margin_px: 1.5}\n"
+                     << "output: {dir: label, overlays: false}\n";
+  const CommandResult label = RunHandlabelCommand({"label", "--job", job});
+  ASSERT_EQ(label.status, 0) << label.err;
+  EXPECT_EQ(testing::FilesUnder(dir + "/fit/labels"),
+            testing::FilesUnder(dir + "/label/labels"));
+  const LabelRecord record = ReadLabelFile(LabelFilePath(dir + "/fit", "000000"));
+  const nlohmann::json& margins = record.fit.at("view_mask_margin_px");
+  ASSERT_EQ(margins.size(), 8u);  // the test capture's cameras
+  int estimated = 0;
+  for (const nlohmann::json& m : margins) {
+    if (m.is_null()) continue;
+    EXPECT_LE(std::abs(m.get<double>()), 1.5);
+    ++estimated;
+  }
+  EXPECT_GT(estimated, 0);
+  const CommandResult bad =
+      RunHandlabelCommand({"fit", "--capture", dir + "/capture", "--out", dir + "/bad",
+                           "--mask-margin", "-2"});
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("mask_margin_px"), std::string::npos) << bad.err;
 }
 
 // `fit` is a label job without a network: on the same capture it writes the same label

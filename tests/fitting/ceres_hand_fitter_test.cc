@@ -253,3 +253,76 @@ TEST(CeresHandFitterSilhouetteTest, OneSidedSilhouettesWithUnknownOccluders) {
 
 }  // namespace
 }  // namespace handlabel
+
+namespace handlabel {
+namespace {
+
+// `mask` grown (radius > 0) or shrunk (radius < 0) by a disc of |radius| pixels.
+MaskImage MorphDisc(const MaskImage& mask, int radius) {
+  MaskImage out = mask;
+  const uint8_t grow = radius > 0;
+  const int r = std::abs(radius);
+  for (Eigen::Index y = 0; y < mask.rows(); ++y) {
+    for (Eigen::Index x = 0; x < mask.cols(); ++x) {
+      for (int dy = -r; dy <= r && out(y, x) != grow * 255; ++dy) {
+        for (int dx = -r; dx <= r; ++dx) {
+          const Eigen::Index u = x + dx, v = y + dy;
+          if (dx * dx + dy * dy > r * r || u < 0 || v < 0 || u >= mask.cols() ||
+              v >= mask.rows() || (mask(v, u) != 0) != grow) {
+            continue;
+          }
+          out(y, x) = grow * 255;
+          break;
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// Masks dilated or eroded by 2 px (alternating over the views), exact keypoints: the
+// fitter finds each view's margin and, with it taken out, the silhouettes pull the
+// hand less off the keypoints' pose than without. An eroded outline lies inside the
+// hand, where its samples match the nearest contour-band vertex rather than the rim (as
+// in the silhouette term itself), so the margin found there is smaller than 2 px: it is
+// the offset the term would pull by.
+TEST(CeresHandFitterSilhouetteTest, MaskMarginTakesOutDilatedAndErodedMasks) {
+  const SilhouetteScene scene;
+  HandFitOptions off_options = SilhouetteScene::Options();
+  off_options.mask_margin_max_px = 0;
+  const CeresHandFitter off(scene.model, {}, off_options);
+  for (int trial = 0; trial < 2; ++trial) {
+    auto [frame, input] = scene.NextTrial();
+    std::vector<int> radius;
+    for (size_t v = 0; v < input.masks.size(); ++v) {
+      radius.push_back(v % 2 == 0 ? 2 : -2);
+      input.masks[v] = MorphDisc(input.masks[v], radius.back());
+    }
+    const HandParams init = scene.fitter.InitFromViews(input.views);
+    const HandFitResult with = scene.fitter.Fit(input, init);
+    const HandFitResult without = off.Fit(input, init);
+    ASSERT_EQ(with.view_mask_margin_px.size(), input.masks.size());
+    double eroded_sum = 0;
+    for (size_t v = 0; v < input.masks.size(); ++v) {
+      const double margin = with.view_mask_margin_px[v];
+      if (radius[v] > 0) {
+        EXPECT_NEAR(margin, 2.0, 0.75) << trial << " view " << v;
+      } else {
+        EXPECT_LT(margin, 0.0) << trial << " view " << v;
+        eroded_sum += margin;
+      }
+      EXPECT_TRUE(std::isnan(without.view_mask_margin_px[v]));
+    }
+    EXPECT_LT(eroded_sum / 4, -0.3) << trial;
+    const double with_mm = 1000 * MeanPointError(with.vertices, frame.mesh.vertices);
+    const double without_mm =
+        1000 * MeanPointError(without.vertices, frame.mesh.vertices);
+    std::cout << "trial " << trial << ": vertex error with margin " << with_mm
+              << " mm, without " << without_mm << " mm\n";
+    EXPECT_LT(with_mm, 1.2) << trial;
+    EXPECT_LT(with_mm, without_mm - 0.02) << trial;
+  }
+}
+
+}  // namespace
+}  // namespace handlabel

@@ -29,6 +29,36 @@ TEST(SilhouetteOutlineTest, DiskOutlineAndNormals) {
   }
 }
 
+// Projected points on a circle 3 px inside a disk mask's outline; every fifth outline
+// sample is matched to the centre instead (where the fit or the mask is locally off):
+// the margin is the median gap, 3 px.
+TEST(SilhouetteOutlineTest, MaskMarginIsTheMedianGap) {
+  const Eigen::Vector2d centre(50.3, 40.6);
+  MaskImage mask = MaskImage::Zero(90, 110);
+  for (int y = 0; y < 90; ++y) {
+    for (int x = 0; x < 110; ++x)
+      mask(y, x) = (Eigen::Vector2d(x, y) - centre).norm() <= 20;
+  }
+  const MaskOutline outline = SampleMaskOutline(mask, 60);
+  std::vector<Eigen::Vector2d> projected;
+  for (int i = 0; i < 360; ++i) {
+    const double a = i * M_PI / 180;
+    projected.push_back(centre + 17.0 * Eigen::Vector2d(std::cos(a), std::sin(a)));
+  }
+  std::vector<int> match =
+      MatchOutlineToPoints(outline, projected, std::vector<char>(projected.size(), 1));
+  projected.push_back(centre);
+  for (size_t s = 0; s < match.size(); s += 5) match[s] = 360;
+  EXPECT_NEAR(EstimateMaskMargin(outline, match, projected), 3.0, 0.6);
+  EXPECT_EQ(EstimateMaskMargin(outline, std::vector<int>(match.size(), -1), projected),
+            0);
+  const std::vector<Eigen::Vector2d> shifted = ShiftedOutline(outline, 3.0);
+  ASSERT_EQ(shifted.size(), outline.points.size());
+  for (size_t s = 0; s < shifted.size(); ++s) {
+    EXPECT_NEAR((shifted[s] - centre).norm(), 17.0, 0.8);
+  }
+}
+
 TEST(SilhouetteOutlineTest, MatchesNearestValidPoint) {
   MaskOutline outline;
   outline.points = {{0, 0}, {10, 0}};

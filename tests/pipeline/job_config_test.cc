@@ -127,7 +127,8 @@ TEST(JobConfig, FitSectionAndFileEvidence) {
                                     "evidence: {keypoint_files: keypoints, mask_files: "
                                     "truth, ignore_views: [cam01]}\n"
                                     "fit: {init: gt, keypoint_loss: huber, "
-                                    "silhouette_rounds: 0, joint_limits: false}\n");
+                                    "silhouette_rounds: 0, joint_limits: false, "
+                                    "mask_margin_px: 1.5}\n");
   const JobConfig job = LoadJobConfig(path);
   EXPECT_EQ(job.keypoint_files, "keypoints");
   EXPECT_EQ(job.mask_files, "truth");
@@ -136,6 +137,7 @@ TEST(JobConfig, FitSectionAndFileEvidence) {
   EXPECT_EQ(job.fit.keypoint_loss, std::optional<std::string>("huber"));
   EXPECT_EQ(job.fit.silhouette_rounds, std::optional<int>(0));
   EXPECT_EQ(job.fit.joint_limits, std::optional<bool>(false));
+  EXPECT_EQ(job.fit.mask_margin_px, std::optional<double>(1.5));
   EXPECT_FALSE(job.fit.keypoint_sigma_px.has_value());
   EXPECT_FALSE(job.fit.IsDefault());
   // A folder start resolves against the job's folder.
@@ -153,6 +155,7 @@ TEST(JobConfig, FitSectionErrorsNameTheField) {
               "cauchy | huber | trivial");
   ExpectError(base + "fit: {keypoint_sigma_px: 0}\n", "fit.keypoint_sigma_px", "> 0");
   ExpectError(base + "fit: {pose_pca_comps: 7}\n", "fit.pose_pca_comps", "0, 12 or 45");
+  ExpectError(base + "fit: {mask_margin_px: -1}\n", "fit.mask_margin_px", "0..50");
   ExpectError(base + "fit: {rounds: 2}\n", "fit.rounds", "a known key");
   ExpectError(base + "evidence: {keypoint_files: guesses}\n", "evidence.keypoint_files",
               "auto | detections | keypoints");
