@@ -330,18 +330,6 @@ ShadingOptions RealisticLighting(std::mt19937_64& rng) {
 
 }  // namespace
 
-SynthAppearance SynthAppearanceFromName(const std::string& name,
-                                        const std::string& source,
-                                        const std::string& field) {
-  if (name == "basic") return SynthAppearance::kBasic;
-  if (name == "realistic") return SynthAppearance::kRealistic;
-  throw InputError(source, field, "basic | realistic", "'" + name + "'");
-}
-
-std::string SynthAppearanceName(SynthAppearance appearance) {
-  return appearance == SynthAppearance::kRealistic ? "realistic" : "basic";
-}
-
 void RealisticLookOptions::Check() const {
   const std::string src = "realistic look options";
   if (!(forearm_length > 0.02 && forearm_length < 1)) {

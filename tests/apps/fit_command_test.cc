@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_record.h"
@@ -52,31 +53,44 @@ TEST(FitCommand, BadUnknownOccludersIsAnErrorNamingTheFlag) {
   EXPECT_NE(r.err.find("one_sided | two_sided"), std::string::npos) << r.err;
 }
 
-// The silhouette flags are job fields too: --no-silhouette-check is
-// fit.silhouette_check: false, --unknown-occluders is fit.unknown_occluders.
-TEST(FitCommand, SilhouetteCheckFlagsMapToJobFields) {
-  const std::string dir = testing::ScratchDir();
+// Runs `fit` with `flags` on a one-frame test capture in `dir`, then `label` with a job
+// of the same `evidence` and `fit` sections (YAML flow mappings); both must write the
+// same label files. Returns the fit's label of frame 000000.
+LabelRecord FitEqualsLabelJob(const std::string& dir,
+                              const std::vector<std::string>& flags,
+                              const std::string& evidence, const std::string& fit) {
   testing::WriteTestCapture(dir + "/capture", 1, 6);
-  const CommandResult fit = RunHandlabelCommand(
-      {"fit", "--capture", dir + "/capture", "--out", dir + "/fit", "--hand-model",
-       "capsule", "--evidence", "keypoints", "--masks", "truth", "--silhouette-rounds",
-       "1", "--object-masks", "none", "--unknown-occluders", "one_sided",
-       "--no-silhouette-check"});
-  ASSERT_EQ(fit.status, 0) << fit.err;
+  std::vector<std::string> args = {"fit",    "--capture",  dir + "/capture",
+                                   "--out",  dir + "/fit", "--hand-model",
+                                   "capsule"};
+  args.insert(args.end(), flags.begin(), flags.end());
+  const CommandResult fit_run = RunHandlabelCommand(args);
+  EXPECT_EQ(fit_run.status, 0) << fit_run.err;
   const std::string job = dir + "/job.yaml";
   std::ofstream(job) << "hand_model: capsule\n"
                      << "input: {format: native, path: capture}\n"
                      << "refine: {mode: always}\n"
-                     << "evidence: {keypoints_2d: files, masks: files, keypoint_files: "
-                        "keypoints, mask_files: truth, object_masks: none}\n"
-                     << "fit: {silhouette_rounds: 1, silhouette_check: false, "
-                        "unknown_occluders: one_sided}\n"
+                     << "evidence: " << evidence << "\n"
+                     << "fit: " << fit << "\n"
                      << "output: {dir: label, overlays: false}\n";
   const CommandResult label = RunHandlabelCommand({"label", "--job", job});
-  ASSERT_EQ(label.status, 0) << label.err;
+  EXPECT_EQ(label.status, 0) << label.err;
   EXPECT_EQ(testing::FilesUnder(dir + "/fit/labels"),
             testing::FilesUnder(dir + "/label/labels"));
-  const LabelRecord record = ReadLabelFile(LabelFilePath(dir + "/fit", "000000"));
+  return ReadLabelFile(LabelFilePath(dir + "/fit", "000000"));
+}
+
+// The silhouette flags are job fields too: --no-silhouette-check is
+// fit.silhouette_check: false, --unknown-occluders is fit.unknown_occluders.
+TEST(FitCommand, SilhouetteCheckFlagsMapToJobFields) {
+  const LabelRecord record = FitEqualsLabelJob(
+      testing::ScratchDir(),
+      {"--evidence", "keypoints", "--masks", "truth", "--silhouette-rounds", "1",
+       "--object-masks", "none", "--unknown-occluders", "one_sided",
+       "--no-silhouette-check"},
+      "{keypoints_2d: files, masks: files, keypoint_files: keypoints, mask_files: "
+      "truth, object_masks: none}",
+      "{silhouette_rounds: 1, silhouette_check: false, unknown_occluders: one_sided}");
   EXPECT_EQ(record.fit.at("silhouettes"), "files+one_sided");
   EXPECT_EQ(record.fit.at("used"), "silhouettes");
   EXPECT_EQ(record.fit.at("silhouette_check").size(), 2u);
@@ -86,23 +100,10 @@ TEST(FitCommand, SilhouetteCheckFlagsMapToJobFields) {
 // within the limit.
 TEST(FitCommand, MaskMarginFlagMapsToTheJobFieldAndIsRecorded) {
   const std::string dir = testing::ScratchDir();
-  testing::WriteTestCapture(dir + "/capture", 1, 6);
-  const CommandResult fit = RunHandlabelCommand(
-      {"fit", "--capture", dir + "/capture", "--out", dir + "/fit", "--hand-model",
-       "capsule", "--silhouette-rounds", "1", "--mask-margin", "1.5"});
-  ASSERT_EQ(fit.status, 0) << fit.err;
-  const std::string job = dir + "/job.yaml";
-  std::ofstream(job) << "hand_model: capsule\n"
-                     << "input: {format: native, path: capture}\n"
-                     << "refine: {mode: always}\n"
-                     << "evidence: {keypoints_2d: files, masks: files}\n"
-                     << "fit: {silhouette_rounds: 1, mask_margin_px: 1.5}\n"
-                     << "output: {dir: label, overlays: false}\n";
-  const CommandResult label = RunHandlabelCommand({"label", "--job", job});
-  ASSERT_EQ(label.status, 0) << label.err;
-  EXPECT_EQ(testing::FilesUnder(dir + "/fit/labels"),
-            testing::FilesUnder(dir + "/label/labels"));
-  const LabelRecord record = ReadLabelFile(LabelFilePath(dir + "/fit", "000000"));
+  const LabelRecord record =
+      FitEqualsLabelJob(dir, {"--silhouette-rounds", "1", "--mask-margin", "1.5"},
+                        "{keypoints_2d: files, masks: files}",
+                        "{silhouette_rounds: 1, mask_margin_px: 1.5}");
   const nlohmann::json& margins = record.fit.at("view_mask_margin_px");
   ASSERT_EQ(margins.size(), 8u);  // the test capture's cameras
   int estimated = 0;
