@@ -49,7 +49,7 @@ std::vector<std::optional<Keypoints2d>> ReadDetectionsFile(const std::string& pa
 DetectionsFrameSource::DetectionsFrameSource(std::unique_ptr<FrameSource> inner,
                                              const std::string& folder,
                                              const std::string& field)
-    : inner_(std::move(inner)), folder_(folder) {
+    : Replaced2dFrameSource(std::move(inner)), folder_(folder) {
   if (!fs::is_directory(folder)) {
     throw InputError(folder, field,
                      "a folder of 2D detections, <frame id>.json per frame",
@@ -62,10 +62,6 @@ FrameInput DetectionsFrameSource::Load(const std::string& id) const {
   frame.keypoints_2d =
       ReadDetectionsFile((fs::path(folder_) / (id + ".json")).string(), frame.rig);
   return frame;
-}
-
-std::string DetectionsFrameSource::Describe() const {
-  return inner_->Describe() + "; 2D keypoints from " + KeypointsSource();
 }
 
 std::string DetectionsFrameSource::KeypointsSource() const {

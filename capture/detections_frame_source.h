@@ -12,25 +12,21 @@
 #include <string>
 #include <vector>
 
-#include "capture/frame_source.h"
+#include "capture/replaced_2d_frame_source.h"
 
 namespace handlabel {
 
-class DetectionsFrameSource : public FrameSource {
+class DetectionsFrameSource : public Replaced2dFrameSource {
  public:
   // Reads frames from `inner` and their 2D keypoints from `folder` (which must exist;
   // InputError naming `field` otherwise), replacing any the capture has.
   DetectionsFrameSource(std::unique_ptr<FrameSource> inner, const std::string& folder,
                         const std::string& field = "evidence.detections");
-  std::vector<std::string> FrameIds() const override { return inner_->FrameIds(); }
   // Throws InputError naming the detection file when it is missing or malformed.
   FrameInput Load(const std::string& id) const override;
-  std::string Describe() const override;
   std::string KeypointsSource() const override;
-  std::optional<HandSide> side() const override { return inner_->side(); }
 
  private:
-  std::unique_ptr<FrameSource> inner_;
   std::string folder_;
 };
 

@@ -11,7 +11,7 @@
 #include "core/image_file.h"
 #include "core/json_util.h"
 #include "core/stopwatch.h"
-#include "pipeline/detect_overlay.h"
+#include "network/detector_overlay.h"
 
 namespace handlabel {
 namespace {

@@ -22,7 +22,7 @@ struct DetectCaptureOptions {
   // Replace detections the capture already has (e.g. a synthetic capture's simulated
   // ones); without it such a capture is refused, so nothing written is lost.
   bool overwrite = false;
-  // When set, also a picture per view of what was found (pipeline/detect_overlay.h):
+  // When set, also a picture per view of what was found (network/detector_overlay.h):
   // <overlays_dir>/<frame>/<camera>.png.
   std::string overlays_dir;
   // Throws InputError naming `source` when a field is out of range.

@@ -39,7 +39,9 @@ std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
 DetectorFrameSource::DetectorFrameSource(std::unique_ptr<FrameSource> inner,
                                          const DetectCaptureOptions& options,
                                          std::shared_ptr<DetectionStore> store)
-    : inner_(std::move(inner)), options_(options), store_(std::move(store)) {
+    : Replaced2dFrameSource(std::move(inner)),
+      options_(options),
+      store_(std::move(store)) {
   options_.Check("evidence.keypoints_2d: detector");
   detector_ = std::make_unique<MediapipeHands>(options_.hands);
 }
@@ -64,10 +66,6 @@ FrameInput DetectorFrameSource::Load(const std::string& id) const {
   frame.keypoints_2d = KeypointsFromDetection(result);
   if (store_) store_->Put(id, std::move(result));
   return frame;
-}
-
-std::string DetectorFrameSource::Describe() const {
-  return inner_->Describe() + "; 2D keypoints from " + KeypointsSource();
 }
 
 std::string DetectorFrameSource::KeypointsSource() const {

@@ -5,7 +5,7 @@
 // `handlabel detect --capture` would write them (pipeline/detect_capture.h): a
 // keypoint with confidence 0 is unknown (position 0), a view without a detection has
 // none. The detector's full answer per frame stays available to the overlay writer
-// (DetectionStore), which draws it (pipeline/detect_overlay.h).
+// (DetectionStore), which draws it (network/detector_overlay.h).
 
 #include <map>
 #include <memory>
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "capture/frame_source.h"
+#include "capture/replaced_2d_frame_source.h"
 #include "network/hand_detector.h"
 #include "pipeline/detect_capture.h"
 
@@ -39,23 +39,19 @@ class DetectionStore {
 std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
     const FrameHandResult& result);
 
-class DetectorFrameSource : public FrameSource {
+class DetectorFrameSource : public Replaced2dFrameSource {
  public:
   // Loads the models (InputError naming the file when one is missing). `store` may be
   // null (nothing kept).
   DetectorFrameSource(std::unique_ptr<FrameSource> inner,
                       const DetectCaptureOptions& options,
                       std::shared_ptr<DetectionStore> store);
-  std::vector<std::string> FrameIds() const override { return inner_->FrameIds(); }
   // Reads the frame's images (InputError naming a file that cannot be read or does not
   // fit its camera) and detects; frames are detected one at a time.
   FrameInput Load(const std::string& id) const override;
-  std::string Describe() const override;
   std::string KeypointsSource() const override;
-  std::optional<HandSide> side() const override { return inner_->side(); }
 
  private:
-  std::unique_ptr<FrameSource> inner_;
   DetectCaptureOptions options_;
   std::unique_ptr<MediapipeHands> detector_;
   std::shared_ptr<DetectionStore> store_;

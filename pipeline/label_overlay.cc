@@ -9,7 +9,7 @@
 #include "core/image_file.h"
 #include "core/rasterizer.h"
 #include "core/view_image.h"
-#include "pipeline/detect_overlay.h"
+#include "network/detector_overlay.h"
 #include "pipeline/label_outputs.h"
 
 namespace handlabel {

@@ -23,7 +23,7 @@ class RasterOverlayWriter : public OverlayWriter {
  public:
   // `detections`: the detector's answers when the job's 2D comes from it
   // (evidence.keypoints_2d: detector); each view then also shows its detection
-  // (pipeline/detect_overlay.h). Null: the label only.
+  // (network/detector_overlay.h). Null: the label only.
   explicit RasterOverlayWriter(const HandModel& model,
                                std::shared_ptr<DetectionStore> detections = nullptr)
       : faces_(model.faces), detections_(std::move(detections)) {}

@@ -1,4 +1,4 @@
-#include "pipeline/detect_overlay.h"
+#include "network/detector_overlay.h"
 
 #include <gtest/gtest.h>
 
