@@ -119,6 +119,9 @@ RobustTriangulation TriangulateRobust(const Rig& rig,
   double best_score = -1;
   double best_error = std::numeric_limits<double>::infinity();
   for (const auto& [i, j] : pairs) {
+    // Once every observation is an inlier no hypothesis can change the inlier set,
+    // and the answer is the DLT over that set: the clean case needs one pair.
+    if (best.inliers.size() == usable.size()) break;
     const auto hypothesis = TriangulatePrepared({&prepared[i], &prepared[j]});
     if (!hypothesis) continue;
     double score = 0;

@@ -96,6 +96,10 @@ void RequirePositive(double value, const char* field) {
 void RequireNonNegative(int value, const char* field) {
   if (value < 0) throw InputError("HandFitOptions", field, ">= 0", std::to_string(value));
 }
+// A double overload: through the int one -0.5 would truncate to 0 and pass.
+void RequireNonNegative(double value, const char* field) {
+  if (!(value >= 0)) throw InputError("HandFitOptions", field, ">= 0", Str(value));
+}
 
 ceres::Solver::Options SolverOptions(const HandFitOptions& o, int iterations) {
   ceres::Solver::Options s;
@@ -123,10 +127,13 @@ class StageProblem {
     problem_->AddParameterBlock(blocks->betas, kBetas);
     problem_->AddParameterBlock(blocks->transl, 3);
   }
-  void AddFull(const std::string& term, ceres::CostFunction* cost) {
+  // `folded`: terms evaluated inside `cost` (folded_terms.h), reported on their own.
+  void AddFull(const std::string& term, ceres::CostFunction* cost,
+               const FoldedTerms* folded = nullptr) {
     ids_[term].push_back(problem_->AddResidualBlock(cost, nullptr, blocks_->orient,
                                                     blocks_->pose.data(), blocks_->betas,
                                                     blocks_->transl));
+    if (folded != nullptr && !folded->empty()) folded_.emplace_back(term, folded);
   }
   void Add(const std::string& term, ceres::CostFunction* cost, double* block) {
     ids_[term].push_back(problem_->AddResidualBlock(cost, nullptr, block));
@@ -149,6 +156,14 @@ class StageProblem {
       }
       costs[term] = total;
     }
+    const double* params[] = {blocks_->orient, blocks_->pose.data(), blocks_->betas,
+                              blocks_->transl};
+    for (const auto& [host, folded] : folded_) {
+      for (const auto& [term, cost] : folded->Costs(params)) {
+        costs[term] += cost;
+        costs[host] -= cost;
+      }
+    }
     return costs;
   }
 
@@ -156,6 +171,7 @@ class StageProblem {
   Blocks* blocks_;
   std::unique_ptr<ceres::Problem> problem_;
   std::map<std::string, std::vector<ceres::ResidualBlockId>> ids_;
+  std::vector<std::pair<std::string, const FoldedTerms*>> folded_;
 };
 
 bool IsDone(const ceres::Solver::Summary& s) {
@@ -215,6 +231,7 @@ void HandFitOptions::Check() const {
   RequireNonNegative(silhouette_window_margin_px, "silhouette_window_margin_px");
   RequirePositive(unknown_occluder_cap_px, "unknown_occluder_cap_px");
   RequireNonNegative(mask_margin_max_px, "mask_margin_max_px");
+  RequireNonNegative(rigid_skip_below_px, "rigid_skip_below_px");
   RequireNonNegative(rigid_iterations, "rigid_iterations");
   RequireNonNegative(keypoint_iterations, "keypoint_iterations");
   RequireNonNegative(init_iterations, "init_iterations");
@@ -305,24 +322,55 @@ class FitRun {
     return p;
   }
 
-  void AddPriors(StageProblem* problem, Blocks* b) const {
+  // Calls add(name, cost, block) for each prior the config asks for; block indexes the
+  // full parameter blocks (orient, pose, betas, transl).
+  template <typename Add>
+  void ForEachPrior(Add add) const {
+    constexpr int kPoseBlock = 1, kBetasBlock = 2;
     if (config_.use_joint_limits) {
       const double w = 1.0 / std::pow(options_.limit_sigma_deg * M_PI / 180.0, 2);
-      problem->Add("joint_limits",
-                   JointLimitCost<P>::Create(evaluator_, anatomy_, limits_, w),
-                   b->pose.data());
+      add("joint_limits", JointLimitCost<P>::Create(evaluator_, anatomy_, limits_, w),
+          kPoseBlock);
     }
     if (config_.use_pose_prior) {
       const Eigen::Matrix<double, 45, 1> inv =
           Eigen::Matrix<double, 45, 1>::Constant(1.0 / options_.pose_prior_sigma_rad);
-      problem->Add("pose_prior",
-                   PosePriorCost<P>::Create(evaluator_, PoseMean(model_), inv),
-                   b->pose.data());
+      add("pose_prior", PosePriorCost<P>::Create(evaluator_, PoseMean(model_), inv),
+          kPoseBlock);
     }
     if (config_.use_shape_prior) {
-      problem->Add("shape_prior",
-                   ShapePriorCost<kBetas>::Create(options_.shape_prior_sigma), b->betas);
+      add("shape_prior", ShapePriorCost<kBetas>::Create(options_.shape_prior_sigma),
+          kBetasBlock);
     }
+  }
+  void AddPriors(StageProblem* problem, Blocks* b) const {
+    double* blocks[] = {b->orient, b->pose.data(), b->betas, b->transl};
+    ForEachPrior([&](const char* name, ceres::CostFunction* cost, int block) {
+      problem->Add(name, cost, blocks[block]);
+    });
+  }
+
+  // Median distance (px) between the observed 2D keypoints and the projections of the
+  // hand of `b` over all views; infinity without observations.
+  double MedianKeypointErrorPx(const std::vector<KeypointView>& views,
+                               const Blocks& b) const {
+    double keypoints[3 * kNumHandKeypoints];
+    evaluator_.Keypoints(b.orient, b.pose.data(), b.betas, b.transl, keypoints);
+    std::vector<double> errors;
+    for (const KeypointView& view : views) {
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        Eigen::Vector2d uv;
+        if (!(view.keypoints.confidence[k] > 0.0) ||
+            !view.camera.ProjectWorld(Eigen::Vector3d::Map(keypoints + 3 * k), &uv)) {
+          continue;
+        }
+        errors.push_back((uv - view.keypoints.uv_px.row(k).transpose()).norm());
+      }
+    }
+    if (errors.empty()) return std::numeric_limits<double>::infinity();
+    auto middle = errors.begin() + errors.size() / 2;
+    std::nth_element(errors.begin(), middle, errors.end());
+    return *middle;
   }
 
   // 3D targets as the only evidence: the IK-style initialisation.
@@ -375,11 +423,19 @@ class FitRun {
     use_sil &= config_.use_silhouettes && options_.silhouette_rounds > 0;
 
     HandFitResult result;
-    auto add_evidence = [&](StageProblem* problem) {
+    // with_priors: the priors too, folded into the keypoint term when there is one.
+    auto add_evidence = [&](StageProblem* problem, bool with_priors) {
       if (use_kp) {
-        problem->AddFull("keypoints", MultiViewKeypointSquareRootCost::Create(
-                                          evaluator_, input.views, options_.keypoint_loss,
-                                          options_.keypoint_sigma_px));
+        auto* keypoints = new MultiViewKeypointSquareRootCost(
+            evaluator_, input.views, options_.keypoint_loss, options_.keypoint_sigma_px);
+        if (with_priors) {
+          ForEachPrior([&](const char* name, ceres::CostFunction* cost, int block) {
+            keypoints->folded()->Add(name, cost, block);
+          });
+        }
+        problem->AddFull("keypoints", keypoints, keypoints->folded());
+      } else if (with_priors) {
+        AddPriors(problem, &b);
       }
       if (use_3d) {
         problem->AddFull("points3d",
@@ -407,18 +463,20 @@ class FitRun {
       result.term_costs = problem->TermCosts();
     };
 
-    // 1. Rigid.
-    if ((use_kp || use_3d) && options_.rigid_iterations > 0) {
+    // 1. Rigid: brings a far start (a flat hand, another frame's answer) into the
+    // keypoints' basin; a start already aligned to this frame's keypoints skips it.
+    if ((use_kp || use_3d) && options_.rigid_iterations > 0 &&
+        !(use_kp &&
+          MedianKeypointErrorPx(input.views, b) < options_.rigid_skip_below_px)) {
       StageProblem problem(&b);
-      add_evidence(&problem);
+      add_evidence(&problem, /*with_priors=*/false);
       problem.Hold(b.pose.data());
       problem.Hold(b.betas);
       run(&problem, options_.rigid_iterations);
     }
     // 2. Pose and shape on keypoints.
     auto full_problem = [&](StageProblem* problem) {
-      add_evidence(problem);
-      AddPriors(problem, &b);
+      add_evidence(problem, /*with_priors=*/true);
       add_temporal(problem);
       if (!config_.optimise_shape) problem->Hold(b.betas);
     };
@@ -551,9 +609,12 @@ class FitRun {
     return out;
   }
 
+  // `solve` = false keeps the closed form (rigid palm alignment + bone alignment) where
+  // it applies: a keypoint fit follows and refines it anyway.
   HandParams InitFromKeypoints3d(const Points3d& keypoints,
                                  const Eigen::VectorXd& weights,
-                                 const Eigen::Vector3d& fallback_position) const {
+                                 const Eigen::Vector3d& fallback_position,
+                                 bool solve) const {
     HL_CHECK(keypoints.rows() == kNumHandKeypoints && weights.size() == kNumHandKeypoints,
              "21 keypoints and weights");
     Blocks b = ToBlocks(HandParams());
@@ -589,14 +650,16 @@ class FitRun {
       b.orient[i] = orient[i];
       b.transl[i] = transl[i];
     }
+    bool closed_form = false;
     if constexpr (P == kNumPoseParams) {
       if (source.size() >= 3) {
         const Points3d rest_points =
             Eigen::Map<const Points3d>(rest, kNumHandKeypoints, 3);
         AnalyticHandPose(rest_points, keypoints, weights, r, b.pose.data());
+        closed_form = true;
       }
     }
-    if (known >= 4) {
+    if (known >= 4 && (solve || !closed_form)) {
       Points3dTargets targets;
       targets.keypoints = keypoints;
       targets.keypoint_weights = weights.cwiseMax(0.0);
@@ -621,10 +684,10 @@ HandParams CeresHandFitter::InitFromKeypoints3d(const Points3d& keypoints,
   const Eigen::Vector3d fallback(0, 0, options_.fallback_depth_m);
   if (evaluator_.pose_dim() == 12) {
     return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
-        .InitFromKeypoints3d(keypoints, weights, fallback);
+        .InitFromKeypoints3d(keypoints, weights, fallback, /*solve=*/true);
   }
   return FitRun<45>(model_, evaluator_, anatomy_, limits_, config_, options_)
-      .InitFromKeypoints3d(keypoints, weights, fallback);
+      .InitFromKeypoints3d(keypoints, weights, fallback, /*solve=*/true);
 }
 
 HandParams CeresHandFitter::InitFromViews(const std::vector<KeypointView>& views) const {
@@ -658,10 +721,10 @@ HandParams CeresHandFitter::InitFromViews(const std::vector<KeypointView>& views
   }
   if (evaluator_.pose_dim() == 12) {
     return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
-        .InitFromKeypoints3d(keypoints, weights, fallback);
+        .InitFromKeypoints3d(keypoints, weights, fallback, /*solve=*/false);
   }
   return FitRun<45>(model_, evaluator_, anatomy_, limits_, config_, options_)
-      .InitFromKeypoints3d(keypoints, weights, fallback);
+      .InitFromKeypoints3d(keypoints, weights, fallback, /*solve=*/false);
 }
 
 HandFitResult CeresHandFitter::Fit(const HandFitInput& input,

@@ -101,6 +101,10 @@ struct HandFitOptions {
   double mask_margin_max_px = 3.0;
   // Ceres iterations per stage (silhouette: per round).
   int rigid_iterations = 20;
+  // The rigid stage is skipped when the start's median keypoint reprojection error
+  // over all views is below this (px): a start aligned to this frame's keypoints
+  // (InitFromViews) needs no rigid pass. 0 = always run it; >= 0.
+  double rigid_skip_below_px = 10.0;
   int keypoint_iterations = 60;
   int silhouette_iterations = 10;
   // Pose-and-shape iterations of the 3D initialisation (InitFromKeypoints3d/Views): it
@@ -189,7 +193,10 @@ class CeresHandFitter {
   HandParams InitFromKeypoints3d(const Points3d& keypoints,
                                  const Eigen::VectorXd& weights) const;
   // The baseline's start: each keypoint triangulated robustly over the views
-  // (core/triangulation.h), then InitFromKeypoints3d.
+  // (core/triangulation.h), then InitFromKeypoints3d's closed form (rigid palm
+  // alignment + bone alignment) without its pose-and-shape solve: Fit's keypoint stage
+  // does that against the 2D keypoints themselves. With a PCA pose (no closed form)
+  // or fewer than 3 palm keypoints the 3D solve still runs.
   HandParams InitFromViews(const std::vector<KeypointView>& views) const;
 
   // Staged solve from `init`.

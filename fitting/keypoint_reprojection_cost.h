@@ -17,7 +17,8 @@
 //                                       autodiff one in tests.
 //   MultiViewKeypointSquareRootCost     the analytic one in square-root form (what the
 //                                       fitter uses): same cost, gradient and
-//                                       Gauss-Newton matrix in num_params + 1 rows.
+//                                       Gauss-Newton matrix in num_params + 1 rows;
+//                                       the priors may be folded into it.
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/cost_function.h>
@@ -28,6 +29,7 @@
 
 #include "core/camera_models.h"
 #include "core/hand_evaluator.h"
+#include "fitting/folded_terms.h"
 #include "fitting/keypoint_view.h"
 #include "fitting/point_term_normal_equations.h"
 #include "fitting/robust_loss.h"
@@ -241,7 +243,8 @@ class MultiViewKeypointSquareRootCost : public ceres::CostFunction {
       : evaluator_(evaluator),
         views_(MakeKeypointViewData(views, sigma_px)),
         loss_(loss),
-        block_sizes_({3, evaluator.pose_dim(), evaluator.num_betas(), 3}) {
+        block_sizes_({3, evaluator.pose_dim(), evaluator.num_betas(), 3}),
+        folded_(block_sizes_) {
     set_num_residuals(evaluator.num_params() + 1);
     mutable_parameter_block_sizes()->assign(block_sizes_.begin(), block_sizes_.end());
   }
@@ -267,7 +270,7 @@ class MultiViewKeypointSquareRootCost : public ceres::CostFunction {
           squared_norm += r[0] * r[0] + r[1] * r[1];
         }
       }
-      WriteCostOnly(squared_norm, n + 1, residuals);
+      WriteCostOnly(squared_norm + folded_.SquaredNorm(parameters), n + 1, residuals);
       return true;
     }
     kp_jac.resize(3 * kNumHandKeypoints * n);
@@ -291,15 +294,25 @@ class MultiViewKeypointSquareRootCost : public ceres::CostFunction {
     for (size_t i = 0; i < used.size(); ++i) {
       std::copy_n(kp_jac.data() + 3 * used[i] * n, 3 * n, used_jac.data() + 3 * i * n);
     }
-    normal.WriteCeresOutput(used_jac.data(), n, block_sizes_, residuals, jacobians);
+    Eigen::MatrixXd jtj;
+    Eigen::VectorXd jtr;
+    normal.Accumulate(used_jac.data(), n, &jtj, &jtr);
+    double squared_norm = normal.squared_norm();
+    folded_.AddNormalEquations(parameters, &jtj, &jtr, &squared_norm);
+    WriteSquareRootForm(jtj, jtr, squared_norm, block_sizes_, residuals, jacobians);
     return true;
   }
+
+  // Terms on one of this cost's blocks evaluated inside it (folded_terms.h).
+  FoldedTerms* folded() { return &folded_; }
+  const FoldedTerms& folded() const { return folded_; }
 
  private:
   const HandEvaluator& evaluator_;
   std::vector<KeypointViewData> views_;
   RobustLoss loss_;
   std::vector<int> block_sizes_;
+  FoldedTerms folded_;
 };
 
 }  // namespace handlabel

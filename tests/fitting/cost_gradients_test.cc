@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <utility>
 
 #include "core/hand_anatomy.h"
 #include "fitting/axis_angle_manifold.h"
@@ -95,14 +96,13 @@ void EvaluateFull(const ceres::CostFunction& cost,
 // A term in square-root form (fitting/point_term_normal_equations.h) against the same
 // term with one row per residual: equal cost (with and without Jacobians), gradient
 // J^T r and Gauss-Newton matrix J^T J, each within `tolerance` of its largest entry.
-void ExpectSameGaussNewton(const ceres::CostFunction& rows,
+// `r` and `j`: the rows' residuals and full Jacobian.
+void ExpectSameGaussNewton(const Eigen::VectorXd& r, const Eigen::MatrixXd& j,
                            const ceres::CostFunction& square_root,
                            const std::vector<const double*>& blocks,
                            double tolerance = 1e-8) {
-  ASSERT_EQ(rows.parameter_block_sizes(), square_root.parameter_block_sizes());
-  Eigen::VectorXd r, r2;
-  Eigen::MatrixXd j, j2;
-  EvaluateFull(rows, blocks, &r, &j);
+  Eigen::VectorXd r2;
+  Eigen::MatrixXd j2;
   EvaluateFull(square_root, blocks, &r2, &j2);
   ASSERT_EQ(r2.size(), j.cols() + 1);
   EXPECT_GT(r.squaredNorm(), 0.0);
@@ -117,6 +117,17 @@ void ExpectSameGaussNewton(const ceres::CostFunction& rows,
   EXPECT_THAT(
       Eigen::MatrixXd(j2.transpose() * j2),
       testing::MatrixNear(gauss_newton, tolerance * gauss_newton.cwiseAbs().maxCoeff()));
+}
+
+void ExpectSameGaussNewton(const ceres::CostFunction& rows,
+                           const ceres::CostFunction& square_root,
+                           const std::vector<const double*>& blocks,
+                           double tolerance = 1e-8) {
+  ASSERT_EQ(rows.parameter_block_sizes(), square_root.parameter_block_sizes());
+  Eigen::VectorXd r;
+  Eigen::MatrixXd j;
+  EvaluateFull(rows, blocks, &r, &j);
+  ExpectSameGaussNewton(r, j, square_root, blocks, tolerance);
 }
 
 // Central differences (step 1e-6) against the cost function's Jacobians, block by
@@ -251,6 +262,68 @@ TEST_F(CostGradientsTest, Priors) {
   ExpectGradientsMatch(*prior, {params_.transl}, 1e-7);
   std::unique_ptr<ceres::CostFunction> diff(ParameterDifferenceCost<3>::Create(0.01));
   ExpectGradientsMatch(*diff, {params_.transl, target}, 1e-7);
+}
+
+// The priors folded into the keypoint term (fitting/folded_terms.h) give the
+// Gauss-Newton data of the keypoint rows and the priors' rows stacked, and each prior
+// still reports its own cost.
+TEST_F(CostGradientsTest, PriorsFoldedIntoTheKeypointTerm) {
+  const HandAnatomy anatomy = ComputeHandAnatomy(model_);
+  Eigen::Matrix<double, 45, 1> mean, inv_sigma;
+  for (int i = 0; i < 45; ++i) {
+    mean[i] = testing::Gaussian(0.2);
+    inv_sigma[i] = testing::Uniform(0.5, 2.0);
+  }
+  for (double& beta : params_.betas) beta = testing::Gaussian(1.0);
+  const RobustLoss loss{RobustLossType::kCauchy, 1.5};
+  std::vector<std::unique_ptr<ceres::CostFunction>> priors;
+  priors.emplace_back(
+      JointLimitCost<>::Create(evaluator_, anatomy, DefaultHandLimits(), 3.0));
+  priors.emplace_back(PosePriorCost<>::Create(evaluator_, mean, inv_sigma));
+  priors.emplace_back(ShapePriorCost<>::Create(0.7));
+  const int prior_block[] = {1, 1, 2};
+  const int block_offset[] = {0, 3, 48, 58};
+
+  MultiViewKeypointSquareRootCost folded(evaluator_, frame_.views, loss, 1.0);
+  folded.folded()->Add(
+      "joint_limits",
+      JointLimitCost<>::Create(evaluator_, anatomy, DefaultHandLimits(), 3.0), 1);
+  folded.folded()->Add("pose_prior", PosePriorCost<>::Create(evaluator_, mean, inv_sigma),
+                       1);
+  folded.folded()->Add("shape_prior", ShapePriorCost<>::Create(0.7), 2);
+
+  // The same terms as rows: the keypoints' rows, then each prior's on its block.
+  std::unique_ptr<ceres::CostFunction> keypoints(
+      MultiViewKeypointCost<>::Create(evaluator_, frame_.views, loss, 1.0));
+  Eigen::VectorXd r;
+  Eigen::MatrixXd j;
+  EvaluateFull(*keypoints, params_.Blocks(), &r, &j);
+  std::vector<double> prior_costs;
+  for (size_t t = 0; t < priors.size(); ++t) {
+    const int m = priors[t]->num_residuals();
+    const int size = priors[t]->parameter_block_sizes()[0];
+    Eigen::VectorXd pr(m);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> pj(m, size);
+    const double* block = params_.Blocks()[prior_block[t]];
+    double* pj_data = pj.data();
+    ASSERT_TRUE(priors[t]->Evaluate(&block, pr.data(), &pj_data));
+    EXPECT_GT(pr.squaredNorm(), 0.0) << "prior " << t;
+    prior_costs.push_back(0.5 * pr.squaredNorm());
+    const Eigen::Index rows = r.size();
+    r.conservativeResize(rows + m);
+    r.tail(m) = pr;
+    j.conservativeResize(rows + m, Eigen::NoChange);
+    j.bottomRows(m).setZero();
+    j.block(rows, block_offset[prior_block[t]], m, size) = pj;
+  }
+  ExpectSameGaussNewton(r, j, folded, params_.Blocks());
+
+  const auto costs = std::as_const(folded).folded().Costs(params_.Blocks().data());
+  ASSERT_EQ(costs.size(), 3u);
+  for (size_t t = 0; t < costs.size(); ++t) {
+    EXPECT_NEAR(costs[t].second, prior_costs[t], 1e-12 * prior_costs[t])
+        << costs[t].first;
+  }
 }
 
 TEST_F(CostGradientsTest, Points3d) {
