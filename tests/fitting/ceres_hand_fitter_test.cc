@@ -25,6 +25,13 @@ TEST_F(CeresHandFitterTest, OptionsCheck) {
   o = {};
   o.silhouette_vertex_stride = 0;
   EXPECT_THROW(o.Check(), InputError);
+  // Fractional negatives of double fields (an int check would truncate them to 0).
+  o = {};
+  o.mask_margin_max_px = -0.5;
+  EXPECT_THROW(o.Check(), InputError);
+  o = {};
+  o.rigid_skip_below_px = -0.5;
+  EXPECT_THROW(o.Check(), InputError);
   HandFitConfig c;
   c.pose_pca_comps = 7;
   EXPECT_THROW(c.Check(), InputError);
