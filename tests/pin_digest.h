@@ -5,6 +5,7 @@
 // code under test; a new digest means the numbers changed.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -30,6 +31,18 @@ class PinDigest {
     return Bytes(s.data(), s.size());
   }
   PinDigest& Add(const char* s) { return Add(std::string(s ? s : "(null)")); }
+  // Shape, then the entries rounded to multiples of `quantum`, row by row: for values
+  // whose last bits legitimately vary between machines.
+  template <typename Derived>
+  PinDigest& AddRounded(const Eigen::DenseBase<Derived>& m, double quantum) {
+    Add(m.rows()).Add(m.cols());
+    for (Eigen::Index r = 0; r < m.rows(); ++r) {
+      for (Eigen::Index c = 0; c < m.cols(); ++c) {
+        Add(static_cast<int64_t>(std::llround(m(r, c) / quantum)));
+      }
+    }
+    return *this;
+  }
   // Shape, then the entries row by row (independent of the storage order).
   template <typename Derived>
   PinDigest& Add(const Eigen::DenseBase<Derived>& m) {

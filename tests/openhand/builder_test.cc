@@ -103,13 +103,17 @@ TEST(OpenHandBuilder, SameOptionsGiveTheSameBits) {
   testing::PinDigest digest;
   digest.Add(m.name).Add(static_cast<int>(m.side)).Add(m.v_template).Add(m.faces);
   digest.Add(m.shapedirs).Add(m.posedirs).Add(m.skinning_weights);
-  digest.Add(Eigen::MatrixXd(m.joint_regressor)).Add(m.pose_pca_basis).Add(m.pose_mean);
+  // The pose PCA comes from poses sampled through libm's sin/cos, whose results differ
+  // in the last bits between glibc's FMA and plain variants (chosen by the CPU):
+  // 8e-14 in the basis between the two on one machine. It is pinned to 1e-8.
+  digest.Add(Eigen::MatrixXd(m.joint_regressor)).AddRounded(m.pose_pca_basis, 1e-8);
+  digest.Add(m.pose_mean);
   for (int p : m.parents) digest.Add(p);
   for (int t : m.tip_vertex_ids) digest.Add(t);
   digest.Add(report.fine_vertices).Add(report.fine_faces);
   digest.Add(report.shape_variance_explained).Add(report.max_regressor_error);
   digest.Add(report.max_regressor_error_mean).Add(report.pose_variance_explained_6);
-  EXPECT_EQ(digest.Hex(), "acf65eee7d6e7eb1");
+  EXPECT_EQ(digest.Hex(), "5d321c5c5b47d020");
 }
 
 TEST(OpenHandBuilder, LeftIsTheMirrorOfRight) {
