@@ -1,6 +1,7 @@
 // Cost of fitting one multi-view frame with CeresHandFitter on the shipped open hand
 // (or whatever ResolveHandModel finds), 8-camera DexYCB-like rig, 2 px keypoint noise:
 //   BM_FitKeypoints             triangulation init + keypoint stages, one thread
+//   BM_FitKeypointsOutliers     the same with 10 % keypoint outliers
 //   BM_FitKeypointsSilhouettes  the same plus silhouette rounds (masks rendered before)
 //   BM_FitFramesParallel/2      frames per second, TBB over frames on 2 threads
 //
@@ -25,6 +26,7 @@ namespace {
 struct BenchFrames {
   HandModel model;
   std::vector<HandFitInput> inputs;
+  std::vector<HandFitInput> with_outliers;  // the same frames, 10 % outliers added
   std::vector<PixelRays> rays;
 };
 
@@ -34,7 +36,7 @@ const BenchFrames& Frames() {
     f->model = ResolveHandModel("", HandSide::kRight).model;
     for (const RigCamera& cam : testing::DexYcbLikeRig())
       f->rays.emplace_back(cam.camera);
-    std::mt19937_64 rng(5);
+    std::mt19937_64 rng(5), outlier_rng(6);
     for (int i = 0; i < 8; ++i) {
       testing::SceneFrame frame = testing::RandomSceneFrame(f->model, rng);
       HandFitInput input;
@@ -42,9 +44,14 @@ const BenchFrames& Frames() {
         input.masks.push_back(RenderHandMask(frame.mesh.vertices, f->model.faces,
                                              frame.views[v].camera, f->rays[v]));
       }
+      std::vector<KeypointView> clean = frame.views;
       testing::CorruptViews(&frame.views, 2.0, 0.0, {}, rng);
       input.views = frame.views;
       f->inputs.push_back(input);
+      // Its own generator: BM_FitKeypoints' frames stay those of older versions.
+      testing::CorruptViews(&clean, 2.0, 0.1, {}, outlier_rng);
+      input.views = clean;
+      f->with_outliers.push_back(input);
     }
     return f;
   }();
@@ -71,6 +78,17 @@ void BM_FitKeypoints(benchmark::State& state) {
       benchmark::Counter(iterations, benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_FitKeypoints)->Unit(benchmark::kMillisecond);
+
+// A detector's keypoints: 10 % of them anywhere in the image. The RANSAC of the
+// initialisation then needs more pairs than on BM_FitKeypoints' clean frames.
+void BM_FitKeypointsOutliers(benchmark::State& state) {
+  const BenchFrames& f = Frames();
+  const CeresHandFitter fitter(f.model);
+  size_t i = 0;
+  for (auto _ : state)
+    FitOne(fitter, f.with_outliers[i++ % f.with_outliers.size()], false);
+}
+BENCHMARK(BM_FitKeypointsOutliers)->Unit(benchmark::kMillisecond);
 
 // The baseline's initialisation alone (robust triangulation + 3D alignment), the part of
 // BM_FitKeypoints before the keypoint stages.
