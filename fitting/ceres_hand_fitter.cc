@@ -76,6 +76,20 @@ PixelWindow HandWindow(const MaskImage& mask, const RigCamera& camera,
 }
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Squared pixel distances between a view's observed keypoints (confidence > 0) and the
+// projections of `keypoints` (world frame); keypoints behind the camera are left out.
+std::vector<double> KeypointSquaredErrorsPx(const KeypointView& view,
+                                            const Points3d& keypoints) {
+  std::vector<double> squared;
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (!(view.keypoints.confidence[k] > 0.0)) continue;
+    Eigen::Vector2d uv;
+    if (!view.camera.ProjectWorld(keypoints.row(k).transpose(), &uv)) continue;
+    squared.push_back((uv - view.keypoints.uv_px.row(k).transpose()).squaredNorm());
+  }
+  return squared;
+}
 // Palm keypoints (SNAP): wrist and the four finger MCPs; rigid in the hand's frame.
 constexpr int kPalmKeypoints[] = {0, 5, 9, 13, 17};
 
@@ -267,23 +281,17 @@ class FitRun {
   // hand of `b` over all views; infinity without observations.
   double MedianKeypointErrorPx(const std::vector<KeypointView>& views,
                                const Blocks& b) const {
-    double keypoints[3 * kNumHandKeypoints];
-    evaluator_.Keypoints(b.orient, b.pose.data(), b.betas, b.transl, keypoints);
-    std::vector<double> errors;
+    Points3d keypoints(kNumHandKeypoints, 3);
+    evaluator_.Keypoints(b.orient, b.pose.data(), b.betas, b.transl, keypoints.data());
+    std::vector<double> squared;
     for (const KeypointView& view : views) {
-      for (int k = 0; k < kNumHandKeypoints; ++k) {
-        Eigen::Vector2d uv;
-        if (!(view.keypoints.confidence[k] > 0.0) ||
-            !view.camera.ProjectWorld(Eigen::Vector3d::Map(keypoints + 3 * k), &uv)) {
-          continue;
-        }
-        errors.push_back((uv - view.keypoints.uv_px.row(k).transpose()).norm());
-      }
+      const std::vector<double> view_squared = KeypointSquaredErrorsPx(view, keypoints);
+      squared.insert(squared.end(), view_squared.begin(), view_squared.end());
     }
-    if (errors.empty()) return std::numeric_limits<double>::infinity();
-    auto middle = errors.begin() + errors.size() / 2;
-    std::nth_element(errors.begin(), middle, errors.end());
-    return *middle;
+    if (squared.empty()) return std::numeric_limits<double>::infinity();
+    auto middle = squared.begin() + squared.size() / 2;
+    std::nth_element(squared.begin(), middle, squared.end());
+    return std::sqrt(*middle);
   }
 
   // 3D targets as the only evidence: the IK-style initialisation.
@@ -501,16 +509,10 @@ class FitRun {
     out.vertices = mesh.vertices;
     out.keypoints = mesh.keypoints;
     for (const KeypointView& view : input.views) {
+      const std::vector<double> squared = KeypointSquaredErrorsPx(view, mesh.keypoints);
       double sum = 0.0;
-      int n = 0;
-      for (int k = 0; k < kNumHandKeypoints; ++k) {
-        if (!(view.keypoints.confidence[k] > 0.0)) continue;
-        Eigen::Vector2d uv;
-        if (!view.camera.ProjectWorld(mesh.keypoints.row(k).transpose(), &uv)) continue;
-        sum += (uv - view.keypoints.uv_px.row(k).transpose()).squaredNorm();
-        ++n;
-      }
-      out.view_rms_px.push_back(n > 0 ? std::sqrt(sum / n) : kNaN);
+      for (double e : squared) sum += e;
+      out.view_rms_px.push_back(squared.empty() ? kNaN : std::sqrt(sum / squared.size()));
     }
     out.view_iou.assign(input.views.size(), kNaN);
     for (size_t v = 0; v < input.masks.size(); ++v) {

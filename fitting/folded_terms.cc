@@ -36,11 +36,16 @@ std::vector<double> FoldedTerms::Residuals(const FoldedTerm& term,
   return r;
 }
 
+double FoldedTerms::TermSquaredNorm(const FoldedTerm& term,
+                                    double const* const* parameters) const {
+  double sum = 0.0;
+  for (double r : Residuals(term, parameters, nullptr)) sum += r * r;
+  return sum;
+}
+
 double FoldedTerms::SquaredNorm(double const* const* parameters) const {
   double sum = 0.0;
-  for (const FoldedTerm& term : terms_) {
-    for (double r : Residuals(term, parameters, nullptr)) sum += r * r;
-  }
+  for (const FoldedTerm& term : terms_) sum += TermSquaredNorm(term, parameters);
   return sum;
 }
 
@@ -76,9 +81,7 @@ std::vector<std::pair<std::string, double>> FoldedTerms::Costs(
     double const* const* parameters) const {
   std::vector<std::pair<std::string, double>> costs;
   for (const FoldedTerm& term : terms_) {
-    double sum = 0.0;
-    for (double r : Residuals(term, parameters, nullptr)) sum += r * r;
-    costs.emplace_back(term.name, 0.5 * sum);
+    costs.emplace_back(term.name, 0.5 * TermSquaredNorm(term, parameters));
   }
   return costs;
 }

@@ -42,6 +42,7 @@ class FoldedTerms {
  private:
   std::vector<double> Residuals(const FoldedTerm& term, double const* const* parameters,
                                 std::vector<double>* jacobian) const;
+  double TermSquaredNorm(const FoldedTerm& term, double const* const* parameters) const;
 
   std::vector<int> block_sizes_;
   std::vector<int> block_offsets_;
