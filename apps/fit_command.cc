@@ -116,7 +116,7 @@ void AddRunFlags(CLI::App& app, FitFlags* f) {
                  "in memory");
   app.add_flag("--overlay", o.overlays,
                "also write the label job's overlay pictures: every view of every frame "
-               "with the fitted mesh and keypoints, <out>/overlays/<frame>/<camera>.png");
+               "with the fitted mesh and keypoints, <out>/overlays/<frame>/<camera>.jpg");
   app.add_option("--threads", o.num_threads, "frames in parallel, 0 = all cores")
       ->capture_default_str();
 }

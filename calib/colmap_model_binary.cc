@@ -3,11 +3,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 #include "calib/colmap_model.h"
 #include "calib/rig_json.h"
 #include "core/errors.h"
+#include "core/file_bytes.h"
 
 namespace handlabel {
 namespace {
@@ -18,12 +18,8 @@ static_assert(sizeof(double) == 8, "COLMAP binary files hold IEEE doubles");
 // the record and the field when the data ends early.
 class BinaryReader {
  public:
-  explicit BinaryReader(const std::string& path) : path_(path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-      throw InputError(path, "(file)", "a readable COLMAP binary file", "cannot open");
-    data_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
+  explicit BinaryReader(const std::string& path)
+      : path_(path), data_(ReadFileBytes(path, "COLMAP binary file")) {}
 
   void SetRecord(const std::string& record) { record_ = record; }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/hand_lbs.h"
+#include "core/image.h"
 #include "core/keypoints2d.h"
 #include "core/mask_image.h"
 #include "core/rig.h"
@@ -25,12 +26,17 @@ struct FrameGroundTruth {
 };
 
 // Everything the capture holds about one multi-view frame. Images and masks stay on
-// disk: the stages that need them read them.
+// disk: the stages that need them read them, unless `images` holds them already.
 struct FrameInput {
   std::string id;
   Rig rig;
   std::vector<std::string> image_paths;  // one per rig camera
-  std::vector<std::string> mask_paths;   // one per rig camera, or empty
+  // The views' images decoded once for several stages (the network's crops, the
+  // detector, the overlays): RGB, one per rig camera, each checked against its camera's
+  // size; a 0 x 0 image for a view without an image file. Empty: read image_paths
+  // (capture/frame_images.h).
+  std::vector<ImageU8> images;
+  std::vector<std::string> mask_paths;  // one per rig camera, or empty
   // Object label maps (0 = none, k = object k), one per rig camera, or empty when the
   // capture has none: pixels where an object may hide the hand.
   std::vector<std::string> object_mask_paths;

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/npy.h"
 #include "core/npz.h"
 #include "core/pickle_reader.h"
@@ -110,16 +111,6 @@ Entry EntryFromPickle(const PickleValue& v) {
     e.array = std::make_shared<NdArray>(NdArray::FromDoubles({}, &x));
   }
   return e;
-}
-
-std::string ReadFileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(path, "", "a readable hand model file", "cannot open");
-  std::string bytes(static_cast<size_t>(in.tellg()), '\0');
-  in.seekg(0);
-  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (!in) throw InputError(path, "", "a readable hand model file", "read error");
-  return bytes;
 }
 
 bool ContainsChumpy(const PickleValue& v) {
@@ -432,7 +423,8 @@ LoadedHandModel LoadHandModelFile(const std::string& path,
     const Entries entries = ReadNpzEntries(path, &out.format);
     out.model = ModelFromEntries(entries, out.format, options);
   } else {
-    const Entries entries = ReadPickleEntries(path, ReadFileBytes(path), &out.format);
+    const Entries entries =
+        ReadPickleEntries(path, ReadFileBytes(path, "hand model file"), &out.format);
     out.model = ModelFromEntries(entries, out.format, options);
   }
   return out;

@@ -5,9 +5,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 
 namespace handlabel {
 namespace {
@@ -81,10 +81,7 @@ void ReadFromString(png_structp png, png_bytep data, png_size_t length) {
 // Decodes into 8-bit (want16 = false) or 16-bit gray (want16 = true).
 template <typename T>
 Image<T> Decode(const std::string& path, bool want16) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "file", "an existing readable PNG file", "missing");
-  const std::string bytes((std::istreambuf_iterator<char>(in)),
-                          std::istreambuf_iterator<char>());
+  const std::string bytes = ReadFileBytes(path, "PNG file");
   if (bytes.size() < 8 ||
       png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, 8) != 0) {
     throw InputError(path, "signature", "a PNG file", "other data");

@@ -8,9 +8,9 @@
 #include <csetjmp>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 
 namespace handlabel {
 namespace {
@@ -39,16 +39,13 @@ void FailOnWarning(j_common_ptr info, int level) {
 // The whole file, or its first `max_bytes`.
 std::string ReadBytes(const std::string& path, const std::string& what,
                       size_t max_bytes = std::string::npos) {
+  if (max_bytes == std::string::npos) return ReadFileBytes(path, what);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "file", "an existing readable " + what, "missing");
-  if (max_bytes != std::string::npos) {
-    std::string head(max_bytes, '\0');
-    in.read(head.data(), static_cast<std::streamsize>(max_bytes));
-    head.resize(static_cast<size_t>(in.gcount()));
-    return head;
-  }
-  return std::string((std::istreambuf_iterator<char>(in)),
-                     std::istreambuf_iterator<char>());
+  std::string head(max_bytes, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(max_bytes));
+  head.resize(static_cast<size_t>(in.gcount()));
+  return head;
 }
 
 bool IsJpeg(const std::string& bytes) {
@@ -97,8 +94,7 @@ ImageU8 DecodeJpeg(const std::string& path, const std::string& bytes) {
 
 }  // namespace
 
-void WriteJpeg(const std::string& path, const ImageU8& image,
-               const JpegWriteOptions& options) {
+std::string EncodeJpeg(const ImageU8& image, const JpegWriteOptions& options) {
   HL_CHECK(image.channels == 1 || image.channels == 3, "gray or RGB image");
   HL_CHECK(options.quality >= 1 && options.quality <= 100, "quality in 1..100");
   jpeg_compress_struct info;
@@ -111,7 +107,7 @@ void WriteJpeg(const std::string& path, const ImageU8& image,
   if (setjmp(error.jump)) {
     jpeg_destroy_compress(&info);
     std::free(buffer);
-    throw Error("JPEG encoding of " + path + " failed: " + error.message);
+    throw Error(std::string("JPEG encoding failed: ") + error.message);
   }
   jpeg_create_compress(&info);
   jpeg_mem_dest(&info, &buffer, &size);
@@ -138,6 +134,12 @@ void WriteJpeg(const std::string& path, const ImageU8& image,
   jpeg_destroy_compress(&info);
   const std::string bytes(reinterpret_cast<const char*>(buffer), size);
   std::free(buffer);
+  return bytes;
+}
+
+void WriteJpeg(const std::string& path, const ImageU8& image,
+               const JpegWriteOptions& options) {
+  const std::string bytes = EncodeJpeg(image, options);
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
   std::ofstream out(path, std::ios::binary);

@@ -17,6 +17,9 @@ struct JpegWriteOptions {
   bool full_chroma = true;
 };
 
+// A gray (1) or RGB (3) image as baseline JPEG file bytes.
+std::string EncodeJpeg(const ImageU8& image, const JpegWriteOptions& options = {});
+
 // Writes a gray (1) or RGB (3) baseline JPEG. Creates missing parent folders. Throws
 // Error naming the path on failure.
 void WriteJpeg(const std::string& path, const ImageU8& image,

@@ -41,6 +41,24 @@ PixelRays::PixelRays(const Camera& camera) : camera_(camera) {
   }
 }
 
+std::shared_ptr<const PixelRays> PixelRaysCache::Get(const Camera& camera) {
+  // The key is everything the rays depend on: model, size and the exact parameters.
+  std::string key = std::to_string(static_cast<int>(camera.model())) + " " +
+                    std::to_string(camera.width()) + "x" +
+                    std::to_string(camera.height());
+  key.append(reinterpret_cast<const char*>(camera.params().data()),
+             camera.params().size() * sizeof(double));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = rays_.find(key);
+    if (it != rays_.end()) return it->second;
+  }
+  auto rays = std::make_shared<const PixelRays>(camera);  // built outside the lock
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (rays_.size() >= 64) rays_.clear();
+  return rays_.emplace(key, std::move(rays)).first->second;
+}
+
 void VisibilityBuffer::Reset(int w, int h) {
   width = w;
   height = h;

@@ -22,7 +22,10 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <mutex>
+#include <string>
 #include <vector>
 
 #include "core/camera.h"
@@ -73,6 +76,18 @@ class PixelRays {
   std::vector<double> xy_;
   Eigen::Vector2d min_xy_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d max_xy_ = Eigen::Vector2d::Zero();
+};
+
+// The PixelRays of the cameras seen so far, shared between threads: a 640 x 480
+// camera's rays take 300k undistortions, so pictures of many frames of one rig build them
+// once per camera, not once per picture. Holds at most 64 cameras (then starts afresh).
+class PixelRaysCache {
+ public:
+  std::shared_ptr<const PixelRays> Get(const Camera& camera);
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<const PixelRays>> rays_;
 };
 
 // Per-pixel result of rasterisation: the nearest surface.

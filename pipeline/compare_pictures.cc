@@ -11,6 +11,7 @@
 #include "core/draw.h"
 #include "core/image_file.h"
 #include "core/line_plot.h"
+#include "core/rasterizer.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/label_stage_factory.h"
@@ -357,6 +358,7 @@ ImageU8 WorstFramesPicture(const JobConfig& base, const CompareResult& r, int co
     if (view < 0) continue;
     const RigCamera& cam = input.rig[view];
     const ImageU8 image = ReadRgb(input.image_paths[view], cam);
+    const PixelRays rays(cam.camera);
     std::vector<ImageU8> panels;
     LabelRecord truth_label;
     truth_label.mesh.keypoints = truth.keypoints;
@@ -364,7 +366,7 @@ ImageU8 WorstFramesPicture(const JobConfig& base, const CompareResult& r, int co
                                     ? truth.vertices
                                     : Points3d(0, 3);
     ImageU8 drawn = image;
-    DrawLabelOverlay(cam, truth_label, faces, &drawn);
+    DrawLabelOverlay(cam, rays, truth_label, faces, &drawn);
     panels.push_back(Panel(drawn, box, 200, frame + " truth (" + cam.name + ")"));
     for (const MethodRun* run : ScoredMethods(r)) {
       const std::optional<LabelRecord> label = MethodLabel(*run, frame);
@@ -376,7 +378,7 @@ ImageU8 WorstFramesPicture(const JobConfig& base, const CompareResult& r, int co
               ? kNaN
               : 1000 * run->scores.per_frame[it - run->scores.frames.begin()].mpjpe;
       drawn = image;
-      DrawLabelOverlay(cam, *label, faces, &drawn);
+      DrawLabelOverlay(cam, rays, *label, faces, &drawn);
       panels.push_back(Panel(drawn, box, 200,
                              ToString(run->method) + " " + FormatFixed(mm, 1) + " mm"));
     }

@@ -1,8 +1,7 @@
 #include "pipeline/detect_frame_source.h"
 
+#include "capture/frame_images.h"
 #include "core/errors.h"
-#include "core/image_file.h"
-#include "core/view_image.h"
 
 namespace handlabel {
 
@@ -53,15 +52,18 @@ FrameInput DetectorFrameSource::Load(const std::string& id) const {
                      std::to_string(frame.image_paths.size()) + " for " +
                          std::to_string(frame.rig.size()) + " cameras");
   }
-  std::vector<ImageU8> images;
+  DecodeFrameImages(&frame);  // kept in the frame for the network and the overlays
   for (size_t c = 0; c < frame.rig.size(); ++c) {
-    images.push_back(ReadViewImageRgb(frame.image_paths[c], frame.rig[c]));
+    if (frame.images[c].empty()) {
+      throw InputError(Describe(), "images", "one image per camera for the detector",
+                       "none for camera " + frame.rig[c].name);
+    }
   }
   FrameHandResult result;
   {
     // One frame at a time: the models are shared, and they use the cores themselves.
     std::lock_guard<std::mutex> lock(detect_mutex_);
-    result = DetectHandMultiView(*detector_, frame.rig, images, options_.multiview);
+    result = DetectHandMultiView(*detector_, frame.rig, frame.images, options_.multiview);
   }
   frame.keypoints_2d = KeypointsFromDetection(result);
   if (store_) store_->Put(id, std::move(result));

@@ -272,6 +272,10 @@ void JobConfig::Check() const {
     if (m != "ply" && m != "obj")
       throw InputError(f, "output.meshes", "ply and/or obj", "'" + m + "'");
   }
+  if (overlay_format != "jpg" && overlay_format != "png") {
+    throw InputError(f, "output.overlay_format", "jpg or png",
+                     "'" + overlay_format + "'");
+  }
   if (max_frames < 0)
     throw InputError(f, "input.max_frames", ">= 0", std::to_string(max_frames));
   CheckFileEvidence(*this);
@@ -321,6 +325,7 @@ JobConfig LoadJobConfig(const std::string& path) {
   output.Read("dir", &job.output_dir);
   output.Read("meshes", &job.meshes);
   output.Read("overlays", &job.overlays);
+  output.Read("overlay_format", &job.overlay_format);
   output.Read("evaluate", &job.evaluate);
   output.Read("baseline", &job.baseline);
   output.RejectUnknownKeys();

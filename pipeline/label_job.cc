@@ -17,6 +17,7 @@
 #include <set>
 #include <sstream>
 
+#include "capture/frame_images.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/progress.h"
@@ -351,10 +352,24 @@ class LabelJobRun {
     const Clock::time_point t = Clock::now();
     try {
       batch.inputs[i] = stages_.source->Load(batch.ids[i]);
+      if (stages_.predictor || (stages_.overlays && job_.overlays)) {
+        DecodeImages(&*batch.inputs[i]);
+      }
     } catch (...) {
       batch.errors[i] = "read: " + Describe(std::current_exception());
     }
     batch.seconds[i] += SecondsSince(t);
+  }
+
+  // The frame's images, decoded here (in parallel) once for the network, whose stage
+  // is serial, and the overlays. A bad image file is left to the stage that needs it:
+  // the network's failure falls back to fitting, the overlay's fails the frame.
+  static void DecodeImages(FrameInput* frame) {
+    try {
+      DecodeFrameImages(frame);
+    } catch (const InputError&) {
+      frame->images.clear();
+    }
   }
 
   // The network on the batch's readable frames (one caller at a time). If the batch

@@ -69,9 +69,9 @@ std::string SummaryMarkdownPath(const std::string& output_dir) {
   return output_dir + "/summary.md";
 }
 std::string OverlayPath(const std::string& output_dir, const std::string& frame,
-                        const std::string& camera) {
+                        const std::string& camera, const std::string& format) {
   return output_dir + "/overlays/" + FrameFileStem(frame, "frame id") + "/" +
-         FrameFileStem(camera, "camera name") + ".png";
+         FrameFileStem(camera, "camera name") + "." + format;
 }
 
 std::map<std::string, FrameRecord> ReadShardLogs(const std::string& output_dir) {
@@ -197,7 +197,7 @@ int RemoveStaleFrameTemporaries(const std::string& output_dir,
       if (!entry.is_regular_file()) continue;
       const std::string target = TemporaryTarget(entry.path().filename().string());
       if (target.empty()) continue;
-      // labels/<stem>.json, meshes/<stem>.<ext>, overlays/<stem>/<camera>.png
+      // labels/<stem>.json, meshes/<stem>.<ext>, overlays/<stem>/<camera>.<jpg|png>
       const std::string stem = std::string(sub) == "overlays"
                                    ? entry.path().parent_path().filename().string()
                                    : fs::path(target).stem().string();

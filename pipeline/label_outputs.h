@@ -3,7 +3,7 @@
 //   job.json                          job name and hash (a folder holds one job)
 //   labels/<frame>.json               one label per frame (label_record.h)
 //   meshes/<frame>.ply|.obj           optional meshes
-//   overlays/<frame>/<camera>.png     optional overlay pictures
+//   overlays/<frame>/<camera>.jpg     optional overlay pictures (or .png)
 //   shards/shard-<i>-of-<N>.jsonl     resume log of shard i (frame_log.h)
 //   shards/shard-<i>-of-<N>.summary.json   what that shard's last run did
 //   manifest.json, summary.json, summary.md   written by merge (and by a 1-shard run)
@@ -24,8 +24,9 @@ std::string JobStampPath(const std::string& output_dir);
 std::string ManifestPath(const std::string& output_dir);
 std::string SummaryJsonPath(const std::string& output_dir);
 std::string SummaryMarkdownPath(const std::string& output_dir);
+// `format`: the job's output.overlay_format, the file's extension (jpg | png).
 std::string OverlayPath(const std::string& output_dir, const std::string& frame,
-                        const std::string& camera);
+                        const std::string& camera, const std::string& format);
 
 // The latest record per frame over every shard log in the folder (logs of any shard
 // count, so a job may be re-sharded between runs). An ok record wins over a failed

@@ -2,26 +2,24 @@
 
 #include <cmath>
 
+#include "capture/frame_images.h"
 #include "core/atomic_file.h"
 #include "core/draw.h"
 #include "core/errors.h"
 #include "core/hand_skeleton.h"
 #include "core/image_file.h"
-#include "core/rasterizer.h"
-#include "core/view_image.h"
 #include "network/detector_overlay.h"
 #include "pipeline/label_outputs.h"
 
 namespace handlabel {
 
-void DrawLabelOverlay(const RigCamera& camera, const LabelRecord& label,
-                      const Faces& faces, ImageU8* rgb) {
+void DrawLabelOverlay(const RigCamera& camera, const PixelRays& rays,
+                      const LabelRecord& label, const Faces& faces, ImageU8* rgb) {
   if (faces.rows() > 0 && label.mesh.vertices.rows() > faces.maxCoeff()) {
     RenderMesh mesh;
     mesh.vertices = label.mesh.vertices;
     mesh.faces = faces;
     mesh.color = Eigen::Vector3f(0.55f, 0.75f, 1.0f);
-    const PixelRays rays(camera.camera);
     VisibilityBuffer buffer;
     buffer.Reset(rgb->width, rgb->height);
     RasterizeMesh(mesh, 0, camera.cam_from_world, rays, &buffer);
@@ -35,6 +33,7 @@ void DrawLabelOverlay(const RigCamera& camera, const LabelRecord& label,
           static_cast<uint8_t>((int(rgb->data[i]) + int(shaded.data[i]) + 1) / 2);
     }
   }
+  if (label.mesh.keypoints.rows() != kNumHandKeypoints) return;  // no skeleton to draw
   std::vector<Eigen::Vector2d> uv(kNumHandKeypoints);
   std::vector<bool> in_front(kNumHandKeypoints);
   for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -60,15 +59,14 @@ void RasterOverlayWriter::Write(const std::string& output_dir, const FrameInput&
     const RigCamera& camera = frame.rig[v];
     // Grey only for a view without an image file; a file that cannot be read or does
     // not fit the camera fails the frame (the error names it), never a grey overlay.
-    ImageU8 rgb(camera.camera.width(), camera.camera.height(), 3, 96);
-    if (v < frame.image_paths.size() && !frame.image_paths[v].empty()) {
-      rgb = ReadViewImageRgb(frame.image_paths[v], camera);
-    }
-    DrawLabelOverlay(camera, label, faces_, &rgb);
+    ImageU8 rgb = FrameViewImageRgb(frame, v);
+    if (rgb.empty()) rgb = ImageU8(camera.camera.width(), camera.camera.height(), 3, 96);
+    DrawLabelOverlay(camera, *rays_.Get(camera.camera), label, faces_, &rgb);
     if (detection && v < detection->views.size()) {
       DrawHandDetection(detection->views[v], &rgb);
     }
-    WriteFileAtomically(OverlayPath(output_dir, frame.id, camera.name), EncodePng(rgb));
+    WriteFileAtomically(OverlayPath(output_dir, frame.id, camera.name, format_),
+                        format_ == "png" ? EncodePng(rgb) : EncodeJpeg(rgb, {90}));
   }
 }
 

@@ -139,7 +139,8 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
         std::make_unique<CeresLabelFitter>(built.hand_model, FitterOptions(job));
   }
   if (job.overlays) {
-    built.overlays = std::make_unique<RasterOverlayWriter>(built.hand_model, detections);
+    built.overlays = std::make_unique<RasterOverlayWriter>(
+        built.hand_model, job.overlay_format, detections);
   }
   return built;
 }

@@ -3,9 +3,9 @@
 #include <filesystem>
 #include <memory>
 
+#include "capture/frame_images.h"
 #include "core/errors.h"
 #include "core/image.h"
-#include "core/image_file.h"
 #include "core/sha256.h"
 
 namespace handlabel {
@@ -52,10 +52,10 @@ HandMeshInput CropFrameForNetwork(const FrameInput& frame, int num_views,
   HandMeshInput input;
   crops->clear();
   for (size_t v = 0; v < rig.size(); ++v) {
-    const ImageU8 image = ReadImageFile(frame.image_paths.at(v));
-    if (image.channels != 3) {
-      throw InputError(frame.image_paths[v], "channels", "an RGB image",
-                       std::to_string(image.channels));
+    const ImageU8 image = FrameViewImageRgb(frame, v);
+    if (image.empty()) {
+      throw InputError(frame.id, "images", "an image for every view the network sees",
+                       "none for camera " + rig[v].name);
     }
     HandEvidence evidence;
     if (!frame.keypoints_2d.empty()) evidence.keypoints = frame.keypoints_2d[v];

@@ -111,7 +111,8 @@ void WriteFitOnlyJob(const std::string& path, const std::string& capture,
                       << "\nnetwork:\n  weights: \"\"\nrefine:\n  mode: always\n"
                       << "evidence:\n  keypoints_2d: " << keypoints_2d
                       << "\n  masks: none\noutput:\n  dir: " << out
-                      << "\n  meshes: []\n  overlays: true\n  evaluate: true\n";
+                      << "\n  meshes: []\n  overlays: true\n  overlay_format: png"
+                      << "\n  evaluate: true\n";
 }
 
 // `evidence.keypoints_2d: detector` runs the detector inside the job: its 2D is what

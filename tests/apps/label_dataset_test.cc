@@ -50,8 +50,8 @@ TEST(LabelDataset, DexYcbSequenceThroughTheNetworkAndTheFallbackFit) {
   const nlohmann::json summary =
       nlohmann::json::parse(testing::ReadFileBytes(dir + "/out/summary.json"));
   EXPECT_LT(summary.at("metrics").at("labels").at("mpjpe_mm").get<double>(), 5.0);
-  EXPECT_TRUE(
-      std::filesystem::exists(OverlayPath(dir + "/out", "000001", fx.rig[3].name)));
+  EXPECT_TRUE(std::filesystem::exists(
+      OverlayPath(dir + "/out", "000001", fx.rig[3].name, "jpg")));
   EXPECT_EQ(testing::RunHandlabelCommand({"merge", "--job", dir + "/job.yaml"}).status,
             0);
 }

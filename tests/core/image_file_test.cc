@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "tests/image_difference.h"
 #include "tests/test_util.h"
 
@@ -71,6 +72,31 @@ TEST(ImageFile, JpegRoundTripKeepsSizeLayoutAndPixelsWithinQuality) {
     EXPECT_LT(std::filesystem::file_size(dir + "/b.jpg"),
               std::filesystem::file_size(dir + "/sub/a.jpg"));
   }
+}
+
+TEST(ImageFile, EncodeJpegGivesTheBytesWriteJpegWrites) {
+  const std::string dir = testing::ScratchDir();
+  const ImageU8 image = TestImage(40, 30, 3);
+  WriteJpeg(dir + "/a.jpg", image);
+  EXPECT_EQ(EncodeJpeg(image), ReadFileBytes(dir + "/a.jpg", "JPEG file"));
+}
+
+TEST(ImageFile, ReadFileBytesGivesEveryByteAndNamesAMissingFile) {
+  const std::string dir = testing::ScratchDir();
+  std::string bytes(100000, '\0');
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>(i * 7 % 256);
+  std::ofstream(dir + "/b.bin", std::ios::binary) << bytes;
+  EXPECT_EQ(ReadFileBytes(dir + "/b.bin", "file"), bytes);
+  std::ofstream(dir + "/empty.bin", std::ios::binary);
+  EXPECT_EQ(ReadFileBytes(dir + "/empty.bin", "file"), "");
+  std::string error = "(no InputError)";
+  try {
+    ReadFileBytes(dir + "/none.bin", "weights file");
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  EXPECT_THAT(error, HasSubstr(dir + "/none.bin"));
+  EXPECT_THAT(error, HasSubstr("readable weights file"));
 }
 
 TEST(ImageFile, ReadsByContentNotByName) {

@@ -281,6 +281,26 @@ TEST(Rasterizer, LambertShadingOfAPlane) {
   }
 }
 
+// The cache hands out one PixelRays per distinct camera, equal to a fresh one.
+TEST(Rasterizer, PixelRaysCacheBuildsOncePerCamera) {
+  PixelRaysCache cache;
+  const Camera distorted = DistortedCamera();
+  Camera other = distorted;
+  other.mutable_params()[0] += 0.5;  // another focal length: another camera
+  const std::shared_ptr<const PixelRays> a = cache.Get(distorted);
+  EXPECT_EQ(cache.Get(distorted), a);
+  const std::shared_ptr<const PixelRays> b = cache.Get(other);
+  EXPECT_NE(b, a);
+  const PixelRays fresh(other);
+  for (int y : {0, 60, 119}) {
+    for (int x : {0, 80, 159}) {
+      EXPECT_EQ(b->xy(x, y)[0], fresh.xy(x, y)[0]);
+      EXPECT_EQ(b->xy(x, y)[1], fresh.xy(x, y)[1]);
+    }
+  }
+  EXPECT_NE(a->xy(0, 0)[0], b->xy(0, 0)[0]);
+}
+
 TEST(Rasterizer, BackgroundPixelsAreLeftAlone) {
   const Camera camera = Camera::Pinhole(100, 100, 32, 24, 64, 48);
   const PixelRays rays(camera);

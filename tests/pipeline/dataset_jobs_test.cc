@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -73,13 +74,16 @@ output:
   EXPECT_EQ(summary.metrics.at("labels").count("mpvpe_mm"), 0u);  // no truth vertices
   const LabelRecord label = ReadLabelFile(LabelFilePath(dir + "/out", "000001"));
   EXPECT_EQ(label.path, LabelPath::kFallbackFit);
-  const ImageU8 overlay = ReadPng(OverlayPath(dir + "/out", "000001", fx.rig[0].name));
+  const ImageU8 overlay =
+      ReadImageFile(OverlayPath(dir + "/out", "000001", fx.rig[0].name, "jpg"));
   EXPECT_EQ(overlay.width, 160);
   // Drawn on the camera's image, not on the grey stand-in for a missing one.
   const ImageU8 image =
       ReadJpeg(fx.sequence + "/" + fx.rig[0].name + "/color_000001.jpg");
   int same = 0;
-  for (size_t i = 0; i < image.data.size(); ++i) same += overlay.data[i] == image.data[i];
+  for (size_t i = 0; i < image.data.size(); ++i) {  // within JPEG's loss
+    same += std::abs(int(overlay.data[i]) - int(image.data[i])) <= 6;
+  }
   EXPECT_GT(same, static_cast<int>(image.data.size() / 2));
 }
 

@@ -89,6 +89,9 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
   ExpectError(
       "input: {path: c}\noutput: {dir: o, meshes: [stl]}\nnetwork: {weights: w}\n",
       "output.meshes", "ply and/or obj");
+  ExpectError(
+      "input: {path: c}\noutput: {dir: o, overlay_format: gif}\nnetwork: {weights: w}\n",
+      "output.overlay_format", "jpg or png");
   ExpectError(base + "refine: {mode: always}\nevidence: {network_mask_sigma_px: -1}\n",
               "evidence.network_mask_sigma_px", "> 0 pixels");
 }
