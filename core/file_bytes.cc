@@ -8,7 +8,7 @@ namespace handlabel {
 
 std::string ReadFileBytes(const std::string& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(path, "file", "an existing readable " + what, "missing");
+  if (!in) throw InputError(path, "file", "an existing readable " + what, "cannot open");
   const std::streamoff size = in.tellg();
   if (size < 0)
     throw InputError(path, "file", "a readable " + what, "not a regular file");

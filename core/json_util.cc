@@ -1,12 +1,12 @@
 #include "core/json_util.h"
 
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <vector>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 
 namespace handlabel {
 
@@ -59,11 +59,7 @@ json ParseJsonStrict(const std::string& text, const std::string& source) {
 }
 
 json ReadJsonFileStrict(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "(file)", "a readable JSON file", "cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseJsonStrict(text.str(), path);
+  return ParseJsonStrict(ReadFileBytes(path, "JSON file"), path);
 }
 
 void RejectUnknownKeys(const json& object, std::initializer_list<const char*> known,

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 
 namespace handlabel {
 namespace {
@@ -346,11 +347,7 @@ NdArray ParseNpy(const std::string& bytes, const std::string& source, int64_t ma
 }
 
 NdArray ReadNpyFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "a readable .npy file", "cannot open");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return ParseNpy(buffer.str(), path);
+  return ParseNpy(ReadFileBytes(path, ".npy file"), path);
 }
 
 std::string SerializeNpy(const NdArray& a) {

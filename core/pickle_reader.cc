@@ -1,10 +1,10 @@
 #include "core/pickle_reader.h"
 
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/pickle_machine.h"
 #include "core/utf8.h"
 
@@ -250,11 +250,7 @@ PickleValue ReadPickle(const std::string& bytes, const std::string& source,
 }
 
 PickleValue ReadPickleFile(const std::string& path, const PickleLimits& limits) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "a readable pickle file", "cannot open");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return ReadPickle(buffer.str(), path, limits);
+  return ReadPickle(ReadFileBytes(path, "pickle file"), path, limits);
 }
 
 }  // namespace handlabel

@@ -78,7 +78,13 @@ TEST(ImageFile, EncodeJpegGivesTheBytesWriteJpegWrites) {
   const std::string dir = testing::ScratchDir();
   const ImageU8 image = TestImage(40, 30, 3);
   WriteJpeg(dir + "/a.jpg", image);
-  EXPECT_EQ(EncodeJpeg(image), ReadFileBytes(dir + "/a.jpg", "JPEG file"));
+  const std::string bytes = EncodeJpeg(image);
+  EXPECT_EQ(bytes, ReadFileBytes(dir + "/a.jpg", "JPEG file"));
+  // The bytes are a JPEG of the image (written by hand, read back by libjpeg).
+  std::ofstream(dir + "/by_hand.jpg", std::ios::binary) << bytes;
+  const auto [mean, worst] = ImageDifference(ReadJpeg(dir + "/by_hand.jpg"), image);
+  EXPECT_LT(mean, 2.0);
+  EXPECT_LT(worst, 64);
 }
 
 TEST(ImageFile, ReadFileBytesGivesEveryByteAndNamesAMissingFile) {
