@@ -59,7 +59,8 @@ class HandMeshPredictor {
   // Learned parameters (weights and biases, not buffers); 0 when unknown.
   virtual int64_t num_parameters() const { return 0; }
   // One prediction per frame. Throws InputError naming the frame, view and field of
-  // the first invalid input, before any inference runs.
+  // the first invalid input, before any inference runs. Safe to call from several
+  // threads at once (the model is only read); each call uses the intra-op threads.
   virtual std::vector<HandMeshPrediction> Predict(
       const std::vector<HandMeshInput>& frames) = 0;
 };
@@ -72,8 +73,10 @@ struct HandMeshPredictorOptions {
   std::string weights;
   // PoemConfigByName name ("released-dexycb", "small", ...); empty for own checkpoints.
   std::string config;
-  int num_views = 0;         // for "small" / "tiny"
-  int num_threads = 0;       // intra-op threads; 0 = the machine's hardware threads
+  int num_views = 0;  // for "small" / "tiny"
+  // Intra-op threads (process-wide: LibTorch has one setting); 0 = the machine's
+  // hardware threads.
+  int num_threads = 0;
   int batch_size = 4;        // frames per forward pass
   uint64_t random_seed = 0;  // random weights only
   void Check() const;        // throws InputError naming the field

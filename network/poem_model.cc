@@ -38,16 +38,29 @@ void ExpectShape(const torch::Tensor& t, const std::vector<int64_t>& shape,
   }
 }
 
-torch::Tensor SampleViews(const torch::Tensor& features, const torch::Tensor& grid,
-                          int64_t B, int64_t N) {
-  // features (B*N, C, H, W), grid (B*N, P, 1, 2) -> (B, P, N, C)
+// features (B*N, C, H, W), grid (B*N, P, 1, 2) -> (B, N, C, P), bilinear, zeros
+// outside.
+torch::Tensor SampleFeatures(const torch::Tensor& features, const torch::Tensor& grid,
+                             int64_t B, int64_t N) {
   const torch::Tensor s = F::grid_sample(features, grid,
                                          F::GridSampleFuncOptions()
                                              .mode(torch::kBilinear)
                                              .padding_mode(torch::kZeros)
                                              .align_corners(false));
-  const int64_t C = features.size(1), P = grid.size(1);
-  return s.squeeze(-1).reshape({B, N, C, P}).permute({0, 3, 1, 2});
+  return s.reshape({B, N, features.size(1), grid.size(1)});
+}
+
+// -> (B, P, N, C)
+torch::Tensor SampleViews(const torch::Tensor& features, const torch::Tensor& grid,
+                          int64_t B, int64_t N) {
+  return SampleFeatures(features, grid, B, N).permute({0, 3, 1, 2});
+}
+
+// SampleViews(...).sum(2) -> (B, P, C), summed in grid_sample's own layout: the same
+// sums, read contiguously rather than through the permuted view.
+torch::Tensor SampleViewsSum(const torch::Tensor& features, const torch::Tensor& grid,
+                             int64_t B, int64_t N) {
+  return SampleFeatures(features, grid, B, N).sum(1).transpose(1, 2);
 }
 
 // Adds the time since the previous lap to a stage (nothing when times is null).
@@ -225,7 +238,7 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
       ProjectToGrid(points, batch.intrinsics, cam_from_master, c.crop_size);
   const torch::Tensor point_feat =
       MergeViews(SampleViews(x, point_grid, B, N), merge_net_feature);
-  const torch::Tensor point_embed = SampleViews(pos_embed, point_grid, B, N).sum(2);
+  const torch::Tensor point_embed = SampleViewsSum(pos_embed, point_grid, B, N);
   clock.Lap("points: sampling + merge");
 
   const torch::Tensor coords_out = transformer->forward(
@@ -296,8 +309,12 @@ PoemOutputs PoemModelImpl::forward(const PoemBatch& batch) {
   const int64_t B = batch.images.size(0), N = c.num_views, J = PoemConfig::kNumJoints;
   const int64_t S = c.crop_size, H = c.heatmap_size();
   PoemOutputs out;
-  ptEmb_head->stage_times = stage_times;
-  ptEmb_head->transformer->stage_times = stage_times;
+  // Written only when it changes: concurrent forward passes (the label job's
+  // network batches) then only read the model.
+  if (ptEmb_head->stage_times != stage_times) {
+    ptEmb_head->stage_times = stage_times;
+    ptEmb_head->transformer->stage_times = stage_times;
+  }
   StageClock clock(stage_times);
 
   const auto f = img_backbone->forward(batch.images.reshape({B * N, 3, S, S}));

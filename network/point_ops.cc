@@ -27,6 +27,27 @@ void CheckPoints(const torch::Tensor& t, const char* name) {
   HL_CHECK(t.device().is_cpu(), std::string(name) + " must be on the CPU");
 }
 
+// Keeps the k smallest of `dist` (indices in increasing order arrive first, so a
+// strict comparison keeps the lower index on ties), nearest first, in `best_i`.
+void KeepNearest(const std::vector<float>& dist, int k, std::vector<float>* best_d,
+                 int64_t* best_i) {
+  float* bd = best_d->data();
+  int count = 0;
+  const int64_t P = static_cast<int64_t>(dist.size());
+  for (int64_t p = 0; p < P; ++p) {
+    const float d = dist[p];
+    if (count == k && !(d < bd[k - 1])) continue;
+    int pos = count < k ? count++ : k - 1;
+    while (pos > 0 && d < bd[pos - 1]) {
+      bd[pos] = bd[pos - 1];
+      best_i[pos] = best_i[pos - 1];
+      --pos;
+    }
+    bd[pos] = d;
+    best_i[pos] = p;
+  }
+}
+
 }  // namespace
 
 torch::Tensor KnnIndices(const torch::Tensor& query_in, const torch::Tensor& points_in,
@@ -39,34 +60,30 @@ torch::Tensor KnnIndices(const torch::Tensor& query_in, const torch::Tensor& poi
   HL_CHECK(points.size(0) == B, "batch sizes differ");
   HL_CHECK(k >= 1 && k <= P, "k must be in 1..P");
   torch::Tensor out = torch::empty({B, Q, k}, torch::kInt64);
+  // The points as coordinate planes (B, 3, P): the distance loop below then reads
+  // each coordinate contiguously and the compiler vectorises it.
+  const torch::Tensor planes = points.transpose(1, 2).contiguous();
   const float* qd = query.data_ptr<float>();
-  const float* pd = points.data_ptr<float>();
+  const float* sd = planes.data_ptr<float>();
   int64_t* od = out.data_ptr<int64_t>();
   // Grain: a few queries per task; each query scans all P points.
   const int64_t grain = std::max<int64_t>(1, 32768 / std::max<int64_t>(P, 1));
   at::parallel_for(0, B * Q, grain, [&](int64_t begin, int64_t end) {
-    std::vector<float> best_d(k);
-    std::vector<int64_t> best_i(k);
+    std::vector<float> dist(P), best_d(k);
     for (int64_t bq = begin; bq < end; ++bq) {
-      const int64_t b = bq / Q;
       const float* q = qd + bq * 3;
-      const float* pts = pd + b * P * 3;
-      int count = 0;
+      const float* x = sd + (bq / Q) * 3 * P;
+      const float* y = x + P;
+      const float* z = y + P;
+      // SquaredDistance's arithmetic, term by term, so the same floats.
       for (int64_t p = 0; p < P; ++p) {
-        const float d = SquaredDistance(q, pts + p * 3);
-        // Points arrive in increasing index order, so a strict comparison keeps the
-        // lower index on ties.
-        if (count == k && !(d < best_d[k - 1])) continue;
-        int pos = count < k ? count++ : k - 1;
-        while (pos > 0 && d < best_d[pos - 1]) {
-          best_d[pos] = best_d[pos - 1];
-          best_i[pos] = best_i[pos - 1];
-          --pos;
-        }
-        best_d[pos] = d;
-        best_i[pos] = p;
+        const float dx = q[0] - x[p], dy = q[1] - y[p], dz = q[2] - z[p];
+        float d = dx * dx;
+        d = d + dy * dy;
+        d = d + dz * dz;
+        dist[p] = d;
       }
-      std::copy(best_i.begin(), best_i.end(), od + bq * k);
+      KeepNearest(dist, k, &best_d, od + bq * k);
     }
   });
   return out;

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -37,6 +38,7 @@ using Clock = std::chrono::steady_clock;
 
 // The frames of one batch as they move through the stages.
 struct Batch {
+  size_t index = 0;  // in hand-out order: picks the network lane
   std::vector<std::string> ids;
   std::vector<std::optional<FrameInput>> inputs;
   std::vector<std::optional<MeshPrediction>> predictions;
@@ -323,12 +325,27 @@ class LabelJobRun {
                   << todo_.size() << " to label; " << (in_order_ ? 1 : threads_)
                   << " thread(s)"
                   << (in_order_ ? " (fit.init previous: frames in order)" : "")
-                  << "\n  input: " << stages_.source->Describe() << "\n  network: "
-                  << (stages_.predictor ? stages_.predictor->model_name
-                                        : std::string("none"))
+                  << "\n  input: " << stages_.source->Describe()
+                  << "\n  network: " << NetworkText()
                   << ", refine: " << ToString(job_.refine_mode) << ", fitter: "
                   << (stages_.fitter ? stages_.fitter->Describe() : std::string("none"))
                   << "\n  output: " << out_ << "\n";
+  }
+
+  // The network's name and how it runs: "poem (w.pt), batches of 4, 2 at once on 1
+  // thread each".
+  std::string NetworkText() const {
+    const NetworkStage* n = stages_.predictor;
+    if (!n) return "none";
+    std::ostringstream s;
+    s << n->model_name << ", batches of " << job_.batch_size;
+    const int lanes = in_order_ ? 1 : n->lanes;
+    if (lanes > 1) s << ", " << lanes << " at once";
+    if (n->threads_per_batch > 0) {
+      s << " on " << n->threads_per_batch << " thread"
+        << (n->threads_per_batch == 1 ? "" : "s") << (lanes > 1 ? " each" : "");
+    }
+    return s.str();
   }
 
   // The next batch of frames to do (serial), or nullptr when all are handed out.
@@ -336,6 +353,7 @@ class LabelJobRun {
     if (next_ >= todo_.size()) return nullptr;
     auto batch = std::make_shared<Batch>();
     const size_t end = std::min(todo_.size(), next_ + size);
+    batch->index = batches_++;
     batch->ids.assign(todo_.begin() + next_, todo_.begin() + end);
     next_ = end;
     const size_t n = batch->ids.size();
@@ -474,11 +492,31 @@ class LabelJobRun {
     record->metrics = std::move(outcome.metrics);
   }
 
-  // Four TBB stages over batches: hand out (serial), read (parallel), network (serial,
-  // batched), label and write (parallel).
+  // The network stage as `lanes` serial filters in a row; lane k predicts the batches
+  // whose index is k modulo lanes and passes the others on: at most `lanes` batches in
+  // the network at once, without blocking a worker thread.
+  static tbb::filter<std::shared_ptr<Batch>, std::shared_ptr<Batch>> NetworkLanes(
+      int lanes, const std::function<void(Batch&)>& predict) {
+    using BatchPtr = std::shared_ptr<Batch>;
+    auto lane = [&predict, lanes](int k) {
+      return tbb::make_filter<BatchPtr, BatchPtr>(
+          tbb::filter_mode::serial_out_of_order, [&predict, lanes, k](BatchPtr batch) {
+            if (batch->index % lanes == static_cast<size_t>(k)) predict(*batch);
+            return batch;
+          });
+    };
+    tbb::filter<BatchPtr, BatchPtr> all = lane(0);
+    for (int k = 1; k < lanes; ++k) all = all & lane(k);
+    return all;
+  }
+
+  // TBB stages over batches: hand out (serial), read (parallel), network (serial per
+  // lane, batched), label and write (parallel).
   void LabelPipelined() {
     using BatchPtr = std::shared_ptr<Batch>;
     const size_t batch_size = static_cast<size_t>(job_.batch_size);
+    const int lanes = stages_.predictor ? std::max(1, stages_.predictor->lanes) : 1;
+    const std::function<void(Batch&)> predict = [this](Batch& b) { Predict(b); };
     tbb::task_arena arena(threads_);
     arena.execute([&] {
       tbb::parallel_pipeline(
@@ -496,11 +534,7 @@ class LabelJobRun {
                                       [&](size_t i) { Load(*batch, i); });
                     return batch;
                   }) &
-              tbb::make_filter<BatchPtr, BatchPtr>(tbb::filter_mode::serial_out_of_order,
-                                                   [&](BatchPtr batch) {
-                                                     Predict(*batch);
-                                                     return batch;
-                                                   }) &
+              NetworkLanes(lanes, predict) &
               tbb::make_filter<BatchPtr, void>(
                   tbb::filter_mode::parallel, [&](BatchPtr batch) {
                     tbb::parallel_for(size_t(0), batch->ids.size(),
@@ -563,7 +597,8 @@ class LabelJobRun {
   int done_before_ = 0;
   int threads_ = 1;
   bool in_order_ = false;
-  size_t next_ = 0;  // next frame of todo_ to hand out
+  size_t next_ = 0;     // next frame of todo_ to hand out
+  size_t batches_ = 0;  // batches handed out
   LabelContext context_;
   OutputFolderLock lock_;  // held for the whole run
   FrameLog* log_ = nullptr;

@@ -42,9 +42,11 @@ struct NetworkStage {
   std::string weights_sha256;   // SHA-256 of the weights file (recorded in every label)
   bool predicts_masks = false;  // predictions carry silhouettes (MeshPrediction::masks)
   int64_t num_parameters = 0;   // the network's learned parameters (0: unknown)
-  // One batch; called by one thread at a time (it may use threads itself). Returns one
-  // prediction per frame, in order. Throws if the whole batch fails; the runner then
-  // retries the frames one by one so that one bad frame fails alone.
+  int lanes = 1;                // batches the runner may predict at once
+  int threads_per_batch = 0;    // the network's own threads per batch (0: unknown)
+  // One batch; called by up to `lanes` threads at once (each may use threads itself).
+  // Returns one prediction per frame, in order. Throws if the whole batch fails; the
+  // runner then retries the frames one by one so that one bad frame fails alone.
   std::function<std::vector<MeshPrediction>(const std::vector<const FrameInput*>&)>
       predict;
 };

@@ -1,7 +1,9 @@
 #include "pipeline/network_stage.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <thread>
 
 #include "capture/frame_images.h"
 #include "core/errors.h"
@@ -116,10 +118,19 @@ std::vector<MeshPrediction> PredictFramesInRig(
 
 NetworkStage LoadNetworkStage(const JobConfig& job) {
   const std::string& weights = job.network_weights;
+  // Two batches at once, each on half the job's threads: one batch's serial stretches
+  // (sampling, kNN, small layers) and the frames' fits then fill the cores instead of
+  // idle LibTorch workers (issue 21: ~7 % of the demo job; docs/labeling-jobs.md).
+  // fit.init previous labels frame by frame: its one batch at a time gets them all.
+  const int threads =
+      job.threads > 0
+          ? job.threads
+          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int lanes = job.fit.init == "previous" ? 1 : std::min(threads, 2);
   HandMeshPredictorOptions options;
   options.weights = weights;
   options.batch_size = job.batch_size;
-  options.num_threads = job.threads;
+  options.num_threads = threads / lanes;
   // Shared: std::function needs a copyable callable.
   std::shared_ptr<HandMeshPredictor> network = CreateHandMeshPredictor(options);
   NetworkStage stage;
@@ -128,6 +139,8 @@ NetworkStage LoadNetworkStage(const JobConfig& job) {
   stage.weights_sha256 = Sha256OfFile(weights);
   stage.predicts_masks = network->predicts_masks();
   stage.num_parameters = network->num_parameters();
+  stage.lanes = lanes;
+  stage.threads_per_batch = options.num_threads;
   stage.predict = [network](const std::vector<const FrameInput*>& frames) {
     return PredictFramesInRig(*network, frames);
   };

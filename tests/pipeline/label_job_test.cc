@@ -90,6 +90,34 @@ TEST(LabelJob, FallbackModeKeepsGoodNetworkAnswersAndFitsTheOthers) {
   EXPECT_TRUE(fs::exists(ManifestPath(out)));
 }
 
+// The network stage's lanes: at most `lanes` batches in the network at once, every
+// batch predicted exactly once, and the same labels whatever the lane count.
+TEST(LabelJob, NetworkLanesBoundTheBatchesInTheNetworkAndKeepTheLabels) {
+  std::map<int, std::map<std::string, std::string>> labels;
+  for (const int lanes : {1, 2, 3}) {
+    Stages s;
+    s.predictor.lanes = lanes;
+    s.predictor.hold = std::chrono::milliseconds(20);
+    const std::string out = testing::ScratchDir() + "/lanes" + std::to_string(lanes);
+    JobConfig job = MakeJob(out, RefineMode::kFallback);
+    job.threads = 4;
+    job.batch_size = 1;
+    const LabelSummary summary = RunLabelJob(job, s.Set(), {});
+    EXPECT_EQ(summary.ok, 12);
+    EXPECT_EQ(s.predictor.batches.load(), 12) << lanes << " lanes";
+    EXPECT_EQ(s.predictor.predicted.load(), 12) << lanes << " lanes";
+    EXPECT_LE(s.predictor.most_inside.load(), lanes);
+    // 12 batches of 20 ms on 4 threads: the lanes do overlap.
+    if (lanes > 1) EXPECT_GE(s.predictor.most_inside.load(), 2);
+    for (const auto& [frame, path] : LabelPaths(out)) {
+      labels[lanes][frame] = testing::ReadFileBytes(LabelFilePath(out, frame));
+    }
+  }
+  EXPECT_EQ(labels[1].size(), 12u);
+  EXPECT_EQ(labels[2], labels[1]);
+  EXPECT_EQ(labels[3], labels[1]);
+}
+
 TEST(LabelJob, RefineAlwaysRefinesEveryNetworkAnswer) {
   Stages s;
   const std::string out = testing::ScratchDir() + "/out";

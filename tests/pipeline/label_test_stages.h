@@ -7,10 +7,12 @@
 // real network and fitter is tested where those live and in the end-to-end tests.
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <random>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 #include "core/triangulation.h"
 #include "pipeline/label_job.h"
@@ -129,6 +131,8 @@ class TestPredictor : public NetworkStage {
   }
   std::vector<MeshPrediction> Predict(const std::vector<const FrameInput*>& frames) {
     ++batches;
+    const InsideCount inside(this);
+    if (hold.count() > 0) std::this_thread::sleep_for(hold);
     std::vector<MeshPrediction> out;
     for (const FrameInput* frame : frames) {
       if (throws.count(frame->id))
@@ -151,8 +155,27 @@ class TestPredictor : public NetworkStage {
   }
   std::set<std::string> shifted;
   std::set<std::string> throws;
+  std::chrono::milliseconds hold{0};  // time each batch stays inside Predict
   std::atomic<int> batches{0};
   std::atomic<int> predicted{0};
+  std::atomic<int> most_inside{0};  // the most batches inside Predict at once
+
+ private:
+  // Counts the batches inside Predict while it lives.
+  class InsideCount {
+   public:
+    explicit InsideCount(TestPredictor* p) : p_(p) {
+      const int now = ++p_->inside_;
+      int most = p_->most_inside.load();
+      while (now > most && !p_->most_inside.compare_exchange_weak(most, now)) {
+      }
+    }
+    ~InsideCount() { --p_->inside_; }
+
+   private:
+    TestPredictor* p_;
+  };
+  std::atomic<int> inside_{0};
 };
 
 // Triangulates each keypoint from the evidence (a stand-in for the Ceres fitter with
