@@ -73,12 +73,11 @@ double ProjectedMeshIoU(const Points3d& vertices, const MeshFaces& faces,
     }
   }
   auto counts = [&](int x, int y) { return !ignore || (*ignore)(y, x) == 0; };
-  long both = 0, in_mask = 0, in_mesh = 0;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (mask(y, x) != 0 && counts(x, y)) ++in_mask;
-    }
-  }
+  // Whole-image counts as array expressions: no per-pixel branch (this ran on every
+  // view of every fit stage).
+  long in_mask = ignore ? ((mask.array() != 0) && (ignore->array() == 0)).count()
+                        : (mask.array() != 0).count();
+  long both = 0, in_mesh = 0;
   for (int y = 0; y < covered.rows(); ++y) {
     for (int x = 0; x < covered.cols(); ++x) {
       const int u = x + origin.x(), v = y + origin.y();
