@@ -120,7 +120,7 @@ NetworkStage LoadNetworkStage(const JobConfig& job) {
   const std::string& weights = job.network_weights;
   // Two batches at once, each on half the job's threads: one batch's serial stretches
   // (sampling, kNN, small layers) and the frames' fits then fill the cores instead of
-  // idle LibTorch workers (issue 21: ~7 % of the demo job; docs/labeling-jobs.md).
+  // idle LibTorch workers (issue 21: 5-10 % of the demo job; docs/labeling-jobs.md).
   // fit.init previous labels frame by frame: its one batch at a time gets them all.
   const int threads =
       job.threads > 0
