@@ -5,9 +5,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <type_traits>
 
 #include "core/errors.h"
 #include "core/file_bytes.h"
+#include "core/png_decode_fast.h"
 
 namespace handlabel {
 namespace {
@@ -85,6 +87,10 @@ Image<T> Decode(const std::string& path, bool want16) {
   if (bytes.size() < 8 ||
       png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, 8) != 0) {
     throw InputError(path, "signature", "a PNG file", "other data");
+  }
+  if constexpr (std::is_same_v<T, uint8_t>) {
+    ImageU8 fast;
+    if (!want16 && DecodePngFast(bytes, &fast)) return fast;
   }
   png_structp png =
       png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
