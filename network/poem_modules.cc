@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/errors.h"
 
@@ -28,6 +29,45 @@ torch::Tensor FrozenBatchNorm2dImpl::forward(const torch::Tensor& x) {
   const torch::Tensor scale = w * (rv + 1e-5).rsqrt();
   const torch::Tensor shift = b - rm * scale;
   return x * scale + shift;
+}
+
+torch::Tensor FoldedConv::operator()(const torch::Tensor& x) const {
+  return at::conv2d(x, weight, bias, stride, padding);
+}
+
+FoldedConv FoldConvNorm(const torch::nn::Conv2dImpl& conv, torch::nn::Module& norm) {
+  torch::Tensor gamma, beta, mean, var;
+  double eps = 1e-5;
+  if (auto* frozen = norm.as<FrozenBatchNorm2d>()) {
+    gamma = frozen->weight, beta = frozen->bias;
+    mean = frozen->running_mean, var = frozen->running_var;
+  } else if (auto* bn = norm.as<torch::nn::BatchNorm2d>()) {
+    HL_CHECK(!bn->is_training(), "FoldConvNorm: batch norm in training mode");
+    gamma = bn->weight, beta = bn->bias;
+    mean = bn->running_mean, var = bn->running_var;
+    eps = bn->options.eps();
+  } else {
+    HL_CHECK(false, "FoldConvNorm: not a batch norm module");
+  }
+  torch::NoGradGuard no_grad;
+  const torch::Tensor scale = gamma * (var + eps).rsqrt();
+  const torch::Tensor bias = conv.bias.defined() ? conv.bias : torch::zeros_like(mean);
+  FoldedConv f;
+  f.weight = (conv.weight * scale.reshape({-1, 1, 1, 1})).contiguous();
+  f.bias = (bias - mean) * scale + beta;
+  f.stride = c10::IntArrayRef(conv.options.stride()).vec();
+  f.padding =
+      c10::IntArrayRef(c10::get<torch::ExpandingArray<2>>(conv.options.padding())).vec();
+  return f;
+}
+
+void FoldNormsForInference(torch::nn::Module& model) {
+  HL_CHECK(!model.is_training(), "FoldNormsForInference: the model is in training mode");
+  for (const auto& m : model.modules()) {
+    if (auto* block = m->as<BasicBlock>()) block->FoldNorms();
+    if (auto* resnet = m->as<ResNet>()) resnet->FoldNorms();
+    if (auto* conv_block = m->as<ConvBlock>()) conv_block->FoldNorms();
+  }
 }
 
 namespace {
@@ -70,7 +110,21 @@ BasicBlockImpl::BasicBlockImpl(int64_t inplanes, int64_t planes, int64_t stride,
   KaimingFanOut(conv2);
 }
 
+void BasicBlockImpl::FoldNorms() {
+  folded1 = FoldConvNorm(*conv1, *bn1.ptr());
+  folded2 = FoldConvNorm(*conv2, *bn2.ptr());
+  if (downsample) {
+    folded_downsample = FoldConvNorm(*downsample[0]->as<torch::nn::Conv2d>(),
+                                     *downsample->ptr(1));
+  }
+}
+
 torch::Tensor BasicBlockImpl::forward(const torch::Tensor& x) {
+  if (folded1.defined() && UseInferenceKernels()) {
+    torch::Tensor out = folded2(folded1(x).relu_());
+    out += folded_downsample.defined() ? folded_downsample(x) : x;
+    return out.relu_();
+  }
   torch::Tensor out = torch::relu(bn1.forward(conv1(x)));
   out = bn2.forward(conv2(out));
   const torch::Tensor residual = downsample ? downsample->forward(x) : x;
@@ -95,8 +149,12 @@ ResNetImpl::ResNetImpl(const std::array<int, 4>& blocks, int width) {
   fc = register_module("fc", torch::nn::Linear(8 * width, 1000));
 }
 
+void ResNetImpl::FoldNorms() { folded_stem = FoldConvNorm(*conv1, *bn1); }
+
 std::array<torch::Tensor, 4> ResNetImpl::forward(const torch::Tensor& image) {
-  torch::Tensor x = torch::relu(bn1(conv1(image)));
+  torch::Tensor x = folded_stem.defined() && UseInferenceKernels()
+                        ? folded_stem(image).relu_()
+                        : torch::relu(bn1(conv1(image)));
   x = F::max_pool2d(x, F::MaxPool2dFuncOptions(3).stride(2).padding(1));
   std::array<torch::Tensor, 4> out;
   for (int s = 0; s < 4; ++s) {
@@ -114,7 +172,15 @@ ConvBlockImpl::ConvBlockImpl(int64_t in, int64_t out, int64_t kernel, bool use_n
   if (use_norm) norm = register_module("norm", torch::nn::BatchNorm2d(out));
 }
 
+void ConvBlockImpl::FoldNorms() {
+  if (norm) folded = FoldConvNorm(*conv, *norm);
+}
+
 torch::Tensor ConvBlockImpl::forward(const torch::Tensor& x) {
+  if (folded.defined() && UseInferenceKernels()) {
+    const torch::Tensor y = folded(x);
+    return relu ? y.relu_() : y;
+  }
   torch::Tensor y = conv(x);
   if (norm) y = norm(y);
   return relu ? torch::relu(y) : y;

@@ -11,6 +11,7 @@
 #include "network/poem_checkpoint.h"
 #include "network/poem_import.h"
 #include "network/poem_model.h"
+#include "network/poem_modules.h"
 
 namespace handlabel {
 namespace {
@@ -24,6 +25,7 @@ class PoemPredictor : public HandMeshPredictor {
   PoemPredictor(PoemModel model, int batch_size)
       : model_(std::move(model)), batch_size_(batch_size) {
     model_->eval();
+    FoldNormsForInference(*model_);
   }
 
   std::string name() const override { return "poem"; }

@@ -4,6 +4,7 @@
 
 #include "core/errors.h"
 #include "network/poem_model.h"
+#include "network/poem_modules.h"
 #include "tests/network/poem_test_util.h"
 
 namespace handlabel {
@@ -27,6 +28,7 @@ TEST(HandMeshPredictor, PoemFromCheckpointMatchesTheModel) {
 
   PoemModel model = MakeRandomPoemModel(c, 21);
   model->eval();
+  FoldNormsForInference(*model);  // as the predictor does
   torch::NoGradGuard g;
   PoemBatch b = batch;
   // The predictor rebuilds master_from_cam from Rigid3 in double; feed the same.

@@ -14,6 +14,7 @@
 #include "network/poem_import.h"
 #include "network/poem_loss.h"
 #include "network/poem_model.h"
+#include "network/poem_modules.h"
 #include "tests/network/tensor_bundle.h"
 #include "tests/test_util.h"
 
@@ -69,6 +70,7 @@ std::string ExpectParity(const PoemConfig& config, int batch, int seed) {
       LoadPoemStateDict(model, run.weights, run.dir + "/weights", {"mano_layer."});
   EXPECT_EQ(report.ignored, (std::vector<std::string>{"mano_layer.th_faces"}));
   model->eval();
+  FoldNormsForInference(*model);  // the predictor's path
   torch::NoGradGuard no_grad;
   PoemBatch b;
   b.images = run.inputs.at("images");
@@ -113,6 +115,7 @@ std::string ExpectParity(const PoemConfig& config, int batch, int seed) {
       run.dir + "/PtEmbedMultiviewStereo.pth.tar", config, &imported);
   EXPECT_EQ(imported.ignored, (std::vector<std::string>{"mano_layer.th_faces"}));
   from_pth->eval();
+  FoldNormsForInference(*from_pth);
   EXPECT_TRUE(torch::equal(from_pth->forward(b).layer_coords, out.layer_coords));
   return run.dir;
 }
