@@ -114,8 +114,8 @@ void BasicBlockImpl::FoldNorms() {
   folded1 = FoldConvNorm(*conv1, *bn1.ptr());
   folded2 = FoldConvNorm(*conv2, *bn2.ptr());
   if (downsample) {
-    folded_downsample = FoldConvNorm(*downsample[0]->as<torch::nn::Conv2d>(),
-                                     *downsample->ptr(1));
+    folded_downsample =
+        FoldConvNorm(*downsample[0]->as<torch::nn::Conv2d>(), *downsample->ptr(1));
   }
 }
 

@@ -105,9 +105,9 @@ TEST(FoldConvNorm, EqualsTheConvolutionFollowedByTheNorm) {
     const torch::Tensor y = conv(x);
     const torch::Tensor v = frozen->running_var.reshape({1, -1, 1, 1});
     const torch::Tensor m = frozen->running_mean.reshape({1, -1, 1, 1});
-    const torch::Tensor want_frozen = (y - m) / (v + 1e-5).sqrt() *
-                                          frozen->weight.reshape({1, -1, 1, 1}) +
-                                      frozen->bias.reshape({1, -1, 1, 1});
+    const torch::Tensor want_frozen =
+        (y - m) / (v + 1e-5).sqrt() * frozen->weight.reshape({1, -1, 1, 1}) +
+        frozen->bias.reshape({1, -1, 1, 1});
     const torch::Tensor want_bn =
         (y - bn->running_mean.reshape({1, -1, 1, 1})) /
             (bn->running_var.reshape({1, -1, 1, 1}) + 1e-3).sqrt() *
