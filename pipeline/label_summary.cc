@@ -80,8 +80,9 @@ nlohmann::json LabelSummary::ToJson() const {
                       {"missing", missing},
                       {"skipped", skipped},
                       {"by_path", by_path},
-                      {"frame_seconds", frame_seconds},
-                      {"wall_seconds", wall_seconds}};
+                      {"frame_seconds", frame_seconds}};
+  // A merge does not know a wall time (shards may run anywhere): no field then.
+  if (wall_seconds > 0) j["wall_seconds"] = wall_seconds;
   nlohmann::json fails = nlohmann::json::array();
   for (const auto& [frame, reason] : failures)
     fails.push_back({{"frame", frame}, {"reason", reason}});

@@ -34,8 +34,8 @@ struct LabelSummary {
   int missing = 0;                     // never attempted (a shard that has not run yet)
   std::map<std::string, int> by_path;  // label path -> frames
   double frame_seconds = 0;            // summed per-frame time of the latest records
-  double wall_seconds = 0;             // wall time of this run (0 for a merge)
-  int skipped = 0;                     // done in an earlier run and skipped (run only)
+  double wall_seconds = 0;  // wall time of this run (0 for a merge: not written)
+  int skipped = 0;          // done in an earlier run and skipped (run only)
   std::vector<std::pair<std::string, std::string>> failures;  // frame, reason
   // Where the job's 2D keypoints came from (FrameSource::KeypointsSource, or the
   // network's own); empty when not known (a merge without the job's source).

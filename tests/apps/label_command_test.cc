@@ -173,6 +173,11 @@ TEST(LabelCommand, FitOnlyJobLabelsEveryFrameCloseToTheGroundTruth) {
       nlohmann::json::parse(testing::ReadFileBytes(dir + "/out/summary.json"));
   // Simulated detections with ~2 px noise at 160x120: the fit lands within ~1.5 cm.
   EXPECT_LT(summary.at("metrics").at("labels").at("mpjpe_mm").get<double>(), 15.0);
+  // The merge knows no wall time (no zero written); the shard's summary has it.
+  EXPECT_FALSE(summary.contains("wall_seconds"));
+  const nlohmann::json shard = nlohmann::json::parse(
+      testing::ReadFileBytes(dir + "/out/shards/shard-00000-of-00001.summary.json"));
+  EXPECT_GT(shard.at("wall_seconds").get<double>(), 0.0);
   const LabelRecord label = ReadLabelFile(LabelFilePath(dir + "/out", "000001"));
   EXPECT_EQ(label.path, LabelPath::kFallbackFit);
   ASSERT_TRUE(label.params.has_value());
