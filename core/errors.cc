@@ -18,7 +18,9 @@ InputError::InputError(const std::string& source, const std::string& field,
                        const std::string& expected, const std::string& got)
     : Error(FormatInputError(source, field, expected, got)),
       source_(source),
-      field_(field) {}
+      field_(field),
+      expected_(expected),
+      got_(got) {}
 
 void FailCheck(const char* condition, const char* file, int line,
                const std::string& detail) {

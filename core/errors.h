@@ -20,10 +20,14 @@ class InputError : public Error {
              const std::string& expected, const std::string& got = "");
   const std::string& source() const { return source_; }
   const std::string& field() const { return field_; }
+  const std::string& expected() const { return expected_; }
+  const std::string& got() const { return got_; }
 
  private:
   std::string source_;
   std::string field_;
+  std::string expected_;
+  std::string got_;
 };
 
 [[noreturn]] void FailCheck(const char* condition, const char* file, int line,

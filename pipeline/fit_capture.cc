@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 
 #include "core/errors.h"
 #include "core/hand_anatomy.h"
@@ -70,6 +71,27 @@ void FitCaptureOptions::Check() const {
   }
 }
 
+namespace {
+
+// The command's flag for each fitter field of the job it builds: errors name the flag
+// the user typed, not a job field they never wrote.
+std::string FlagOfFitField(const std::string& field) {
+  static const std::map<std::string, std::string> flags = {
+      {"fit.init", "--init"},
+      {"fit.keypoint_loss", "--loss"},
+      {"fit.keypoint_loss_scale", "--loss-scale"},
+      {"fit.keypoint_sigma_px", "--keypoint-sigma"},
+      {"fit.silhouette_sigma_px", "--silhouette-sigma"},
+      {"fit.silhouette_rounds", "--silhouette-rounds"},
+      {"fit.mask_margin_px", "--mask-margin"},
+      {"fit.pose_pca_comps", "--pca"},
+      {"fit.unknown_occluders", "--unknown-occluders"}};
+  const auto it = flags.find(field);
+  return it == flags.end() ? "" : it->second;
+}
+
+}  // namespace
+
 JobConfig FitJob(const FitCaptureOptions& o) {
   o.Check();
   JobConfig job;
@@ -91,7 +113,13 @@ JobConfig FitJob(const FitCaptureOptions& o) {
   job.fit = o.fit;
   job.output_dir = o.out_dir;
   job.overlays = o.overlays;
-  job.Check();
+  try {
+    job.Check();
+  } catch (const InputError& e) {
+    const std::string flag = FlagOfFitField(e.field());
+    if (flag.empty()) throw;
+    throw InputError("command line", flag, e.expected(), e.got());
+  }
   return job;
 }
 

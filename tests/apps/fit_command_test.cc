@@ -97,7 +97,7 @@ TEST(FitCommand, SilhouetteCheckFlagsMapToJobFields) {
 }
 
 // --mask-margin is fit.mask_margin_px; the label records the margin taken out per view,
-// within the limit.
+// within the limit; bad values are reported against the flag.
 TEST(FitCommand, MaskMarginFlagMapsToTheJobFieldAndIsRecorded) {
   const std::string dir = testing::ScratchDir();
   const LabelRecord record =
@@ -117,7 +117,15 @@ TEST(FitCommand, MaskMarginFlagMapsToTheJobFieldAndIsRecorded) {
       RunHandlabelCommand({"fit", "--capture", dir + "/capture", "--out", dir + "/bad",
                            "--mask-margin", "-2"});
   EXPECT_EQ(bad.status, 1);
-  EXPECT_NE(bad.err.find("mask_margin_px"), std::string::npos) << bad.err;
+  // The error names the flag the user typed, not the job field behind it.
+  EXPECT_NE(bad.err.find("'--mask-margin': expected 0..50 (pixels), got -2"),
+            std::string::npos)
+      << bad.err;
+  EXPECT_EQ(bad.err.find("mask_margin_px"), std::string::npos) << bad.err;
+  const CommandResult bad_pca = RunHandlabelCommand(
+      {"fit", "--capture", dir + "/capture", "--out", dir + "/bad", "--pca", "7"});
+  EXPECT_NE(bad_pca.err.find("'--pca': expected 0, 12 or 45, got 7"), std::string::npos)
+      << bad_pca.err;
 }
 
 // `fit` is a label job without a network: on the same capture it writes the same label
