@@ -8,12 +8,10 @@
 #include <memory>
 #include <vector>
 
+#include "core/big_endian.h"
+
 namespace handlabel {
 namespace {
-
-uint32_t BigEndian32(const unsigned char* p) {
-  return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3];
-}
 
 // Channels of an IHDR this path decodes (8-bit gray, RGB or RGBA, deflate, standard
 // filters, not interlaced); 0 for any other.
@@ -74,16 +72,17 @@ bool ReadChunks(const std::string& bytes, PngChunks* png) {
   bool header = false;
   for (size_t at = 8;;) {
     if (size < at + 12) return false;
-    const uint32_t length = BigEndian32(p + at);
+    const uint32_t length = ReadBigEndian32(p + at);
     if (length > size - at - 12) return false;
     const unsigned char* type = p + at + 4;
     const unsigned char* data = type + 4;
-    if (libdeflate_crc32(0, type, length + 4) != BigEndian32(data + length)) return false;
+    if (libdeflate_crc32(0, type, length + 4) != ReadBigEndian32(data + length))
+      return false;
     at += 12 + static_cast<size_t>(length);
     if (std::memcmp(type, "IHDR", 4) == 0) {
       if (header || length != 13) return false;
-      png->width = BigEndian32(data);
-      png->height = BigEndian32(data + 4);
+      png->width = ReadBigEndian32(data);
+      png->height = ReadBigEndian32(data + 4);
       png->channels = FastChannels(data);
       if (png->channels == 0 || png->width == 0 || png->height == 0) return false;
       header = true;

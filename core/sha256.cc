@@ -4,6 +4,7 @@
 #include <fstream>
 #include <vector>
 
+#include "core/big_endian.h"
 #include "core/errors.h"
 
 namespace handlabel {
@@ -32,8 +33,7 @@ Sha256::Sha256()
 void Sha256::Compress(const uint8_t* block) {
   uint32_t w[64];
   for (int i = 0; i < 16; ++i) {
-    w[i] = (uint32_t(block[4 * i]) << 24) | (uint32_t(block[4 * i + 1]) << 16) |
-           (uint32_t(block[4 * i + 2]) << 8) | uint32_t(block[4 * i + 3]);
+    w[i] = ReadBigEndian32(block + 4 * i);
   }
   for (int i = 16; i < 64; ++i) {
     const uint32_t s0 = Rotr(w[i - 15], 7) ^ Rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
