@@ -9,9 +9,9 @@
 #include <limits>
 
 #include "core/draw.h"
-#include "core/image_file.h"
 #include "core/line_plot.h"
 #include "core/rasterizer.h"
+#include "core/view_image.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/label_stage_factory.h"
@@ -306,13 +306,13 @@ ImageU8 Panel(const ImageU8& image, const Box& box, int size,
   return out;
 }
 
+// A picture is no reason to fail the comparison: an unreadable view is shown grey.
 ImageU8 ReadRgb(const std::string& path, const RigCamera& cam) {
   try {
-    ImageU8 image = ReadImageFile(path);
-    if (image.channels == 3) return image;
+    return ReadViewImageRgb(path, cam);
   } catch (const std::exception&) {
+    return ImageU8(cam.camera.width(), cam.camera.height(), 3, 128);
   }
-  return ImageU8(cam.camera.width(), cam.camera.height(), 3, 128);
 }
 
 std::vector<std::string> WorstFrames(const CompareResult& r, int count) {
