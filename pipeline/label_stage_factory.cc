@@ -110,7 +110,8 @@ std::unique_ptr<FrameSource> BuildFrameSource(
   return source;
 }
 
-BuiltLabelStages BuildLabelStages(const JobConfig& job) {
+BuiltLabelStages BuildLabelStages(const JobConfig& job,
+                                  std::shared_ptr<PredictionMemo> memo) {
   BuiltLabelStages built;
   // The detector's answers, for overlays that show them (evidence.keypoints_2d:
   // detector).
@@ -124,7 +125,7 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job) {
   built.hand_model = std::move(hand.model);
   built.hand_model_note = std::move(hand.note);
   if (!job.network_weights.empty()) {
-    built.predictor = LoadNetworkStage(job);
+    built.predictor = LoadNetworkStage(job, std::move(memo));
   }
   if (job.masks == MaskSource::kNetwork &&
       !(built.predictor && built.predictor->predicts_masks)) {

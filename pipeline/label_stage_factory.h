@@ -11,6 +11,7 @@
 #include "pipeline/detect_frame_source.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"
+#include "pipeline/network_stage.h"
 
 namespace handlabel {
 
@@ -27,7 +28,9 @@ struct BuiltLabelStages {
 };
 
 // Throws InputError naming the job file and the field whose stage cannot be built.
-BuiltLabelStages BuildLabelStages(const JobConfig& job);
+// `memo`: the network's answers shared with other jobs (network_stage.h).
+BuiltLabelStages BuildLabelStages(const JobConfig& job,
+                                  std::shared_ptr<PredictionMemo> memo = nullptr);
 
 // Only the frame source (what `handlabel merge` needs to list the job's frames). With
 // evidence.keypoints_2d: detector, the detector's answers go into `detections` when

@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "core/image.h"
 #include "core/sha256.h"
+#include "core/stopwatch.h"
 
 namespace handlabel {
 namespace {
@@ -96,18 +97,76 @@ MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& 
   return p;
 }
 
+std::string PredictionMemo::Key(const std::string& weights_sha256,
+                                const HandMeshInput& input) {
+  Sha256 hash;
+  hash.Update(weights_sha256);
+  for (const HandMeshViewInput& view : input.views) {
+    hash.Update(view.pixels.data(), view.pixels.size() * sizeof(float));
+    hash.Update(view.intrinsics.data(), 9 * sizeof(double));
+    const Matrix3x4d pose = view.cam_from_master.ToMatrix();
+    hash.Update(pose.data(), 12 * sizeof(double));
+    hash.Update(&view.weight, sizeof(double));
+  }
+  return hash.HexDigest();
+}
+
+bool PredictionMemo::Find(const std::string& key, HandMeshPrediction* prediction) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = entries_.find(key);
+  if (it == entries_.end()) return false;
+  *prediction = it->second.prediction;
+  ++hits_;
+  saved_seconds_ += it->second.seconds;
+  return true;
+}
+
+void PredictionMemo::Store(const std::string& key, const HandMeshPrediction& prediction,
+                           double seconds) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  entries_.emplace(key, Entry{prediction, seconds});
+}
+
+int PredictionMemo::hits() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return hits_;
+}
+
+double PredictionMemo::saved_seconds() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return saved_seconds_;
+}
+
 std::vector<MeshPrediction> PredictFramesInRig(
-    HandMeshPredictor& network, const std::vector<const FrameInput*>& frames) {
+    HandMeshPredictor& network, const std::vector<const FrameInput*>& frames,
+    PredictionMemo* memo, const std::string& weights_sha256) {
   HandCropOptions crop;
   crop.crop_size = network.crop_size();
-  std::vector<HandMeshInput> inputs;
   std::vector<std::vector<ViewCrop>> crops(frames.size());
+  std::vector<HandMeshPrediction> outputs(frames.size());
+  std::vector<std::string> keys(frames.size());
+  std::vector<HandMeshInput> inputs;  // the frames the network has to answer
+  std::vector<size_t> asked;
   for (size_t f = 0; f < frames.size(); ++f) {
-    inputs.push_back(
-        CropFrameForNetwork(*frames[f], network.num_views(), crop, &crops[f]));
+    HandMeshInput input =
+        CropFrameForNetwork(*frames[f], network.num_views(), crop, &crops[f]);
+    if (memo) {
+      keys[f] = PredictionMemo::Key(weights_sha256, input);
+      if (memo->Find(keys[f], &outputs[f])) continue;
+    }
+    inputs.push_back(std::move(input));
+    asked.push_back(f);
   }
-  const std::vector<HandMeshPrediction> outputs = network.Predict(inputs);
-  HL_CHECK(outputs.size() == frames.size(), "one prediction per frame");
+  if (!inputs.empty()) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<HandMeshPrediction> answers = network.Predict(inputs);
+    HL_CHECK(answers.size() == inputs.size(), "one prediction per frame");
+    const double each = SecondsSince(start) / static_cast<double>(inputs.size());
+    for (size_t i = 0; i < asked.size(); ++i) {
+      if (memo) memo->Store(keys[asked[i]], answers[i], each);
+      outputs[asked[i]] = std::move(answers[i]);
+    }
+  }
   std::vector<MeshPrediction> predictions;
   for (size_t f = 0; f < frames.size(); ++f) {
     predictions.push_back(
@@ -116,7 +175,8 @@ std::vector<MeshPrediction> PredictFramesInRig(
   return predictions;
 }
 
-NetworkStage LoadNetworkStage(const JobConfig& job) {
+NetworkStage LoadNetworkStage(const JobConfig& job,
+                              std::shared_ptr<PredictionMemo> memo) {
   const std::string& weights = job.network_weights;
   // Two batches at once, each on half the job's threads: one batch's serial stretches
   // (sampling, kNN, small layers) and the frames' fits then fill the cores instead of
@@ -141,8 +201,9 @@ NetworkStage LoadNetworkStage(const JobConfig& job) {
   stage.num_parameters = network->num_parameters();
   stage.lanes = lanes;
   stage.threads_per_batch = options.num_threads;
-  stage.predict = [network](const std::vector<const FrameInput*>& frames) {
-    return PredictFramesInRig(*network, frames);
+  stage.predict = [network, memo, sha = stage.weights_sha256](
+                      const std::vector<const FrameInput*>& frames) {
+    return PredictFramesInRig(*network, frames, memo.get(), sha);
   };
   return stage;
 }

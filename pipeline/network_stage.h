@@ -7,6 +7,9 @@
 // pixels to full-image (distorted) pixels with the heatmap peaks as confidences, and
 // the mask head's crop masks (if the network has one) to full-image silhouettes.
 
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -29,13 +32,45 @@ HandMeshInput CropFrameForNetwork(const FrameInput& frame, int num_views,
 MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& frame,
                                const std::vector<ViewCrop>& crops, int crop_size);
 
-// The two above around one Predict call of `network`.
+// The network's answers by input, shared by jobs that show the same weights the same
+// frames (the methods of a comparison): each distinct input is predicted once.
+// Thread-safe (network lanes call it at once).
+class PredictionMemo {
+ public:
+  // The key of `input` for the weights with hash `weights_sha256`: a SHA-256 of every
+  // view's crop pixels, crop intrinsics, pose and weight.
+  static std::string Key(const std::string& weights_sha256, const HandMeshInput& input);
+  bool Find(const std::string& key, HandMeshPrediction* prediction) const;
+  // `seconds`: what predicting it cost (its share of the batch).
+  void Store(const std::string& key, const HandMeshPrediction& prediction,
+             double seconds);
+  int hits() const;  // answers given from the memo so far
+  // The network time those answers had cost: a job's timing plus this delta is what
+  // the job would have taken alone.
+  double saved_seconds() const;
+
+ private:
+  struct Entry {
+    HandMeshPrediction prediction;
+    double seconds = 0;
+  };
+  mutable std::mutex mutex_;
+  std::map<std::string, Entry> entries_;
+  mutable int hits_ = 0;
+  mutable double saved_seconds_ = 0;
+};
+
+// The two above around one Predict call of `network`; with a memo, only the frames
+// whose input it has not seen go to the network.
 std::vector<MeshPrediction> PredictFramesInRig(
-    HandMeshPredictor& network, const std::vector<const FrameInput*>& frames);
+    HandMeshPredictor& network, const std::vector<const FrameInput*>& frames,
+    PredictionMemo* memo = nullptr, const std::string& weights_sha256 = "");
 
 // The job's network stage from its `network` section (weights, batch_size, threads):
 // loads and validates the weights (InputError naming the file) and hashes them. This is
-// where capture/'s frames meet network/'s predictor, so it lives in pipeline/.
-NetworkStage LoadNetworkStage(const JobConfig& job);
+// where capture/'s frames meet network/'s predictor, so it lives in pipeline/. With a
+// memo, inputs seen before are answered from it.
+NetworkStage LoadNetworkStage(const JobConfig& job,
+                              std::shared_ptr<PredictionMemo> memo = nullptr);
 
 }  // namespace handlabel

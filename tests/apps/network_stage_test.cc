@@ -121,5 +121,66 @@ TEST_F(NetworkStageTest, MovingTheRigMovesTheAnswerWithIt) {
   }
 }
 
+// Counts the frames it is asked to predict and passes them to a real network.
+class CountingPredictor : public HandMeshPredictor {
+ public:
+  explicit CountingPredictor(std::unique_ptr<HandMeshPredictor> inner)
+      : inner_(std::move(inner)) {}
+  std::string name() const override { return inner_->name(); }
+  int num_views() const override { return inner_->num_views(); }
+  int crop_size() const override { return inner_->crop_size(); }
+  bool predicts_masks() const override { return inner_->predicts_masks(); }
+  std::vector<HandMeshPrediction> Predict(
+      const std::vector<HandMeshInput>& frames) override {
+    asked += static_cast<int>(frames.size());
+    return inner_->Predict(frames);
+  }
+  int asked = 0;
+
+ private:
+  std::unique_ptr<HandMeshPredictor> inner_;
+};
+
+void ExpectSamePrediction(const MeshPrediction& a, const MeshPrediction& b) {
+  EXPECT_EQ(a.keypoints, b.keypoints);
+  EXPECT_EQ(a.vertices, b.vertices);
+  ASSERT_EQ(a.keypoints_2d.size(), b.keypoints_2d.size());
+  for (size_t v = 0; v < a.keypoints_2d.size(); ++v) {
+    EXPECT_EQ(a.keypoints_2d[v].uv_px, b.keypoints_2d[v].uv_px);
+  }
+  ASSERT_EQ(a.masks.size(), b.masks.size());
+  for (size_t v = 0; v < a.masks.size(); ++v) EXPECT_EQ(a.masks[v], b.masks[v]);
+}
+
+// A memo answers an input it has seen (the same crops, poses and weights) without the
+// network, with the network's own answer; other crops or other weights go to the
+// network.
+TEST_F(NetworkStageTest, MemoAnswersSeenInputsAndOnlyThose) {
+  HandMeshPredictorOptions options;
+  options.weights = weights_;
+  options.num_threads = 1;
+  CountingPredictor network(CreateHandMeshPredictor(options));
+  PredictionMemo memo;
+  const MeshPrediction plain = PredictFramesInRig(network, {&frame_}).at(0);
+  ASSERT_EQ(network.asked, 1);
+
+  const MeshPrediction first = PredictFramesInRig(network, {&frame_}, &memo, "w1").at(0);
+  EXPECT_EQ(network.asked, 2);
+  const MeshPrediction again = PredictFramesInRig(network, {&frame_}, &memo, "w1").at(0);
+  EXPECT_EQ(network.asked, 2);  // from the memo
+  EXPECT_EQ(memo.hits(), 1);
+  EXPECT_GT(memo.saved_seconds(), 0.0);  // the first prediction's cost
+  ExpectSamePrediction(again, plain);
+  ExpectSamePrediction(first, plain);
+
+  // Other 2D keypoints move the crops: a new input. Other weights: a new key.
+  FrameInput shifted = frame_;
+  shifted.keypoints_2d.at(3)->uv_px.array() += 9.0;
+  PredictFramesInRig(network, {&shifted, &frame_}, &memo, "w1");
+  EXPECT_EQ(network.asked, 3);  // only the shifted frame
+  PredictFramesInRig(network, {&frame_}, &memo, "w2");
+  EXPECT_EQ(network.asked, 4);
+}
+
 }  // namespace
 }  // namespace handlabel
