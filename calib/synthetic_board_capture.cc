@@ -112,7 +112,7 @@ void AddNearFrames(const BoardSpec& board, const SyntheticBoardCaptureOptions& o
               Eigen::AngleAxisd(uniform(-tilt, tilt), Eigen::Vector3d::UnitX()) *
               Eigen::AngleAxisd(uniform(-tilt, tilt), Eigen::Vector3d::UnitY()) *
               Eigen::AngleAxisd(uniform(-kPi, kPi), Eigen::Vector3d::UnitZ()));
-      char key[32];
+      char key[64];
       std::snprintf(key, sizeof(key), "near%zu_%02d", c, f);
       capture->world_from_board[key] = Rigid3(rotation, centre - rotation * board_centre);
     }

@@ -32,7 +32,7 @@ Rigid3 CamFromWorld(const Placement& p) {
 }
 
 std::string CameraName(size_t i) {
-  char buf[16];
+  char buf[32];
   std::snprintf(buf, sizeof(buf), "cam%02zu", i);
   return buf;
 }

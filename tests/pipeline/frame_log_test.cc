@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <string>
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
@@ -11,6 +13,20 @@
 
 namespace handlabel {
 namespace {
+
+// A record with the fields these tests set; the rest keep their defaults.
+FrameRecord Rec(const std::string& frame, const std::string& status,
+                const std::string& path, const std::string& reason, double seconds,
+                std::map<std::string, double> metrics = {}) {
+  FrameRecord r;
+  r.frame = frame;
+  r.status = status;
+  r.path = path;
+  r.reason = reason;
+  r.seconds = seconds;
+  r.metrics = std::move(metrics);
+  return r;
+}
 
 namespace fs = std::filesystem;
 
@@ -20,9 +36,9 @@ TEST(FrameLog, RecordsSurviveReopenAndLaterRecordsSupersede) {
   const std::string path = TempDir() + "/shard-0-of-1.jsonl";
   {
     FrameLog log(path);
-    log.Record({"000001", "failed", "", "no views", 0.1});
-    log.Record({"000002", "ok", "network", "", 0.2});
-    log.Record({"000001", "ok", "fit", "", 0.3});
+    log.Record(Rec("000001", "failed", "", "no views", 0.1));
+    log.Record(Rec("000002", "ok", "network", "", 0.2));
+    log.Record(Rec("000001", "ok", "fit", "", 0.3));
   }
   FrameLog reopened(path);
   EXPECT_TRUE(reopened.IsDone("000001"));
@@ -37,7 +53,7 @@ TEST(FrameLog, PartialLastLineFromACrashIsIgnored) {
   const std::string path = TempDir() + "/log.jsonl";
   {
     FrameLog log(path);
-    log.Record({"a", "ok", "network", "", 0});
+    log.Record(Rec("a", "ok", "network", "", 0));
   }
   std::ofstream(path, std::ios::app) << "{\"frame\": \"b\", \"sta";  // killed mid-write
   FrameLog log(path);
@@ -49,12 +65,12 @@ TEST(FrameLog, AppendAfterAPartialLineStartsAFreshLine) {
   const std::string path = TempDir() + "/log.jsonl";
   {
     FrameLog log(path);
-    log.Record({"a", "ok", "network", "", 0});
+    log.Record(Rec("a", "ok", "network", "", 0));
   }
   std::ofstream(path, std::ios::app) << "{\"frame\": \"b\", \"sta";  // killed mid-write
   {
     FrameLog log(path);
-    log.Record({"b", "ok", "fit", "", 0, {{"labels/mpjpe_mm", 2.5}}});
+    log.Record(Rec("b", "ok", "fit", "", 0, {{"labels/mpjpe_mm", 2.5}}));
   }
   const auto records = FrameLog::Read(path);  // would throw on a glued line
   ASSERT_EQ(records.size(), 2u);

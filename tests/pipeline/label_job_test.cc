@@ -97,7 +97,7 @@ TEST(LabelJob, NetworkLanesBoundTheBatchesInTheNetworkAndKeepTheLabels) {
   for (const int lanes : {1, 2, 3}) {
     Stages s;
     s.predictor.lanes = lanes;
-    s.predictor.hold = std::chrono::milliseconds(20);
+    s.predictor.hold = std::chrono::milliseconds(1000);
     const std::string out = testing::ScratchDir() + "/lanes" + std::to_string(lanes);
     JobConfig job = MakeJob(out, RefineMode::kFallback);
     job.threads = 4;
@@ -107,8 +107,10 @@ TEST(LabelJob, NetworkLanesBoundTheBatchesInTheNetworkAndKeepTheLabels) {
     EXPECT_EQ(s.predictor.batches.load(), 12) << lanes << " lanes";
     EXPECT_EQ(s.predictor.predicted.load(), 12) << lanes << " lanes";
     EXPECT_LE(s.predictor.most_inside.load(), lanes);
-    // 12 batches of 20 ms on 4 threads: the lanes do overlap.
-    if (lanes > 1) EXPECT_GE(s.predictor.most_inside.load(), 2);
+    // Each batch waits up to 1 s for another: lanes that may overlap do.
+    if (lanes > 1) {
+      EXPECT_GE(s.predictor.most_inside.load(), 2);
+    }
     for (const auto& [frame, path] : LabelPaths(out)) {
       labels[lanes][frame] = testing::ReadFileBytes(LabelFilePath(out, frame));
     }

@@ -132,7 +132,14 @@ class TestPredictor : public NetworkStage {
   std::vector<MeshPrediction> Predict(const std::vector<const FrameInput*>& frames) {
     ++batches;
     const InsideCount inside(this);
-    if (hold.count() > 0) std::this_thread::sleep_for(hold);
+    // With lanes, wait for a second batch to come in (or `hold` to pass), so that a
+    // runner which lets batches overlap shows it whatever the machine's load.
+    const auto until = std::chrono::steady_clock::now() + hold;
+    while (lanes > 1 && inside_.load() < 2 && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    // ... and stay a little, so that a runner letting in more than `lanes` is caught.
+    if (hold.count() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     std::vector<MeshPrediction> out;
     for (const FrameInput* frame : frames) {
       if (throws.count(frame->id))
@@ -155,7 +162,8 @@ class TestPredictor : public NetworkStage {
   }
   std::set<std::string> shifted;
   std::set<std::string> throws;
-  std::chrono::milliseconds hold{0};  // time each batch stays inside Predict
+  // With lanes > 1: the longest a batch waits inside Predict for another to join it.
+  std::chrono::milliseconds hold{0};
   std::atomic<int> batches{0};
   std::atomic<int> predicted{0};
   std::atomic<int> most_inside{0};  // the most batches inside Predict at once
