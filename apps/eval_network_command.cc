@@ -167,7 +167,7 @@ int RunEvalNetwork(int argc, char** argv) {
       "labeling job's network stage: compare's network row (MPVPE, RR-V, PA-V, AUC-V, "
       "MPJPE, RR-J, PA-J, AUC-J).\n"
       "Examples: handlabel eval-network --weights models/poem_small_dexycb.pt --preset "
-      "dexycb --frames 500 --seed 777 --pck-png pck.png\n"
+      "dexycb --frames 500 --seed 9401 --objects --pck-png pck.png\n"
       "          handlabel eval-network --weights models/poem_small_dexycb.pt --capture "
       "captures/dex50 --frames 0:10 --json eval.json",
       "eval-network");
