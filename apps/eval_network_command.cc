@@ -28,6 +28,7 @@ struct EvalNetworkFlags {
   NetworkEvalOptions synth;
   std::string frames = "500";  // synthetic: a count; --capture: a frame list
   std::string hand_model, pck_png, capture, out, json;
+  std::string keypoints = "mean";  // --keypoints
   int max_frames = 0;
   double auc_max_mm = 0;
   bool objects = false, no_clutter = false;
@@ -64,14 +65,17 @@ int RunOnSynth(EvalNetworkFlags& f) {
   progress.Finish();
   std::printf(
       "frames %d (preset %s, seed %llu)\n"
-      "MPJPE    %.2f mm\nMPVPE    %.2f mm\nPA-MPJPE %.2f mm\nPA-MPVPE %.2f mm\n"
+      "MPJPE    %.2f mm (keypoints: %s)\nMPVPE    %.2f mm\nPA-MPJPE %.2f mm\nPA-MPVPE "
+      "%.2f mm\n"
       "AUC joints (0-20 mm)   %.3f\nAUC vertices (0-20 mm) %.3f\n"
       "network %.2f frames/s\n",
       r.frames, o.synth.rig.preset.c_str(), static_cast<unsigned long long>(o.synth.seed),
-      r.mpjpe_mm, r.mpvpe_mm, r.pa_mpjpe_mm, r.pa_mpvpe_mm, r.joint_pck.auc,
-      r.vertex_pck.auc, r.frames_per_second);
-  std::printf("MPJPE of keypoints read off the mesh %.2f mm (true mesh: %.2f mm)\n",
-              r.mpjpe_from_mesh_mm, r.true_mesh_keypoint_gap_mm);
+      r.mpjpe_mm, ToString(o.keypoints).c_str(), r.mpvpe_mm, r.pa_mpjpe_mm, r.pa_mpvpe_mm,
+      r.joint_pck.auc, r.vertex_pck.auc, r.frames_per_second);
+  std::printf(
+      "MPJPE by keypoint reading (--keypoints): joints %.2f mm, mesh %.2f mm (true mesh: "
+      "%.2f mm), mean %.2f mm\n",
+      r.mpjpe_joints_mm, r.mpjpe_mesh_mm, r.true_mesh_keypoint_gap_mm, r.mpjpe_mean_mm);
   if (r.mask_iou >= 0) std::printf("mask IoU (crop grid)   %.3f\n", r.mask_iou);
   if (!o.mask_png.empty()) std::cout << "masks: " << o.mask_png << "\n";
   if (!f.pck_png.empty()) {
@@ -123,6 +127,7 @@ int RunOnCapture(const EvalNetworkFlags& f) {
   o.seed = f.synth.synth.seed;
   o.hand_model = f.hand_model;
   o.auc_max_mm = f.auc_max_mm;
+  o.keypoints = f.synth.keypoints;
   std::optional<ScratchFolder> scratch;
   if (f.out.empty()) scratch.emplace();
   o.out_dir = f.out.empty() ? scratch->path() : f.out;
@@ -200,6 +205,12 @@ int RunEvalNetwork(int argc, char** argv) {
   app.add_option("--hand-model", f.hand_model,
                  "hand model the network was trained with (default: the shipped open "
                  "hand)");
+  app.add_option("--keypoints", f.keypoints,
+                 "how the answer's keypoints are read, as a job's network.keypoints: "
+                 "joints (the network's joint outputs), mesh (read off its mesh), mean "
+                 "(of the two)")
+      ->check(CLI::IsMember({"joints", "mesh", "mean"}))
+      ->capture_default_str();
   app.add_option("--pck-png", f.pck_png, "write the PCK curves to this PNG");
   app.add_option(
       "--mask-png", o.mask_png,
@@ -215,6 +226,7 @@ int RunEvalNetwork(int argc, char** argv) {
       ->capture_default_str();
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("eval-network", [&] {
+    o.keypoints = *AnswerKeypointsNamed(f.keypoints);  // IsMember checked it
     if (f.capture.empty()) {
       for (const char* flag : {"--max-frames", "--out", "--json", "--auc-max-mm"}) {
         if (app.count(flag) > 0) {

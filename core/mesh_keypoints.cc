@@ -27,4 +27,33 @@ Points3d SnapKeypoints(const HandModel& model, const Points3d& joints,
   return keypoints;
 }
 
+Points3d ReadAnswerKeypoints(const HandModel& model, const Points3d& joints,
+                             const Points3d& vertices, AnswerKeypoints how) {
+  if (how == AnswerKeypoints::kJoints) return joints;
+  const Points3d from_mesh = KeypointsFromMeshVertices(model, vertices);
+  if (how == AnswerKeypoints::kMesh) return from_mesh;
+  HL_CHECK(joints.rows() == kNumHandKeypoints, "21 keypoints");
+  return 0.5 * (joints + from_mesh);
+}
+
+std::string ToString(AnswerKeypoints how) {
+  switch (how) {
+    case AnswerKeypoints::kJoints:
+      return "joints";
+    case AnswerKeypoints::kMesh:
+      return "mesh";
+    case AnswerKeypoints::kMean:
+      return "mean";
+  }
+  return "?";
+}
+
+std::optional<AnswerKeypoints> AnswerKeypointsNamed(const std::string& name) {
+  for (AnswerKeypoints how :
+       {AnswerKeypoints::kJoints, AnswerKeypoints::kMesh, AnswerKeypoints::kMean}) {
+    if (ToString(how) == name) return how;
+  }
+  return std::nullopt;
+}
+
 }  // namespace handlabel

@@ -5,6 +5,9 @@
 // posed hand it differs from the skinned joints (PoseHand's keypoints) because the
 // regressor is fitted to rest meshes only.
 
+#include <optional>
+#include <string>
+
 #include "core/hand_lbs.h"  // Points3d, HandModel
 
 namespace handlabel {
@@ -17,5 +20,18 @@ Points3d KeypointsFromMeshVertices(const HandModel& model, const Points3d& verti
 // joints).
 Points3d SnapKeypoints(const HandModel& model, const Points3d& joints,
                        const Points3d& vertices);
+
+// How the 21 keypoints of a network's answer that carries both are read: its own joint
+// outputs, the keypoints read off its mesh, or the mean of the two (two estimates whose
+// errors are partly independent; docs/network.md "Keypoints of the answer" has the
+// measurements that made kMean the default).
+enum class AnswerKeypoints { kJoints, kMesh, kMean };
+
+// joints: 21 x 3 (SNAP order); vertices: model.num_vertices() x 3, in the same frame.
+Points3d ReadAnswerKeypoints(const HandModel& model, const Points3d& joints,
+                             const Points3d& vertices, AnswerKeypoints how);
+
+std::string ToString(AnswerKeypoints how);  // "joints" | "mesh" | "mean"
+std::optional<AnswerKeypoints> AnswerKeypointsNamed(const std::string& name);
 
 }  // namespace handlabel

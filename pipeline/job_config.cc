@@ -316,6 +316,14 @@ JobConfig LoadJobConfig(const std::string& path) {
   network.Read("weights", &job.network_weights);
   network.Read("batch_size", &job.batch_size);
   network.Read("threads", &job.threads);
+  std::string network_keypoints = ToString(job.network_keypoints);
+  network.Read("keypoints", &network_keypoints);
+  const std::optional<AnswerKeypoints> how = AnswerKeypointsNamed(network_keypoints);
+  if (!how) {
+    throw InputError(path, network.Name("keypoints"), "joints | mesh | mean",
+                     "'" + network_keypoints + "'");
+  }
+  job.network_keypoints = *how;
   network.RejectUnknownKeys();
 
   ReadRefineSection(top, path, &job);

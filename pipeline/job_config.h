@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/mesh_keypoints.h"
+
 namespace handlabel {
 
 enum class RefineMode { kOff, kAlways, kFallback };
@@ -92,6 +94,10 @@ struct JobConfig {
   std::string network_weights;  // empty = no network: every frame is fitted
   int batch_size = 4;
   int threads = 0;  // 0 = all cores
+  // network.keypoints: how the answer's 3D keypoints are read (joints | mesh | mean,
+  // core/mesh_keypoints.h); they are what the quality checks judge and what a kept
+  // answer's label carries.
+  AnswerKeypoints network_keypoints = AnswerKeypoints::kMean;
 
   // refinement and fallback
   RefineMode refine_mode = RefineMode::kFallback;

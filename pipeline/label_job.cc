@@ -159,6 +159,10 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   if (!job.object_masks) extra["object_masks"] = "none";
   if (!job.detections.empty()) extra["detections"] = job.detections;
   if (job.keypoints_from_detector) extra["detector"] = job.detector_model;
+  // Labels made before the reading was chosen used the joints.
+  if (!weights_sha256.empty() && job.network_keypoints != AnswerKeypoints::kJoints) {
+    extra["network_keypoints"] = ToString(job.network_keypoints);
+  }
   if (!extra.empty()) j["added"] = extra;
   return Sha256Hex(j.dump());
 }
@@ -345,6 +349,7 @@ class LabelJobRun {
       s << " on " << n->threads_per_batch << " thread"
         << (n->threads_per_batch == 1 ? "" : "s") << (lanes > 1 ? " each" : "");
     }
+    if (!n->keypoints.empty()) s << ", keypoints: " << n->keypoints;
     return s.str();
   }
 

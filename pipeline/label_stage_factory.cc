@@ -126,6 +126,7 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job,
   built.hand_model_note = std::move(hand.note);
   if (!job.network_weights.empty()) {
     built.predictor = LoadNetworkStage(job, std::move(memo));
+    ReadAnswerKeypointsAs(job, built.hand_model, &*built.predictor);
   }
   if (job.masks == MaskSource::kNetwork &&
       !(built.predictor && built.predictor->predicts_masks)) {

@@ -44,6 +44,9 @@ struct NetworkStage {
   int64_t num_parameters = 0;   // the network's learned parameters (0: unknown)
   int lanes = 1;                // batches the runner may predict at once
   int threads_per_batch = 0;    // the network's own threads per batch (0: unknown)
+  // How the answers' 3D keypoints are read (network.keypoints), as the job's start
+  // line shows it; empty = the network's joints, unannounced.
+  std::string keypoints;
   // One batch; called by up to `lanes` threads at once (each may use threads itself).
   // Returns one prediction per frame, in order. Throws if the whole batch fails; the
   // runner then retries the frames one by one so that one bad frame fails alone.

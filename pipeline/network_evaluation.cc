@@ -94,15 +94,19 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
       const int f = first + static_cast<int>(i);
       const TrainingSample& s = samples[i];
       if (vertex_errors.size() == 0) vertex_errors.resize(o.frames, s.vertices_3d.rows());
-      const Points3d joints = pred[i].joints;
+      const Points3d joints =
+          ReadAnswerKeypoints(hand, pred[i].joints, pred[i].vertices, o.keypoints);
       joint_errors.row(f) = PointErrors(joints, s.joints_3d).transpose();
       vertex_errors.row(f) = PointErrors(pred[i].vertices, s.vertices_3d).transpose();
       r.pa_mpjpe_mm += 1000 * ProcrustesMeanPointError(joints, s.joints_3d);
       r.pa_mpvpe_mm += 1000 * ProcrustesMeanPointError(pred[i].vertices, s.vertices_3d);
-      r.mpjpe_from_mesh_mm +=
-          1000 *
-          PointErrors(KeypointsFromMeshVertices(hand, pred[i].vertices), s.joints_3d)
-              .mean();
+      for (auto [how, sum] : {std::pair{AnswerKeypoints::kJoints, &r.mpjpe_joints_mm},
+                              std::pair{AnswerKeypoints::kMesh, &r.mpjpe_mesh_mm},
+                              std::pair{AnswerKeypoints::kMean, &r.mpjpe_mean_mm}}) {
+        const Points3d read =
+            ReadAnswerKeypoints(hand, pred[i].joints, pred[i].vertices, how);
+        *sum += 1000 * PointErrors(read, s.joints_3d).mean();
+      }
       r.true_mesh_keypoint_gap_mm +=
           1000 *
           PointErrors(KeypointsFromMeshVertices(hand, s.vertices_3d), s.joints_3d).mean();
@@ -120,7 +124,9 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   r.mpvpe_mm = 1000 * vertex_errors.mean();
   r.pa_mpjpe_mm /= r.frames;
   r.pa_mpvpe_mm /= r.frames;
-  r.mpjpe_from_mesh_mm /= r.frames;
+  for (double* sum : {&r.mpjpe_joints_mm, &r.mpjpe_mesh_mm, &r.mpjpe_mean_mm}) {
+    *sum /= r.frames;
+  }
   r.true_mesh_keypoint_gap_mm /= r.frames;
   r.joint_pck = ComputePck(joint_errors, o.pck);
   r.vertex_pck = ComputePck(vertex_errors, o.pck);
@@ -149,6 +155,7 @@ CompareResult EvaluateNetworkOnCapture(const CaptureNetworkEvalOptions& o,
   JobConfig base =
       CompareCaptureJob(o.capture, o.weights, o.frames, o.max_frames, o.threads, o.seed);
   base.hand_model = o.hand_model;
+  base.network_keypoints = o.keypoints;
   CompareOptions compare;
   compare.out_dir = o.out_dir;
   compare.methods = {CompareMethod::kNetwork};

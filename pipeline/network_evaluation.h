@@ -15,6 +15,7 @@
 
 #include "capture/synth_capture.h"
 #include "core/hand_model.h"
+#include "core/mesh_keypoints.h"
 #include "core/metrics.h"
 #include "pipeline/compare_run.h"
 #include "pipeline/training_samples.h"
@@ -33,6 +34,9 @@ struct NetworkEvalOptions {
   // true masks to this PNG (network/mask_sheet.h); empty = none.
   std::string mask_png;
   int mask_png_frames = 3;
+  // How the answer's keypoints are read (as a job's network.keypoints): the MPJPE,
+  // PA-MPJPE and joint PCK are of these.
+  AnswerKeypoints keypoints = AnswerKeypoints::kMean;
   void Check() const;
 };
 
@@ -40,10 +44,11 @@ struct NetworkEvalResult {
   int frames = 0;
   double mpjpe_mm = 0, mpvpe_mm = 0;        // mean over frames
   double pa_mpjpe_mm = 0, pa_mpvpe_mm = 0;  // Procrustes-aligned
-  // MPJPE of keypoints read off the predicted mesh (core/mesh_keypoints.h) instead of
-  // the network's own joints, and of the same reading of the true mesh (the reading's
-  // own error, which a perfect mesh would still carry).
-  double mpjpe_from_mesh_mm = 0, true_mesh_keypoint_gap_mm = 0;
+  // MPJPE of each reading of the keypoints (core/mesh_keypoints.h AnswerKeypoints:
+  // joints, mesh, mean), and of the mesh reading of the true mesh (that reading's own
+  // error, which a perfect mesh would still carry).
+  double mpjpe_joints_mm = 0, mpjpe_mesh_mm = 0, mpjpe_mean_mm = 0;
+  double true_mesh_keypoint_gap_mm = 0;
   PckCurve joint_pck, vertex_pck;  // thresholds in metres
   double seconds = 0;              // wall time of the forward passes
   double frames_per_second = 0;    // network only (crops excluded)
@@ -69,6 +74,7 @@ struct CaptureNetworkEvalOptions {
   std::string hand_model;  // model file or 'capsule'; empty = the shipped open hand
   std::string out_dir;     // the network's label job goes to <out_dir>/methods/network
   double auc_max_mm = 0;   // PCK / AUC range; 0 = 50 for HO3D-like input, else 20
+  AnswerKeypoints keypoints = AnswerKeypoints::kMean;  // the job's network.keypoints
   // Throws InputError naming the flag.
   void Check() const;
 };

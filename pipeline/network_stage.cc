@@ -10,6 +10,7 @@
 #include "core/image.h"
 #include "core/sha256.h"
 #include "core/stopwatch.h"
+#include "network/poem_config.h"
 
 namespace handlabel {
 namespace {
@@ -206,6 +207,29 @@ NetworkStage LoadNetworkStage(const JobConfig& job,
     return PredictFramesInRig(*network, frames, memo.get(), sha);
   };
   return stage;
+}
+
+void ReadAnswerKeypointsAs(const JobConfig& job, const HandModel& hand,
+                           NetworkStage* stage) {
+  const AnswerKeypoints how = job.network_keypoints;
+  stage->keypoints = ToString(how);
+  if (how == AnswerKeypoints::kJoints) return;
+  if (hand.num_vertices() != PoemConfig::kNumVertices) {
+    stage->keypoints = "joints (" + ToString(how) + " reads the mesh, whose " +
+                       std::to_string(PoemConfig::kNumVertices) +
+                       " vertices the hand model's " +
+                       std::to_string(hand.num_vertices()) + " do not match)";
+    return;
+  }
+  auto model = std::make_shared<const HandModel>(hand);
+  stage->predict = [predict = std::move(stage->predict), model,
+                    how](const std::vector<const FrameInput*>& frames) {
+    std::vector<MeshPrediction> answers = predict(frames);
+    for (MeshPrediction& p : answers) {
+      p.keypoints = ReadAnswerKeypoints(*model, p.keypoints, p.vertices, how);
+    }
+    return answers;
+  };
 }
 
 }  // namespace handlabel

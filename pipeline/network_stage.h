@@ -73,4 +73,11 @@ std::vector<MeshPrediction> PredictFramesInRig(
 NetworkStage LoadNetworkStage(const JobConfig& job,
                               std::shared_ptr<PredictionMemo> memo = nullptr);
 
+// Makes `stage` read its answers' keypoints as the job's network.keypoints says
+// (core/mesh_keypoints.h) and names the reading in stage->keypoints. The mesh readings
+// need `hand` in the network's topology (POEM: 778 vertices); with another hand model
+// (the capsule hand) the joints are read, and stage->keypoints says why.
+void ReadAnswerKeypointsAs(const JobConfig& job, const HandModel& hand,
+                           NetworkStage* stage);
+
 }  // namespace handlabel

@@ -10,6 +10,9 @@
 #include <Eigen/Geometry>
 
 #include "capture/native_frame_source.h"
+#include "core/capsule_hand.h"
+#include "core/errors.h"
+#include "core/hand_model_io.h"
 #include "core/image_file.h"
 #include "network/poem_config.h"
 #include "tests/apps/label_test_capture.h"
@@ -180,6 +183,38 @@ TEST_F(NetworkStageTest, MemoAnswersSeenInputsAndOnlyThose) {
   EXPECT_EQ(network.asked, 3);  // only the shifted frame
   PredictFramesInRig(network, {&frame_}, &memo, "w2");
   EXPECT_EQ(network.asked, 4);
+}
+
+// network.keypoints: the stage's 3D keypoints become the chosen reading of its own
+// answer; with a hand model of another topology the joints are read.
+TEST_F(NetworkStageTest, KeypointsAreReadAsTheJobSays) {
+  const HandModel hand =
+      LoadHandModel(std::string(HANDLABEL_SOURCE_DIR) + "/models/open_hand_right.npz");
+  JobConfig job = Job();
+  const MeshPrediction raw = LoadNetworkStage(job).predict({&frame_}).at(0);
+  for (AnswerKeypoints how :
+       {AnswerKeypoints::kJoints, AnswerKeypoints::kMesh, AnswerKeypoints::kMean}) {
+    job.network_keypoints = how;
+    NetworkStage stage = LoadNetworkStage(job);
+    ReadAnswerKeypointsAs(job, hand, &stage);
+    EXPECT_EQ(stage.keypoints, ToString(how));
+    const MeshPrediction p = stage.predict({&frame_}).at(0);
+    EXPECT_EQ(p.vertices, raw.vertices);
+    EXPECT_TRUE(p.keypoints.isApprox(
+        ReadAnswerKeypoints(hand, raw.keypoints, raw.vertices, how), 1e-12))
+        << ToString(how);
+  }
+  EXPECT_FALSE(
+      ReadAnswerKeypoints(hand, raw.keypoints, raw.vertices, AnswerKeypoints::kMean)
+          .isApprox(raw.keypoints, 1e-6));  // the readings differ here
+
+  // The capsule hand cannot read a 778-vertex mesh: the joints are read, and said so.
+  job.network_keypoints = AnswerKeypoints::kMean;
+  NetworkStage capsule = LoadNetworkStage(job);
+  ReadAnswerKeypointsAs(job, MakeCapsuleHand(HandSide::kRight), &capsule);
+  EXPECT_EQ(capsule.predict({&frame_}).at(0).keypoints, raw.keypoints);
+  EXPECT_NE(capsule.keypoints.find("joints (mean reads the mesh"), std::string::npos)
+      << capsule.keypoints;
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.h"
+#include "core/hand_model_io.h"
 #include "tests/core/lbs_fixture.h"
 #include "tests/test_util.h"
 
@@ -56,6 +57,71 @@ TEST(KeypointsFromMeshVertices, RejectsWrongVertexCount) {
   EXPECT_THROW(
       KeypointsFromMeshVertices(model, Points3d::Zero(model.num_vertices() - 1, 3)),
       InputError);
+}
+
+// A network's answer: a posed mesh of the shipped open hand, and "joints" that are its
+// skinned keypoints moved off by a known offset (a second, disagreeing estimate).
+struct Answer {
+  HandModel model;
+  Points3d joints, vertices;
+};
+Answer MakeAnswer() {
+  Answer a;
+  a.model =
+      LoadHandModel(std::string(HANDLABEL_SOURCE_DIR) + "/models/open_hand_right.npz");
+  HandParams params;
+  params.hand_pose.setConstant(0.15);
+  params.global_orient = Eigen::Vector3d(0.3, -0.2, 0.1);
+  params.transl = Eigen::Vector3d(0.05, -0.02, 0.6);
+  const HandMesh mesh = PoseHand(a.model, params);
+  a.vertices = mesh.vertices;
+  a.joints = mesh.keypoints;
+  a.joints.col(0).array() += 0.004;
+  return a;
+}
+
+TEST(ReadAnswerKeypoints, JointsMeshAndTheirMean) {
+  const Answer a = MakeAnswer();
+  const Points3d from_mesh = KeypointsFromMeshVertices(a.model, a.vertices);
+  EXPECT_EQ(ReadAnswerKeypoints(a.model, a.joints, a.vertices, AnswerKeypoints::kJoints),
+            a.joints);
+  EXPECT_EQ(ReadAnswerKeypoints(a.model, a.joints, a.vertices, AnswerKeypoints::kMesh),
+            from_mesh);
+  const Points3d mean =
+      ReadAnswerKeypoints(a.model, a.joints, a.vertices, AnswerKeypoints::kMean);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    // Equidistant from both readings, half their gap from each.
+    const double gap = (a.joints.row(k) - from_mesh.row(k)).norm();
+    EXPECT_NEAR((mean.row(k) - a.joints.row(k)).norm(), gap / 2, 1e-12) << k;
+    EXPECT_NEAR((mean.row(k) - from_mesh.row(k)).norm(), gap / 2, 1e-12) << k;
+  }
+}
+
+// The job reads answers in the world frame, eval-network in the master camera's: the
+// readings must commute with a rigid motion (the regressor's rows sum to one).
+TEST(ReadAnswerKeypoints, CommutesWithARigidMotion) {
+  const Answer a = MakeAnswer();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::RowVector3d t(0.4, -1.3, 2.2);
+  auto move = [&](const Points3d& p) -> Points3d {
+    return (p * R.transpose()).rowwise() + t;
+  };
+  for (AnswerKeypoints how : {AnswerKeypoints::kMesh, AnswerKeypoints::kMean}) {
+    EXPECT_THAT(
+        ReadAnswerKeypoints(a.model, move(a.joints), move(a.vertices), how),
+        MatrixNear(move(ReadAnswerKeypoints(a.model, a.joints, a.vertices, how)), 1e-9))
+        << ToString(how);
+  }
+}
+
+TEST(ReadAnswerKeypoints, NamesRoundTripAndUnknownNamesAreRefused) {
+  for (AnswerKeypoints how :
+       {AnswerKeypoints::kJoints, AnswerKeypoints::kMesh, AnswerKeypoints::kMean}) {
+    EXPECT_EQ(AnswerKeypointsNamed(ToString(how)), how);
+  }
+  EXPECT_FALSE(AnswerKeypointsNamed("median").has_value());
+  EXPECT_FALSE(AnswerKeypointsNamed("").has_value());
 }
 
 }  // namespace

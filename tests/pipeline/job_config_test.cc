@@ -49,6 +49,10 @@ TEST(JobConfig, ReadsFieldsAndResolvesPathsAgainstTheJobFolder) {
   // Default: the network's own keypoints are the only evidence -> its masks count.
   EXPECT_EQ(job.keypoints, KeypointSource::kNetwork);
   EXPECT_DOUBLE_EQ(job.network_mask_sigma_px, 2.0);
+  EXPECT_EQ(job.network_keypoints, AnswerKeypoints::kMean);  // default
+  const JobConfig joints = LoadJobConfig(WriteJob(
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w, keypoints: joints}\n"));
+  EXPECT_EQ(joints.network_keypoints, AnswerKeypoints::kJoints);
   const JobConfig with_files = LoadJobConfig(
       WriteJob(std::string(kValidJob) + "evidence: {keypoints_2d: both}\n"));
   EXPECT_DOUBLE_EQ(with_files.network_mask_sigma_px, 16.0);
@@ -92,6 +96,9 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
   ExpectError(
       "input: {path: c}\noutput: {dir: o, overlay_format: gif}\nnetwork: {weights: w}\n",
       "output.overlay_format", "jpg or png");
+  ExpectError(
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w, keypoints: tips}\n",
+      "network.keypoints", "joints | mesh | mean");
   ExpectError(base + "refine: {mode: always}\nevidence: {network_mask_sigma_px: -1}\n",
               "evidence.network_mask_sigma_px", "> 0 pixels");
 }

@@ -341,12 +341,19 @@ TEST(LabelJob, JobHashIgnoresWhereOutputsGoButNotWhatChangesLabels) {
   EXPECT_NE(JobHash(a, "w"), JobHash(a, "v"));
   b.quality.max_reprojection_px = 3;
   EXPECT_NE(JobHash(a, "w"), JobHash(b, "w"));
+  // How answers are read matters only with a network.
+  JobConfig c = a;
+  c.network_keypoints = AnswerKeypoints::kJoints;
+  EXPECT_NE(JobHash(a, "w"), JobHash(c, "w"));
+  EXPECT_EQ(JobHash(a, ""), JobHash(c, ""));
 }
 
 // The fields `handlabel fit` brought into the job change the hash only when set, so a
 // job that does not use them keeps the hash it had before they existed.
 TEST(LabelJob, JobHashCoversTheFitFieldsOnlyWhenSet) {
-  const JobConfig a = MakeJob("/tmp/a", RefineMode::kFallback);
+  JobConfig a = MakeJob("/tmp/a", RefineMode::kFallback);
+  // How answers were read before network.keypoints existed.
+  a.network_keypoints = AnswerKeypoints::kJoints;
   const std::string plain = JobHash(a, "w");
   // The hash of such a job before the fields existed (computed as JobHash did then).
   const QualityThresholds& q = a.quality;
@@ -368,7 +375,9 @@ TEST(LabelJob, JobHashCoversTheFitFieldsOnlyWhenSet) {
            [](JobConfig* j) { j->fit.joint_limits = false; },
            [](JobConfig* j) { j->keypoint_files = "keypoints"; },
            [](JobConfig* j) { j->ignore_views = {"cam1"}; },
-           [](JobConfig* j) { j->max_frames = 3; }}) {
+           [](JobConfig* j) { j->max_frames = 3; },
+           // Today's default reads answers otherwise: older labels must not resume.
+           [](JobConfig* j) { j->network_keypoints = AnswerKeypoints::kMean; }}) {
     JobConfig b = a;
     change(&b);
     EXPECT_NE(JobHash(b, "w"), plain);
