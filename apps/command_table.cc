@@ -35,8 +35,6 @@ const std::vector<Command>& AllCommands() {
        RunCapture},
       {"synth", "generate a synthetic multi-view hand capture with ground truth",
        RunSynth},
-      {"synth", "generate a synthetic multi-view hand capture with ground truth",
-       RunSynth},
       {"fit", "fit the hand model to a capture's 2D keypoints and masks (Ceres)", RunFit},
       {"train", "train the POEM network on synthetic captures (resumable)", RunTrain},
       {"eval-network", "MPJPE / MPVPE / AUC of POEM weights on held-out synthetic frames",

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,20 @@ TEST(CommandTable, HelpListsEverySubcommand) {
   ASSERT_FALSE(AllCommands().empty());
   for (const Command& c : AllCommands()) {
     EXPECT_NE(r.out.find(std::string("  ") + c.name), std::string::npos) << c.name;
+  }
+}
+
+// Each command once (a merge once listed synth twice in --help).
+TEST(CommandTable, EveryCommandIsListedOnce) {
+  const std::string out = RunHandlabelCommand({"--help"}).out;
+  std::set<std::string> names;
+  for (const Command& c : AllCommands()) {
+    EXPECT_TRUE(names.insert(c.name).second) << c.name << " twice in the table";
+    const std::string line = std::string("\n  ") + c.name + " ";
+    const size_t first = out.find(line);
+    ASSERT_NE(first, std::string::npos) << c.name;
+    EXPECT_EQ(out.find(line, first + 1), std::string::npos) << c.name << " twice in\n"
+                                                            << out;
   }
 }
 
