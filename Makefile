@@ -35,8 +35,8 @@ format:
 # suite under it (docs/reliability.md). -O1 -g1: the optimisation ASan's documentation
 # recommends and the line tables a report needs, both to keep the long build shorter.
 # SANITIZE_TARGETS limits the build (ctest then runs only what was built: not the
-# placeholders of unbuilt test binaries, nor the tests of the installed binary, MediaPipe
-# and the browser, which need every target); SANITIZE_TESTS is a ctest -R filter. The environment applies to the build too: it
+# placeholders of unbuilt test binaries, nor the tests of the installed binary, MediaPipe,
+# the browser, the docs' options and the program's link line, which need the program); SANITIZE_TESTS is a ctest -R filter. The environment applies to the build too: it
 # runs each test binary to list its tests. sanitizers/*.supp: system libraries only.
 SANITIZE_DIR ?= build-sanitize
 SANITIZE_TARGETS ?= all
@@ -46,6 +46,7 @@ SANITIZE_FLAGS = -fsanitize=address,undefined -fno-sanitize-recover=undefined \
 SANITIZE_EXCLUDE = _NOT_BUILT$$
 ifneq ($(SANITIZE_TARGETS),all)
 SANITIZE_EXCLUDE := $(SANITIZE_EXCLUDE)|^installed_binary$$|^mediapipe_parity$$|^browser_report$$
+SANITIZE_EXCLUDE := $(SANITIZE_EXCLUDE)|^doc_examples_use_real_options$$|^program_links_no_atlas$$
 endif
 SANITIZE_ENV = ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
   LSAN_OPTIONS=suppressions=$(CURDIR)/sanitizers/lsan.supp:print_suppressions=0 \
