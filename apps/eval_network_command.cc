@@ -209,7 +209,9 @@ int RunEvalNetwork(int argc, char** argv) {
                  "how the answer's keypoints are read, as a job's network.keypoints: "
                  "joints (the network's joint outputs), mesh (read off its mesh), mean "
                  "(of the two)")
-      ->check(CLI::IsMember({"joints", "mesh", "mean"}))
+      ->check([](const std::string& name) {
+        return AnswerKeypointsNamed(name) ? "" : "expected " + AnswerKeypointsChoices();
+      })
       ->capture_default_str();
   app.add_option("--pck-png", f.pck_png, "write the PCK curves to this PNG");
   app.add_option(
@@ -226,7 +228,7 @@ int RunEvalNetwork(int argc, char** argv) {
       ->capture_default_str();
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("eval-network", [&] {
-    o.keypoints = *AnswerKeypointsNamed(f.keypoints);  // IsMember checked it
+    o.keypoints = *AnswerKeypointsNamed(f.keypoints);  // the check above passed
     if (f.capture.empty()) {
       for (const char* flag : {"--max-frames", "--out", "--json", "--auc-max-mm"}) {
         if (app.count(flag) > 0) {

@@ -48,12 +48,23 @@ std::string ToString(AnswerKeypoints how) {
   return "?";
 }
 
+namespace {
+constexpr AnswerKeypoints kAllReadings[] = {
+    AnswerKeypoints::kJoints, AnswerKeypoints::kMesh, AnswerKeypoints::kMean};
+}  // namespace
+
 std::optional<AnswerKeypoints> AnswerKeypointsNamed(const std::string& name) {
-  for (AnswerKeypoints how :
-       {AnswerKeypoints::kJoints, AnswerKeypoints::kMesh, AnswerKeypoints::kMean}) {
+  for (AnswerKeypoints how : kAllReadings) {
     if (ToString(how) == name) return how;
   }
   return std::nullopt;
+}
+
+std::string AnswerKeypointsChoices() {
+  std::string out;
+  for (AnswerKeypoints how : kAllReadings)
+    out += (out.empty() ? "" : " | ") + ToString(how);
+  return out;
 }
 
 }  // namespace handlabel

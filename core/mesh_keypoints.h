@@ -33,5 +33,6 @@ Points3d ReadAnswerKeypoints(const HandModel& model, const Points3d& joints,
 
 std::string ToString(AnswerKeypoints how);  // "joints" | "mesh" | "mean"
 std::optional<AnswerKeypoints> AnswerKeypointsNamed(const std::string& name);
+std::string AnswerKeypointsChoices();  // "joints | mesh | mean", for messages
 
 }  // namespace handlabel

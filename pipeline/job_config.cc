@@ -320,7 +320,7 @@ JobConfig LoadJobConfig(const std::string& path) {
   network.Read("keypoints", &network_keypoints);
   const std::optional<AnswerKeypoints> how = AnswerKeypointsNamed(network_keypoints);
   if (!how) {
-    throw InputError(path, network.Name("keypoints"), "joints | mesh | mean",
+    throw InputError(path, network.Name("keypoints"), AnswerKeypointsChoices(),
                      "'" + network_keypoints + "'");
   }
   job.network_keypoints = *how;

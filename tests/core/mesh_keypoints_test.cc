@@ -120,6 +120,7 @@ TEST(ReadAnswerKeypoints, NamesRoundTripAndUnknownNamesAreRefused) {
        {AnswerKeypoints::kJoints, AnswerKeypoints::kMesh, AnswerKeypoints::kMean}) {
     EXPECT_EQ(AnswerKeypointsNamed(ToString(how)), how);
   }
+  EXPECT_EQ(AnswerKeypointsChoices(), "joints | mesh | mean");
   EXPECT_FALSE(AnswerKeypointsNamed("median").has_value());
   EXPECT_FALSE(AnswerKeypointsNamed("").has_value());
 }
