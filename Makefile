@@ -36,7 +36,8 @@ format:
 # recommends and the line tables a report needs, both to keep the long build shorter.
 # SANITIZE_TARGETS limits the build (ctest then runs only what was built: not the
 # placeholders of unbuilt test binaries, nor the tests of the installed binary, MediaPipe,
-# the browser, the docs' options and the program's link line, which need the program); SANITIZE_TESTS is a ctest -R filter. The environment applies to the build too: it
+# the browser, the docs' options and the program's link line, which need the program).
+# SANITIZE_TESTS is a ctest -R filter. The environment applies to the build too: it
 # runs each test binary to list its tests. sanitizers/*.supp: system libraries only.
 SANITIZE_DIR ?= build-sanitize
 SANITIZE_TARGETS ?= all
