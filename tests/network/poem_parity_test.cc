@@ -89,8 +89,16 @@ std::string ExpectParity(const PoemConfig& config, int batch, int seed) {
     EXPECT_EQ(out.points_inside_ball[i], ref.at("points_inside_ball")[i].item<int64_t>());
   }
   EXPECT_LT(MaxAbsDiff(out.sampled_points, ref.at("sampled_points")), 1e-6);
+  // A decoder point's neighbours are a k-nearest choice: where two distances differ by
+  // a rounding error, the folded norms or another CPU's kernels can pick the other one
+  // and move that point (and, a layer later, its neighbours) by a few 1e-4. On a Zen 3
+  // machine 1 point of 1598 did in layer 0 and 12 in layer 1. A wrong weight or order
+  // moves them all, so: nearly every coordinate to 1e-5, none beyond 1e-3.
   for (int64_t l = 0; l < out.layer_coords.size(0); ++l) {
-    EXPECT_LT(MaxAbsDiff(out.layer_coords[l], ref.at("layer_coords")[l]), 1e-4)
+    const torch::Tensor diff = (out.layer_coords[l] - ref.at("layer_coords")[l]).abs();
+    const double far_share = (diff > 1e-5).to(torch::kFloat64).mean().item<double>();
+    EXPECT_LT(far_share, 0.02) << "decoder layer " << l;
+    EXPECT_LT(MaxAbsDiff(out.layer_coords[l], ref.at("layer_coords")[l]), 1e-3)
         << "decoder layer " << l;
   }
 
