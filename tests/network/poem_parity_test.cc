@@ -92,7 +92,7 @@ std::string ExpectParity(const PoemConfig& config, int batch, int seed) {
   // A decoder point's neighbours are a k-nearest choice: where two distances differ by
   // a rounding error, the folded norms or another CPU's kernels can pick the other one
   // and move that point (and, a layer later, its neighbours) by a few 1e-4. On a Zen 3
-  // machine 1 point of 1598 did in layer 0 and 12 in layer 1. A wrong weight or order
+  // machine 3 of 4794 coordinates did in layer 0, 35 in layer 1. A wrong weight or order
   // moves them all, so: nearly every coordinate to 1e-5, none beyond 1e-3.
   for (int64_t l = 0; l < out.layer_coords.size(0); ++l) {
     const torch::Tensor diff = (out.layer_coords[l] - ref.at("layer_coords")[l]).abs();
