@@ -1,6 +1,6 @@
 // The shipped models/open_hand_{right,left}.npz: loadable, plausible, mirror pair,
 // and equal to what the builder's defaults produce (checked on the arrays' key
-// properties here; the byte-for-byte rebuild is `scripts/check-open-hand`).
+// properties here; the full rebuild within 1e-9 is `scripts/check-open-hand`).
 #include <gtest/gtest.h>
 
 #include "core/hand_model_io.h"
