@@ -10,9 +10,9 @@
 #include "calib/board_images.h"
 #include "calib/board_scale.h"
 #include "calib/colmap_sfm.h"
-#include "calib/rig_io.h"
 #include "calib/rig_plot.h"
 #include "calib/synthetic_board_capture.h"
+#include "cameras/rig_io.h"
 #include "core/errors.h"
 
 namespace handlabel {

@@ -3,9 +3,9 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
-#include "calib/rig_compare.h"
-#include "calib/rig_io.h"
 #include "calib/rig_plot.h"
+#include "cameras/rig_compare.h"
+#include "cameras/rig_io.h"
 
 namespace handlabel {
 namespace {

@@ -2,7 +2,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
-#include "core/sha256.h"
+#include "formats/sha256.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"

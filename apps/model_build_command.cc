@@ -8,9 +8,9 @@
 #include "apps/cli_util.h"
 #include "apps/commands.h"
 #include "core/errors.h"
-#include "core/hand_model_io.h"
-#include "core/hand_preview.h"
-#include "core/image.h"
+#include "hand/hand_model_io.h"
+#include "hand/hand_preview.h"
+#include "image/image.h"
 #include "openhand/builder.h"
 #include "openhand/mesh_checks.h"
 

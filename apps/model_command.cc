@@ -14,8 +14,8 @@
 #include "apps/commands.h"
 #include "apps/model_file_flags.h"
 #include "core/errors.h"
-#include "core/hand_lbs.h"
-#include "core/hand_model_io.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_model_io.h"
 #include "openhand/builder.h"
 
 namespace handlabel {

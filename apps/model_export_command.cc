@@ -10,9 +10,9 @@
 #include "apps/model_file_flags.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
-#include "core/hand_lbs.h"
-#include "core/hand_model_io.h"
-#include "core/hand_preview.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_model_io.h"
+#include "hand/hand_preview.h"
 #include "pipeline/label_record.h"
 
 namespace handlabel {

@@ -1,6 +1,6 @@
 #pragma once
 // Flags shared by the `model` subcommands that load a model file: the side and the
-// fingertips for files that do not record them (core/hand_model_io.h).
+// fingertips for files that do not record them (hand/hand_model_io.h).
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/hand_model_io.h"
+#include "hand/hand_model_io.h"
 
 namespace handlabel {
 

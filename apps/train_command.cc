@@ -9,10 +9,10 @@
 #include "apps/cli_util.h"
 #include "apps/commands.h"
 #include "core/errors.h"
-#include "network/loss_plot.h"
-#include "network/poem_trainer.h"
 #include "pipeline/train_config.h"
 #include "pipeline/training_samples.h"
+#include "poem/loss_plot.h"
+#include "poem/poem_trainer.h"
 
 namespace handlabel {
 

@@ -14,10 +14,10 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/dual.h"
-#include "core/hand_anatomy.h"
-#include "core/hand_evaluator.h"
-#include "core/hand_lbs.h"
+#include "geometry/dual.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_evaluator.h"
+#include "hand/hand_lbs.h"
 
 namespace handlabel {
 namespace {

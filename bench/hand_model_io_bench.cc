@@ -11,9 +11,9 @@
 #include <fstream>
 #include <string>
 
-#include "core/hand_model_io.h"
-#include "core/pickle_reader.h"
-#include "tests/core/mano_sized_model.h"
+#include "formats/pickle_reader.h"
+#include "hand/hand_model_io.h"
+#include "tests/hand/mano_sized_model.h"
 
 namespace handlabel {
 namespace {

@@ -8,7 +8,7 @@
 #include <filesystem>
 
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
+#include "hand/capsule_hand.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_stage_factory.h"
 

@@ -27,13 +27,13 @@
 #include <map>
 #include <random>
 
-#include "core/rigid3.h"
-#include "network/hand_mesh_predictor.h"
-#include "network/poem_batch.h"
-#include "network/poem_checkpoint.h"
-#include "network/poem_model.h"
-#include "network/poem_modules.h"
+#include "geometry/rigid3.h"
 #include "pipeline/build_config.h"
+#include "poem/hand_mesh_predictor.h"
+#include "poem/poem_batch.h"
+#include "poem/poem_checkpoint.h"
+#include "poem/poem_model.h"
+#include "poem/poem_modules.h"
 
 namespace handlabel {
 namespace {

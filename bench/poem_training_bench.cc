@@ -5,11 +5,11 @@
 #include <benchmark/benchmark.h>
 #include <torch/torch.h>
 
-#include "core/capsule_hand.h"
-#include "network/poem_loss.h"
-#include "network/poem_training_batch.h"
+#include "hand/capsule_hand.h"
 #include "openhand/builder.h"
 #include "pipeline/training_samples.h"
+#include "poem/poem_loss.h"
+#include "poem/poem_training_batch.h"
 
 namespace handlabel {
 namespace {

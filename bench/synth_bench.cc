@@ -15,8 +15,8 @@
 #include <benchmark/benchmark.h>
 
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
-#include "core/image.h"
+#include "hand/capsule_hand.h"
+#include "image/image.h"
 #include "pipeline/hand_model_source.h"
 
 namespace handlabel {

@@ -18,7 +18,7 @@
 
 #include "calib/board_detect.h"
 #include "calib/board_spec.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
 
 namespace handlabel {
 

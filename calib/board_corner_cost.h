@@ -11,7 +11,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "core/camera_models.h"
+#include "geometry/camera_models.h"
 
 namespace handlabel {
 

@@ -9,8 +9,8 @@
 
 #include "calib/board_spec.h"
 #include "calib/gray_image.h"
-#include "core/camera.h"
-#include "core/rigid3.h"
+#include "geometry/camera.h"
+#include "geometry/rigid3.h"
 
 namespace handlabel {
 

@@ -6,7 +6,7 @@
 #include <map>
 
 #include "core/errors.h"
-#include "core/triangulation.h"
+#include "geometry/triangulation.h"
 
 namespace handlabel {
 namespace {

@@ -10,8 +10,8 @@
 
 #include "calib/board_calib.h"
 #include "calib/board_spec.h"
-#include "core/rig.h"
-#include "core/rigid3.h"
+#include "geometry/rig.h"
+#include "geometry/rigid3.h"
 
 namespace handlabel {
 

@@ -14,8 +14,8 @@
 #include <iosfwd>
 #include <string>
 
-#include "calib/colmap_model.h"
-#include "core/rig.h"
+#include "cameras/colmap_model.h"
+#include "geometry/rig.h"
 
 namespace handlabel {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "core/rig.h"
+#include "geometry/rig.h"
 
 namespace handlabel {
 

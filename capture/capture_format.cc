@@ -4,6 +4,7 @@
 
 #include "core/errors.h"
 #include "core/json_util.h"
+#include "hand/hand_params_json.h"
 
 namespace handlabel {
 namespace {

@@ -5,7 +5,7 @@
 // path pattern with {camera} and {frame} placeholders (relative to the folder):
 //
 //   capture.json                          manifest (this file's CaptureManifest)
-//   rig.json                              cameras, own JSON (calib/rig_json.h)
+//   rig.json                              cameras, own JSON (cameras/rig_json.h)
 //   colmap/{cameras,images,points3D}.txt  the same rig as a COLMAP text model
 //   images/{camera}/{frame}.png           RGB
 //   masks/{camera}/{frame}.png            hand mask, 0/255 (visible hand pixels)
@@ -26,10 +26,10 @@
 #include <string>
 #include <vector>
 
-#include "core/hand_lbs.h"
-#include "core/hand_model.h"
-#include "core/keypoints2d.h"
-#include "core/rigid3.h"
+#include "geometry/rigid3.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_model.h"
+#include "hand/keypoints2d.h"
 
 namespace handlabel {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "capture/capture_import_sources.h"
-#include "core/image.h"
+#include "image/image.h"
 
 namespace handlabel {
 

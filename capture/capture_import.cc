@@ -7,7 +7,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "calib/rig_json.h"
+#include "cameras/rig_json.h"
 #include "capture/capture_frame_readers.h"
 #include "capture/capture_import_sources.h"
 #include "capture/capture_manifest_file.h"

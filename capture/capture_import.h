@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "calib/rig_io.h"
-#include "core/image.h"
-#include "core/rig.h"
+#include "cameras/rig_io.h"
+#include "geometry/rig.h"
+#include "image/image.h"
 
 namespace handlabel {
 
@@ -40,7 +40,7 @@ struct CaptureInitOptions {
   void Check() const;
 };
 
-// The rig named by `text`: FORMAT:PATH (calib/rig_io.h), or a bare path: a `.json` rig
+// The rig named by `text`: FORMAT:PATH (cameras/rig_io.h), or a bare path: a `.json` rig
 // file, a folder holding `rig.json` (what `calib board` / `calib colmap` write), or a
 // COLMAP model folder (cameras.txt or cameras.bin). Throws InputError naming `flag`.
 RigSpec ResolveRigSpec(const std::string& text, const std::string& flag);

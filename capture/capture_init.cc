@@ -1,9 +1,9 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "calib/colmap_model.h"
-#include "calib/colmap_rig.h"
-#include "calib/rig_json.h"
+#include "cameras/colmap_model.h"
+#include "cameras/colmap_rig.h"
+#include "cameras/rig_json.h"
 #include "capture/capture_import.h"
 #include "capture/capture_manifest_file.h"
 #include "core/errors.h"

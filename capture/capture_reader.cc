@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "calib/rig_json.h"
+#include "cameras/rig_json.h"
 #include "core/errors.h"
 #include "core/json_util.h"
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "capture/capture_format.h"
-#include "core/image.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
+#include "image/image.h"
 
 namespace handlabel {
 

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/draw.h"
 #include "core/errors.h"
-#include "core/hand_skeleton.h"
-#include "core/mask_outline.h"
-#include "core/mesh_render.h"
+#include "hand/hand_skeleton.h"
+#include "image/draw.h"
+#include "image/mask_outline.h"
+#include "image/mesh_render.h"
 
 namespace handlabel {
 namespace {

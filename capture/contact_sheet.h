@@ -5,7 +5,7 @@
 // person can check a capture at a glance.
 
 #include "capture/capture_reader.h"
-#include "core/image.h"
+#include "image/image.h"
 
 namespace handlabel {
 

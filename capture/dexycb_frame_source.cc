@@ -7,9 +7,9 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "calib/dataset_calib.h"
+#include "cameras/dataset_calib.h"
 #include "core/errors.h"
-#include "core/npz.h"
+#include "formats/npz.h"
 
 namespace handlabel {
 namespace {

@@ -7,7 +7,7 @@
 //               must show the same hand: one job fits one hand model)
 //   meta.yml    serials (the cameras, in this order), num_frames, mano_sides, extrinsics
 //   images      <sequence>/<serial>/color_%06d.jpg
-//   cameras     <root>/calibration (calib/dataset_calib.h: intrinsics per serial,
+//   cameras     <root>/calibration (cameras/dataset_calib.h: intrinsics per serial,
 //               extrinsics_<id>; world = DexYCB's common frame), or cameras.file
 //               matched by serial
 //   2D keypoints  <serial>/labels_%06d.npz joint_2d [1,21,2] (SNAP order, pixels; all
@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "capture/frame_source.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
 
 namespace handlabel {
 

@@ -1,6 +1,6 @@
 #include "capture/frame_images.h"
 
-#include "core/view_image.h"
+#include "image/view_image.h"
 
 namespace handlabel {
 

@@ -7,7 +7,7 @@
 #include <cstddef>
 
 #include "capture/frame_source.h"
-#include "core/image.h"
+#include "image/image.h"
 
 namespace handlabel {
 

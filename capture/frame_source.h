@@ -4,18 +4,18 @@
 // frames only through FrameSource.
 //
 // Every point is in the rig's world frame (metres); 2D keypoints are distorted pixels
-// in the full image. Keypoints are in the 21-point SNAP order (core/hand_model.h).
+// in the full image. Keypoints are in the 21-point SNAP order (hand/hand_model.h).
 
 #include <Eigen/Core>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "core/hand_lbs.h"
-#include "core/image.h"
-#include "core/keypoints2d.h"
-#include "core/mask_image.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
+#include "hand/hand_lbs.h"
+#include "hand/keypoints2d.h"
+#include "image/image.h"
+#include "image/mask_image.h"
 
 namespace handlabel {
 

@@ -4,11 +4,11 @@
 #include <filesystem>
 #include <set>
 
-#include "calib/dataset_calib.h"
+#include "cameras/dataset_calib.h"
 #include "core/errors.h"
-#include "core/hand_model.h"
-#include "core/image_file.h"
-#include "core/pickle_reader.h"
+#include "formats/pickle_reader.h"
+#include "hand/hand_model.h"
+#include "image/image_file.h"
 
 namespace handlabel {
 namespace {
@@ -71,7 +71,7 @@ std::string SegmentationFile(const std::string& camera_dir, const std::string& f
 
 // HO3D's segmentation picture, as its scripts read it with OpenCV (BGR): channel 0
 // (blue) is the hand, channel 1 (green) the object; a pixel counts above 127 (the
-// mask rule of core/mask_image.h; JPEG-compressed segmentations are not exactly 0/255).
+// mask rule of image/mask_image.h; JPEG-compressed segmentations are not exactly 0/255).
 // Resampled (nearest pixel) to the camera's size when it differs.
 void ReadHo3dSegmentation(const std::string& file, const Camera& camera, MaskImage* hand,
                           MaskImage* object) {

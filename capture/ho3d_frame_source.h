@@ -5,7 +5,7 @@
 //               not exist): one multi-camera sequence, frame ids = HO3D's (0000, ...);
 //               or <root>/<split>: every sequence of <root>/calibration with camera
 //               folders in that split, ids <SEQ>/<fid>
-//   cameras     <root>/calibration/<SEQ>/calibration (calib/dataset_calib.h): cameras
+//   cameras     <root>/calibration/<SEQ>/calibration (cameras/dataset_calib.h): cameras
 //               <SEQ><i> for i in cam_orders.txt, world = the sequence's common frame;
 //               or cameras.file matched by name
 //   images      <root>/<split>/<SEQ><i>/rgb/<fid>.jpg (or .png): frame <fid> of every
@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "capture/frame_source.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
 
 namespace handlabel {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "calib/rig_io.h"
+#include "cameras/rig_io.h"
 #include "core/errors.h"
 
 namespace handlabel {

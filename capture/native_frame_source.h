@@ -14,7 +14,7 @@
 
 #include "capture/capture_reader.h"
 #include "capture/frame_source.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
 
 namespace handlabel {
 
@@ -42,7 +42,7 @@ class NativeFrameSource : public FrameSource {
 };
 
 // A rig file for cameras.file: a folder is a COLMAP model, anything else the project's
-// JSON rig file (calib/rig_io.h).
+// JSON rig file (cameras/rig_io.h).
 Rig ReadCamerasFile(const std::string& path, const std::string& job_file);
 
 }  // namespace handlabel

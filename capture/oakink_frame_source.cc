@@ -2,9 +2,9 @@
 
 #include <filesystem>
 
-#include "calib/dataset_calib.h"
+#include "cameras/dataset_calib.h"
 #include "core/errors.h"
-#include "core/pickle_reader.h"
+#include "formats/pickle_reader.h"
 
 namespace handlabel {
 namespace {

@@ -5,7 +5,7 @@
 //               image/
 //   frames      every <seq>__<ts>__<sbj>__<frame> group of anno/general_info/*.pkl
 //               (one pickle per camera: <group>__<cam>.pkl); the frame id is the group
-//   cameras     per frame from its pickles' cam_intr / cam_extr (calib/dataset_calib.h,
+//   cameras     per frame from its pickles' cam_intr / cam_extr (cameras/dataset_calib.h,
 //               PINHOLE 848x480, world = OakInk's world), named <cam>, sorted by name;
 //               or cameras.file matched by name
 //   images      stream_release_v2/<seq>/<ts>/<stream>_<frame>.png, where <stream> is
@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "capture/frame_source.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
 
 namespace handlabel {
 

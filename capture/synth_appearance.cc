@@ -53,8 +53,7 @@ class ValueNoise3 {
 // Ambient occlusion per vertex from the mesh itself: the share of nearby vertices that
 // lie in front of the vertex (inside its normal's cone), weighted by closeness. Cheap
 // (V^2 on a ~800-vertex hand) and enough to darken creases between fingers.
-std::vector<float> VertexOcclusion(const MeshVertices& v, const MeshVertices& n,
-                                   double radius) {
+std::vector<float> VertexOcclusion(const Points3d& v, const Points3d& n, double radius) {
   std::vector<float> occ(v.rows(), 0.0f);
   for (Eigen::Index i = 0; i < v.rows(); ++i) {
     double sum = 0;
@@ -75,8 +74,7 @@ void ReskinHand(const HandModel& model, std::mt19937_64& rng, SynthScene* scene)
   RenderMesh& hand = scene->hand_render;
   const Eigen::Vector3f tone = scene->skin;
   // Palm side from the flat template (palm faces -y there, as synth_scene.cc assumes).
-  const MeshVertices template_normals =
-      ComputeVertexNormals(model.v_template, model.faces);
+  const Points3d template_normals = ComputeVertexNormals(model.v_template, model.faces);
   const Eigen::Vector3f palm_tone = (tone.array() * Eigen::Array3f(1.12f, 1.02f, 1.0f) +
                                      Eigen::Array3f(0.04f, 0.0f, 0.0f))
                                         .min(1.0f)
@@ -212,7 +210,7 @@ std::shared_ptr<const ImageU8> MakeTableTexture(const SynthScene& scene, double 
   // Shadow: everything above the table projected along the light onto it, splatted
   // into a coarse density grid and blurred (soft edges).
   std::vector<float> shadow(kSize * kSize, 0.0f);
-  auto splat = [&](const MeshVertices& vertices) {
+  auto splat = [&](const Points3d& vertices) {
     for (Eigen::Index i = 0; i < vertices.rows(); ++i) {
       const Eigen::Vector3d p = vertices.row(i).transpose();
       if (p.z() <= height || light_travel.z() >= -1e-3) continue;
@@ -269,7 +267,7 @@ std::shared_ptr<const ImageU8> MakeTableTexture(const SynthScene& scene, double 
 }
 
 // A square table top at world z = height, extent metres wide, centred under the origin,
-// tessellated finely enough for the rasteriser (core/rasterizer.h).
+// tessellated finely enough for the rasteriser (image/rasterizer.h).
 RenderMesh MakeTable(double extent, double height) {
   constexpr int kCells = 80;
   RenderMesh table;
@@ -293,7 +291,7 @@ RenderMesh MakeTable(double extent, double height) {
       table.faces.row(f++) << p, p + kCells + 2, p + kCells + 1;
     }
   }
-  table.normals = MeshVertices::Zero(table.vertices.rows(), 3);
+  table.normals = Points3d::Zero(table.vertices.rows(), 3);
   table.normals.col(2).setOnes();
   table.color = Eigen::Vector3f::Ones();
   return table;

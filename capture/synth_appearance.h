@@ -23,8 +23,8 @@
 #include <string>
 
 #include "capture/synth_scene.h"
-#include "core/hand_model.h"
-#include "core/image.h"
+#include "hand/hand_model.h"
+#include "image/image.h"
 
 namespace handlabel {
 

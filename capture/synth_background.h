@@ -5,7 +5,7 @@
 
 #include <random>
 
-#include "core/image.h"
+#include "image/image.h"
 
 namespace handlabel {
 

@@ -9,9 +9,9 @@
 #include <fstream>
 #include <mutex>
 
-#include "calib/colmap_model.h"
-#include "calib/colmap_rig.h"
-#include "calib/rig_json.h"
+#include "cameras/colmap_model.h"
+#include "cameras/colmap_rig.h"
+#include "cameras/rig_json.h"
 #include "capture/capture_format.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"

@@ -19,11 +19,11 @@
 #include "capture/synth_detections.h"
 #include "capture/synth_scene.h"
 #include "capture/synth_view.h"
-#include "core/hand_anatomy.h"
-#include "core/hand_model.h"
-#include "core/image.h"
-#include "core/rasterizer.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_model.h"
+#include "image/image.h"
+#include "image/rasterizer.h"
 
 namespace handlabel {
 

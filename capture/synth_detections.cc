@@ -4,9 +4,9 @@
 #include <cmath>
 #include <vector>
 
-#include "core/distance_transform.h"
 #include "core/errors.h"
-#include "core/mask_image.h"
+#include "image/distance_transform.h"
+#include "image/mask_image.h"
 
 namespace handlabel {
 namespace {

@@ -25,8 +25,8 @@
 #include <random>
 
 #include "capture/synth_view.h"
-#include "core/image.h"
-#include "core/keypoints2d.h"
+#include "hand/keypoints2d.h"
+#include "image/image.h"
 
 namespace handlabel {
 

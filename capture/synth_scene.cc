@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "core/errors.h"
-#include "core/mesh_primitives.h"
+#include "image/mesh_primitives.h"
 
 namespace handlabel {
 namespace {
@@ -176,7 +176,8 @@ void SynthSceneOptions::Check() const {
     throw InputError(src, "betas_sigma", "0..5", std::to_string(betas_sigma));
   }
   if (!(object_probability >= 0 && object_probability <= 1)) {
-    throw InputError(src, "object_probability", "0..1", std::to_string(object_probability));
+    throw InputError(src, "object_probability", "0..1",
+                     std::to_string(object_probability));
   }
   if (max_objects < 1 || max_objects > 8) {
     throw InputError(src, "max_objects", "1..8", std::to_string(max_objects));
@@ -327,8 +328,8 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
   scene.cameras_seeing_hand = PlaceHand(model, rig, o, rng, &scene.params);
   scene.hand = PoseHand(model, scene.params);
   SampleAppearance(model, rng, &scene);
-  const bool with_objects =
-      o.objects && (o.object_probability >= 1.0 || Uniform(rng, 0, 1) < o.object_probability);
+  const bool with_objects = o.objects && (o.object_probability >= 1.0 ||
+                                          Uniform(rng, 0, 1) < o.object_probability);
   if (with_objects) AddObjects(o, rng, &scene);
   return scene;
 }

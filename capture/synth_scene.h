@@ -4,7 +4,7 @@
 // hand, placed in a rig's world frame where most cameras see the hand.
 //
 // Pose kinds: the sampler's archetypes (open, fist, pinch, point, random within
-// limits; core/hand_pose_sampler.h), plus "grasp" (a partial fist, t in [0.3, 0.75] of
+// limits; hand/hand_pose_sampler.h), plus "grasp" (a partial fist, t in [0.3, 0.75] of
 // the fist angles, as when holding an object) and "pca" (Gaussian coefficients on the
 // model's pose PCA basis, clamped to the limits). Every pose is clamped to the limits.
 
@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
-#include "core/hand_anatomy.h"
-#include "core/hand_lbs.h"
-#include "core/hand_model.h"
-#include "core/hand_pose_sampler.h"
-#include "core/rasterizer.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_model.h"
+#include "hand/hand_pose_sampler.h"
+#include "image/rasterizer.h"
 
 namespace handlabel {
 

@@ -26,9 +26,9 @@
 #include "capture/synth_appearance.h"
 #include "capture/synth_background.h"
 #include "capture/synth_scene.h"
-#include "core/image.h"
-#include "core/rasterizer.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
+#include "image/image.h"
+#include "image/rasterizer.h"
 
 namespace handlabel {
 

@@ -1,8 +1,5 @@
 #include "core/core_versions.h"
 
-#include <png.h>
-#include <zlib.h>
-
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
@@ -16,8 +13,6 @@ VersionList CoreLibraryVersions() {
       {"nlohmann_json", std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." +
                             std::to_string(NLOHMANN_JSON_VERSION_MINOR) + "." +
                             std::to_string(NLOHMANN_JSON_VERSION_PATCH)},
-      {"zlib", zlibVersion()},
-      {"libpng", png_get_libpng_ver(nullptr)},
   };
 }
 

@@ -22,13 +22,6 @@ json JsonPoints(const Points3d& points) {
   return out;
 }
 
-json JsonHandParams(const HandParams& params) {
-  return {{"global_orient", JsonArray(params.global_orient)},
-          {"hand_pose", JsonArray(params.hand_pose)},
-          {"betas", JsonArray(params.betas)},
-          {"transl", JsonArray(params.transl)}};
-}
-
 json ParseJsonStrict(const std::string& text, const std::string& source) {
   // The keys seen in each open object, innermost last.
   std::vector<std::set<std::string>> open_objects;
@@ -132,35 +125,6 @@ Points3d JsonPointList(const json& value, const std::string& source,
     for (int c = 0; c < 3; ++c) p(i, c) = JsonNumber(value[i][c], source, at, nulls);
   }
   return p;
-}
-
-HandParams HandParamsFromJson(const json& object, const std::string& source,
-                              const std::string& where, JsonNull nulls) {
-  auto vector = [&](const char* key, int size) {
-    return JsonVector(JsonMember(object, key, source, where), source, where + key, size,
-                      nulls);
-  };
-  // Plausible magnitudes: a typo such as 1e300 would otherwise reach the fitter and
-  // come back as a label of NaNs. NaN (null with kAsNan) is left to the caller.
-  const auto bounded = [&](const char* key, int size, double limit, const char* unit) {
-    const Eigen::VectorXd v = vector(key, size);
-    for (Eigen::Index i = 0; i < v.size(); ++i) {
-      if (std::abs(v[i]) > limit) {
-        std::ostringstream got;
-        got << v[i];
-        throw InputError(
-            source, where + key + "[" + std::to_string(i) + "]",
-            "a value within +-" + JsonNumberOrNull(limit).dump() + " " + unit, got.str());
-      }
-    }
-    return v;
-  };
-  HandParams params;
-  params.global_orient = bounded("global_orient", 3, kMaxAxisAngle, "rad");
-  params.hand_pose = bounded("hand_pose", kNumPoseParams, kMaxAxisAngle, "rad");
-  params.betas = bounded("betas", -1, kMaxBeta, "(shape coefficient)");
-  params.transl = bounded("transl", 3, kMaxTranslationM, "m");
-  return params;
 }
 
 }  // namespace handlabel

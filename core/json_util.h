@@ -1,5 +1,5 @@
 #pragma once
-// JSON forms of the project's arrays (numbers, vectors, point lists, hand parameters)
+// JSON forms of the project's arrays (numbers, vectors, point lists)
 // and checked readers for them, shared by every file format (capture manifests and
 // records, labels, fit outputs). Writers give the same bytes whoever calls them;
 // readers throw InputError naming the source (file), the field and what was expected.
@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "core/hand_lbs.h"
+#include "core/point_arrays.h"
 
 namespace handlabel {
 
@@ -31,9 +31,6 @@ nlohmann::json JsonArray(const Eigen::DenseBase<Derived>& v) {
 
 // [[x, y, z], ...], one entry per row.
 nlohmann::json JsonPoints(const Points3d& points);
-
-// {"betas": [...], "global_orient": [3], "hand_pose": [45], "transl": [3]}.
-nlohmann::json JsonHandParams(const HandParams& params);
 
 // Parses JSON text strictly: a syntax error, or a key given twice in one object
 // (nlohmann would silently keep the last), throws InputError naming `source`.
@@ -70,18 +67,5 @@ Eigen::VectorXd JsonVector(const nlohmann::json& value, const std::string& sourc
 Points3d JsonPointList(const nlohmann::json& value, const std::string& source,
                        const std::string& field, Eigen::Index rows,
                        JsonNull nulls = JsonNull::kReject);
-
-// Largest magnitudes HandParamsFromJson accepts: far beyond any hand, so only typos
-// and overflowed numbers are refused.
-inline constexpr double kMaxAxisAngle = 100.0;   // rad, per component
-inline constexpr double kMaxBeta = 100.0;        // shape coefficients (MANO: +-5)
-inline constexpr double kMaxTranslationM = 1e4;  // metres
-
-// The four parameter arrays of JsonHandParams from `object` (global_orient 3,
-// hand_pose 45, betas any count, transl 3), each within the limits above; fields are
-// named where + key.
-HandParams HandParamsFromJson(const nlohmann::json& object, const std::string& source,
-                              const std::string& where = "",
-                              JsonNull nulls = JsonNull::kReject);
 
 }  // namespace handlabel

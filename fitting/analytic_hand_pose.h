@@ -7,12 +7,12 @@
 
 #include <Eigen/Core>
 
-#include "core/hand_lbs.h"
-#include "core/hand_model.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_model.h"
 
 namespace handlabel {
 
-// `rest_keypoints` and `target_keypoints`: 21 x 3, SNAP order (core/hand_model.h); the
+// `rest_keypoints` and `target_keypoints`: 21 x 3, SNAP order (hand/hand_model.h); the
 // rest hand unposed at the origin, the targets in the frame where the wrist has the
 // rotation `root_rotation`. Keypoints with weight <= 0 are unknown: a joint whose bone
 // ends are not both known keeps a zero rotation. Writes the 45 axis-angle values of

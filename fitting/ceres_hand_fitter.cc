@@ -11,7 +11,6 @@
 #include <limits>
 
 #include "core/errors.h"
-#include "core/triangulation.h"
 #include "fitting/analytic_hand_pose.h"
 #include "fitting/joint_limit_cost.h"
 #include "fitting/keypoint_reprojection_cost.h"
@@ -21,6 +20,7 @@
 #include "fitting/silhouette_outline.h"
 #include "fitting/silhouette_render.h"
 #include "fitting/stage_problem.h"
+#include "geometry/triangulation.h"
 
 namespace handlabel {
 namespace {
@@ -457,7 +457,7 @@ class FitRun {
       // outwards and inflate the hand.
       Points3d all(evaluator_.num_vertices(), 3);
       evaluator_.AllVertices(b.orient, b.pose.data(), b.betas, b.transl, all.data());
-      const MeshVertices normals = ComputeVertexNormals(all, model_.faces);
+      const Points3d normals = ComputeVertexNormals(all, model_.faces);
       for (size_t v = 0; v < sil_views.size(); ++v) {
         const Eigen::Vector3d centre = sil_views[v].camera.CenterInWorld();
         std::vector<Eigen::Vector2d> uv(vertex_ids.size());

@@ -20,16 +20,16 @@
 #include <string>
 #include <vector>
 
-#include "core/distance_transform.h"
-#include "core/hand_anatomy.h"
-#include "core/hand_evaluator.h"
-#include "core/hand_lbs.h"
-#include "core/hand_model.h"
-#include "core/rasterizer.h"
 #include "fitting/keypoint_view.h"
 #include "fitting/points3d_targets.h"
 #include "fitting/robust_loss.h"
 #include "fitting/silhouette_outline.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_evaluator.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_model.h"
+#include "image/distance_transform.h"
+#include "image/rasterizer.h"
 
 namespace handlabel {
 
@@ -193,7 +193,7 @@ class CeresHandFitter {
   HandParams InitFromKeypoints3d(const Points3d& keypoints,
                                  const Eigen::VectorXd& weights) const;
   // The baseline's start: each keypoint triangulated robustly over the views
-  // (core/triangulation.h), then InitFromKeypoints3d's closed form (rigid palm
+  // (geometry/triangulation.h), then InitFromKeypoints3d's closed form (rigid palm
   // alignment + bone alignment) without its pose-and-shape solve: Fit's keypoint stage
   // does that against the 2D keypoints themselves. With a PCA pose (no closed form)
   // or fewer than 3 palm keypoints the 3D solve still runs.

@@ -1,5 +1,5 @@
 #pragma once
-// Anatomical joint limits as hinge residuals (core/hand_anatomy.h): for each of the 15
+// Anatomical joint limits as hinge residuals (hand/hand_anatomy.h): for each of the 15
 // non-root joints and each of (twist, spread, bend),
 //   r = sqrt(weight) * (max(0, angle - max) + max(0, min - angle))      [radians]
 // zero inside the limits, linear outside (so the squared cost grows quadratically).
@@ -10,8 +10,8 @@
 
 #include <cmath>
 
-#include "core/hand_anatomy.h"
-#include "core/hand_evaluator.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_evaluator.h"
 
 namespace handlabel {
 

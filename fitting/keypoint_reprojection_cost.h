@@ -6,7 +6,7 @@
 //   uv)
 // with the robust factor f of robust_loss.h applied per keypoint (outliers in one view
 // do not down-weight the others). Projection includes lens distortion
-// (core/camera_models.h). Keypoints behind a camera give zero residuals.
+// (geometry/camera_models.h). Keypoints behind a camera give zero residuals.
 //
 // Parameter blocks: global_orient (3), hand_pose (kPoseDim), betas (kNumBetas),
 // transl (3), as HandEvaluator reads them.
@@ -27,12 +27,12 @@
 #include <algorithm>
 #include <vector>
 
-#include "core/camera_models.h"
-#include "core/hand_evaluator.h"
 #include "fitting/folded_terms.h"
 #include "fitting/keypoint_view.h"
 #include "fitting/point_term_normal_equations.h"
 #include "fitting/robust_loss.h"
+#include "geometry/camera_models.h"
+#include "hand/hand_evaluator.h"
 
 namespace handlabel {
 

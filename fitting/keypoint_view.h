@@ -1,9 +1,9 @@
 #pragma once
 // 2D keypoint evidence of one camera view for the fitter: the camera and its 21
-// detected keypoints (core/keypoints2d.h).
+// detected keypoints (hand/keypoints2d.h).
 
-#include "core/keypoints2d.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
+#include "hand/keypoints2d.h"
 
 namespace handlabel {
 

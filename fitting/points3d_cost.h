@@ -11,9 +11,9 @@
 #include <cmath>
 #include <vector>
 
-#include "core/hand_evaluator.h"
-#include "core/hand_lbs.h"
 #include "fitting/points3d_targets.h"
+#include "hand/hand_evaluator.h"
+#include "hand/hand_lbs.h"
 
 namespace handlabel {
 

@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "core/hand_lbs.h"
+#include "hand/hand_lbs.h"
 
 namespace handlabel {
 

@@ -17,7 +17,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "core/hand_evaluator.h"
+#include "hand/hand_evaluator.h"
 
 namespace handlabel {
 

@@ -4,7 +4,7 @@
 //
 //   mesh -> mask   every listed vertex must project into the mask:
 //                  r = max(0, D_mask(uv) - 0.5) / sigma_px, D_mask = distance to the
-//                  nearest mask pixel centre (core/distance_transform.h), bilinearly
+//                  nearest mask pixel centre (image/distance_transform.h), bilinearly
 //                  interpolated; the 0.5 px allows for vertices on the true outline,
 //                  which lies between the last inside and the first outside pixel
 //                  centre (SilhouetteView::inside_px: more for eroded masks, see
@@ -51,13 +51,13 @@
 #include <memory>
 #include <vector>
 
-#include "core/camera_models.h"
-#include "core/distance_transform.h"
 #include "core/errors.h"
-#include "core/hand_evaluator.h"
-#include "core/rig.h"
-#include "core/scalar_ops.h"
 #include "fitting/point_term_normal_equations.h"
+#include "geometry/camera_models.h"
+#include "geometry/rig.h"
+#include "geometry/scalar_ops.h"
+#include "hand/hand_evaluator.h"
+#include "image/distance_transform.h"
 
 namespace handlabel {
 

@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "core/distance_transform.h"
+#include "image/distance_transform.h"
 
 namespace handlabel {
 

@@ -42,7 +42,7 @@ void FillTriangle(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 
 }  // namespace
 
-double ProjectedMeshIoU(const Points3d& vertices, const MeshFaces& faces,
+double ProjectedMeshIoU(const Points3d& vertices, const Faces& faces,
                         const RigCamera& camera, const MaskImage& mask,
                         const MaskImage* ignore) {
   const int w = camera.camera.width(), h = camera.camera.height();
@@ -90,7 +90,7 @@ double ProjectedMeshIoU(const Points3d& vertices, const MeshFaces& faces,
   return either == 0 ? 1.0 : double(both) / double(either);
 }
 
-MaskImage RenderHandMask(const Points3d& vertices, const MeshFaces& faces,
+MaskImage RenderHandMask(const Points3d& vertices, const Faces& faces,
                          const RigCamera& camera, const PixelRays& rays) {
   RenderMesh mesh;
   mesh.vertices = vertices;

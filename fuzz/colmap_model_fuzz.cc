@@ -1,5 +1,5 @@
-// libFuzzer target for the COLMAP model readers (calib/colmap_model.h) and the rig
-// built from a model (calib/colmap_rig.h). The first byte picks text or binary; the
+// libFuzzer target for the COLMAP model readers (cameras/colmap_model.h) and the rig
+// built from a model (cameras/colmap_rig.h). The first byte picks text or binary; the
 // rest is cut at "@@@@" into cameras, images and points3D, written as files.
 // Decoded or InputError, nothing else.
 
@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <string>
 
-#include "calib/colmap_model.h"
-#include "calib/colmap_rig.h"
+#include "cameras/colmap_model.h"
+#include "cameras/colmap_rig.h"
 #include "core/errors.h"
 #include "fuzz/fuzz_files.h"
 

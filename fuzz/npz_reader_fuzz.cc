@@ -1,4 +1,4 @@
-// libFuzzer target for the zip and .npy readers (core/zip_reader.h, core/npy.h) as
+// libFuzzer target for the zip and .npy readers (formats/zip_reader.h, formats/npy.h) as
 // LoadHandModel uses them on .npz files: every entry is read (inflate, CRC) and parsed
 // as .npy, object arrays through the pickle reader. Inputs that do not start like a
 // zip are parsed as one .npy file. Anything but success or InputError is a finding.
@@ -8,9 +8,9 @@
 #include <string>
 
 #include "core/errors.h"
-#include "core/npy.h"
-#include "core/pickle_reader.h"
-#include "core/zip_reader.h"
+#include "formats/npy.h"
+#include "formats/pickle_reader.h"
+#include "formats/zip_reader.h"
 
 namespace {
 

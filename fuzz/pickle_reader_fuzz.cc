@@ -1,4 +1,4 @@
-// libFuzzer target for the restricted pickle reader (core/pickle_reader.h): any input
+// libFuzzer target for the restricted pickle reader (formats/pickle_reader.h): any input
 // must either decode or throw InputError; anything else (a crash, a sanitizer report,
 // another exception type, a timeout or an out-of-memory) is a finding.
 // Build and run: docs/fuzzing.md.
@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/errors.h"
-#include "core/pickle_reader.h"
+#include "formats/pickle_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   handlabel::PickleLimits limits;

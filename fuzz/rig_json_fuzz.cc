@@ -1,11 +1,11 @@
-// libFuzzer target for the rig file reader (calib/rig_json.h) behind the strict JSON
+// libFuzzer target for the rig file reader (cameras/rig_json.h) behind the strict JSON
 // parser (core/json_util.h): decoded or InputError, nothing else.
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
-#include "calib/rig_json.h"
+#include "cameras/rig_json.h"
 #include "core/errors.h"
 #include "core/json_util.h"
 

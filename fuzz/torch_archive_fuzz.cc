@@ -1,5 +1,5 @@
 // libFuzzer target for torch.save archives read without LibTorch
-// (core/torch_archive.h): the zip, data.pkl through the pickle reader and every
+// (formats/torch_archive.h): the zip, data.pkl through the pickle reader and every
 // tensor's storage checked against its shape and strides. Decoded or InputError.
 
 #include <cstddef>
@@ -7,7 +7,7 @@
 #include <string>
 
 #include "core/errors.h"
-#include "core/torch_archive.h"
+#include "formats/torch_archive.h"
 #include "fuzz/fuzz_files.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -6,8 +6,8 @@
 #include <random>
 
 #include "core/errors.h"
-#include "core/hand_anatomy.h"
-#include "core/hand_pose_sampler.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_pose_sampler.h"
 #include "openhand/implicit_mesher.h"
 #include "openhand/mesh_checks.h"
 #include "openhand/nnls.h"

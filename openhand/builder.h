@@ -9,7 +9,7 @@
 //      around it, fitted by NNLS so that it reproduces the design joints for the mean
 //      shape and along every shape direction;
 //   5. fingertip vertex ids (nearest vertex to each designed fingertip);
-//   6. a pose PCA basis and mean from natural poses (core/hand_pose_sampler.h);
+//   6. a pose PCA basis and mean from natural poses (hand/hand_pose_sampler.h);
 //   7. pose blend shapes are zero (plain LBS; documented in docs/open-hand.md).
 // The left hand is the exact mirror (MirrorHandModel). Same options -> same model,
 // bit for bit.
@@ -17,7 +17,7 @@
 #include <cstdint>
 #include <string>
 
-#include "core/hand_model.h"
+#include "hand/hand_model.h"
 #include "openhand/design.h"
 #include "openhand/mesh_decimation.h"
 #include "openhand/skinning.h"

@@ -21,7 +21,7 @@
 #include <random>
 #include <vector>
 
-#include "core/hand_model.h"
+#include "hand/hand_model.h"
 
 namespace handlabel {
 

@@ -5,12 +5,11 @@
 #include <map>
 #include <numeric>
 
-#include "core/axis_angle.h"
+#include "core/point_arrays.h"
+#include "geometry/axis_angle.h"
 
 namespace handlabel {
 namespace {
-
-using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 int Find(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];

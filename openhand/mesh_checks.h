@@ -6,8 +6,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "core/hand_lbs.h"
-#include "core/hand_model.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_model.h"
 
 namespace handlabel {
 

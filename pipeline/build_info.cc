@@ -6,9 +6,10 @@
 #include "calib/calib_versions.h"
 #include "core/version.h"
 #include "fitting/fitting_versions.h"
-#include "network/network_versions.h"
+#include "image/image_versions.h"
 #include "pipeline/build_config.h"
 #include "pipeline/git_hash.h"
+#include "poem/network_versions.h"
 
 namespace handlabel {
 
@@ -23,6 +24,7 @@ BuildInfo GetBuildInfo() {
     }
   };
   append(CoreLibraryVersions());
+  append(ImageLibraryVersions());
   append(CalibLibraryVersions());
   append(FittingLibraryVersions());
   append(NetworkLibraryVersions());

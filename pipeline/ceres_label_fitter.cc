@@ -5,8 +5,9 @@
 
 #include "core/errors.h"
 #include "core/json_util.h"
-#include "core/mask_image.h"
-#include "core/view_image.h"
+#include "hand/hand_params_json.h"
+#include "image/mask_image.h"
+#include "image/view_image.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/label_record.h"
 

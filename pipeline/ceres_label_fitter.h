@@ -13,7 +13,7 @@
 //                              2D keypoints + IK alignment), then fit
 // Silhouettes are used when the request carries them (the network's, evidence.masks:
 // network), or when use_masks is set and the frame has mask files (read with the one
-// mask rule of core/mask_image.h). A fit with silhouettes is checked against the
+// mask rule of image/mask_image.h). A fit with silhouettes is checked against the
 // keypoints-only fit it started from (CheckSilhouetteFit, pipeline/quality_checks.h);
 // when the check fails, the keypoints-only fit is the label. The report says which
 // (`used`: silhouettes | keypoints_only, `used_why`, `silhouette_check`).
@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "core/hand_model.h"
 #include "fitting/ceres_hand_fitter.h"
+#include "hand/hand_model.h"
 #include "pipeline/label_stages.h"
 #include "pipeline/quality_checks.h"
 

@@ -8,10 +8,10 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/draw.h"
-#include "core/line_plot.h"
-#include "core/rasterizer.h"
-#include "core/view_image.h"
+#include "image/draw.h"
+#include "image/line_plot.h"
+#include "image/rasterizer.h"
+#include "image/view_image.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/label_stage_factory.h"

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "core/image.h"
+#include "image/image.h"
 #include "pipeline/compare_qa.h"
 #include "pipeline/compare_run.h"
 

@@ -7,8 +7,8 @@
 #include <limits>
 
 #include "core/atomic_file.h"
-#include "core/html_report.h"
 #include "core/json_util.h"
+#include "image/html_report.h"
 #include "pipeline/build_info.h"
 #include "pipeline/compare_pictures.h"
 

@@ -251,7 +251,7 @@ namespace {
 
 using Truths = std::map<std::string, FrameGroundTruth>;
 
-// Scores a method's labels against the truth with core/metrics.h.
+// Scores a method's labels against the truth with hand/metrics.h.
 MethodScores ScoreLabels(const MethodRun& run, const std::vector<std::string>& frames,
                          const Truths& truths, const PckOptions& pck) {
   MethodScores s;

@@ -11,7 +11,7 @@
 //                    captures only): the upper bound of fitting
 // Each method is a labeling job (label_job.h) derived from one base job, run by the
 // job runner into <out>/methods/<method>/; its labels are then scored against the
-// capture's ground truth with core/metrics.h. So a method's numbers are those of
+// capture's ground truth with hand/metrics.h. So a method's numbers are those of
 // `label` (or `fit`) with the same job fields: nothing is computed a second way.
 // fit_network_2d is the job `refine.mode: fallback` with `refine.min_views` above the
 // rig's view count (the enough_views check fails on every frame, so every label is the
@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "core/metrics.h"
+#include "hand/metrics.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_record.h"
 

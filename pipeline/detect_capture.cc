@@ -8,10 +8,10 @@
 #include "capture/capture_reader.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
-#include "core/image_file.h"
 #include "core/json_util.h"
 #include "core/stopwatch.h"
-#include "network/detector_overlay.h"
+#include "detector/detector_overlay.h"
+#include "image/image_file.h"
 
 namespace handlabel {
 namespace {

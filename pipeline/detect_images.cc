@@ -5,8 +5,8 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
-#include "core/image_file.h"
 #include "core/json_util.h"
+#include "image/image_file.h"
 
 namespace handlabel {
 namespace {

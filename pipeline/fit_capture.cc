@@ -5,7 +5,7 @@
 #include <map>
 
 #include "core/errors.h"
-#include "core/hand_anatomy.h"
+#include "hand/hand_anatomy.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_record.h"

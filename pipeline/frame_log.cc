@@ -8,7 +8,7 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
-#include "core/sha256.h"
+#include "formats/sha256.h"
 #include "pipeline/label_record.h"
 
 namespace handlabel {

@@ -1,7 +1,7 @@
 #include "pipeline/frame_metrics.h"
 
 #include "core/errors.h"
-#include "core/metrics.h"
+#include "hand/metrics.h"
 
 namespace handlabel {
 

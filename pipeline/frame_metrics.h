@@ -1,5 +1,5 @@
 #pragma once
-// Errors of one frame's hand against ground truth (core/metrics.h, the POEM paper's
+// Errors of one frame's hand against ground truth (hand/metrics.h, the POEM paper's
 // definitions), as scalars that average exactly over frames (every frame has 21
 // keypoints and PCK is linear in the frames), so shards merge by averaging:
 //   mpjpe_mm     mean keypoint distance

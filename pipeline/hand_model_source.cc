@@ -3,10 +3,10 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "core/capsule_hand.h"
 #include "core/data_dir.h"
 #include "core/errors.h"
-#include "core/hand_model_io.h"
+#include "hand/capsule_hand.h"
+#include "hand/hand_model_io.h"
 #include "openhand/builder.h"
 
 namespace handlabel {

@@ -3,7 +3,7 @@
 // decides, in this order (docs/hand-model-files.md):
 //   1. the given value: the --hand-model flag or a job's / training config's
 //      hand_model field: a model file (MANO pickle, .npz) or "capsule" (the built-in
-//      capsule hand, core/capsule_hand.h)
+//      capsule hand, hand/capsule_hand.h)
 //   2. the environment variable HANDLABEL_HAND_MODEL (same values)
 //   3. the shipped open hand <data dir>/models/open_hand_<side>.npz (core/data_dir.h)
 //   4. the open hand built in memory from its default design and options (what the
@@ -13,7 +13,7 @@
 #include <optional>
 #include <string>
 
-#include "core/hand_model.h"
+#include "hand/hand_model.h"
 
 namespace handlabel {
 

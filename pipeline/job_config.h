@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "core/mesh_keypoints.h"
+#include "hand/mesh_keypoints.h"
 
 namespace handlabel {
 
@@ -95,7 +95,7 @@ struct JobConfig {
   int batch_size = 4;
   int threads = 0;  // 0 = all cores
   // network.keypoints: how the answer's 3D keypoints are read (joints | mesh | mean,
-  // core/mesh_keypoints.h); they are what the quality checks judge and what a kept
+  // hand/mesh_keypoints.h); they are what the quality checks judge and what a kept
   // answer's label carries.
   AnswerKeypoints network_keypoints = AnswerKeypoints::kMean;
 

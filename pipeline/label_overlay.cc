@@ -4,11 +4,11 @@
 
 #include "capture/frame_images.h"
 #include "core/atomic_file.h"
-#include "core/draw.h"
 #include "core/errors.h"
-#include "core/hand_skeleton.h"
-#include "core/image_file.h"
-#include "network/detector_overlay.h"
+#include "detector/detector_overlay.h"
+#include "hand/hand_skeleton.h"
+#include "image/draw.h"
+#include "image/image_file.h"
 #include "pipeline/label_outputs.h"
 
 namespace handlabel {

@@ -9,9 +9,9 @@
 #include <memory>
 #include <string>
 
-#include "core/hand_model.h"
-#include "core/image.h"
-#include "core/rasterizer.h"
+#include "hand/hand_model.h"
+#include "image/image.h"
+#include "image/rasterizer.h"
 #include "pipeline/detect_frame_source.h"
 #include "pipeline/label_job.h"
 
@@ -26,7 +26,7 @@ class RasterOverlayWriter : public OverlayWriter {
  public:
   // `detections`: the detector's answers when the job's 2D comes from it
   // (evidence.keypoints_2d: detector); each view then also shows its detection
-  // (network/detector_overlay.h). Null: the label only.
+  // (detector/detector_overlay.h). Null: the label only.
   // `format`: jpg | png (output.overlay_format).
   RasterOverlayWriter(const HandModel& model, std::string format,
                       std::shared_ptr<DetectionStore> detections = nullptr)

@@ -8,6 +8,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/json_util.h"
+#include "hand/hand_params_json.h"
 
 namespace handlabel {
 namespace {

@@ -11,7 +11,8 @@
 #include <optional>
 #include <string>
 
-#include "core/hand_lbs.h"
+#include "core/point_arrays.h"
+#include "hand/hand_lbs.h"
 #include "pipeline/quality_checks.h"
 
 namespace handlabel {
@@ -64,8 +65,6 @@ std::string FrameFileStem(const std::string& frame, const std::string& source);
 std::string LabelFilePath(const std::string& output_dir, const std::string& frame);
 std::string MeshFilePath(const std::string& output_dir, const std::string& frame,
                          const std::string& extension);  // "ply" | "obj"
-
-using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 // ASCII PLY / Wavefront OBJ text of a triangle mesh (vertices in metres).
 std::string MeshToPly(const Points3d& vertices, const Faces& faces);

@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "core/hand_model.h"
+#include "hand/hand_model.h"
 #include "pipeline/detect_frame_source.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"

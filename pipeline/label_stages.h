@@ -6,7 +6,7 @@
 // network, the Ceres fitter); tests pass their own.
 //
 // Every point is in the rig's world frame (metres); 2D keypoints are distorted pixels
-// in the full image. Keypoints are in the 21-point SNAP order (core/hand_model.h).
+// in the full image. Keypoints are in the 21-point SNAP order (hand/hand_model.h).
 
 #include <Eigen/Core>
 #include <functional>
@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "capture/frame_source.h"
-#include "core/distance_transform.h"
-#include "core/hand_lbs.h"
-#include "core/rig.h"
+#include "geometry/rig.h"
+#include "hand/hand_lbs.h"
+#include "image/distance_transform.h"
 
 namespace handlabel {
 
@@ -35,7 +35,7 @@ struct MeshPrediction {
 
 // The network stage: the network's answer per frame in the rig's conventions. A value
 // rather than a class to derive from: the one network interface is
-// network/hand_mesh_predictor.h, pipeline/network_stage.h makes this stage from it,
+// poem/hand_mesh_predictor.h, pipeline/network_stage.h makes this stage from it,
 // and tests set their own `predict`.
 struct NetworkStage {
   std::string model_name;       // recorded in provenance and logs

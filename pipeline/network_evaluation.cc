@@ -4,11 +4,11 @@
 #include <memory>
 
 #include "core/errors.h"
-#include "core/line_plot.h"
-#include "core/mesh_keypoints.h"
 #include "core/stopwatch.h"
-#include "network/hand_mesh_predictor.h"
-#include "network/mask_sheet.h"
+#include "hand/mesh_keypoints.h"
+#include "image/line_plot.h"
+#include "poem/hand_mesh_predictor.h"
+#include "poem/mask_sheet.h"
 
 namespace handlabel {
 namespace {

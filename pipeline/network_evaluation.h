@@ -3,7 +3,7 @@
 //  - on held-out synthetic frames (EvaluatePoemOnSynth): frames from the synthetic
 //    generator with a chosen seed, plain crops around the true 2D keypoint box (no
 //    augmentation), one forward pass per batch, and the POEM paper's metrics
-//    (core/metrics.h) on the last decoder layer in the master frame;
+//    (hand/metrics.h) on the last decoder layer in the master frame;
 //  - on a capture's frames (EvaluateNetworkOnCapture, `--capture`): the labeling
 //    job's network stage (its detector boxes and crops) on the capture's frames,
 //    scored against the capture's truth. This is `compare`'s `network` row run alone
@@ -14,9 +14,9 @@
 #include <string>
 
 #include "capture/synth_capture.h"
-#include "core/hand_model.h"
-#include "core/mesh_keypoints.h"
-#include "core/metrics.h"
+#include "hand/hand_model.h"
+#include "hand/mesh_keypoints.h"
+#include "hand/metrics.h"
 #include "pipeline/compare_run.h"
 #include "pipeline/training_samples.h"
 
@@ -31,7 +31,7 @@ struct NetworkEvalOptions {
   double box_scale = 2.0;     // crop side / keypoint box side
   PckOptions pck;             // thresholds of the PCK curve (POEM: 0-20 mm, 20 steps)
   // With a mask head: write the first mask_png_frames frames' crops with predicted and
-  // true masks to this PNG (network/mask_sheet.h); empty = none.
+  // true masks to this PNG (poem/mask_sheet.h); empty = none.
   std::string mask_png;
   int mask_png_frames = 3;
   // How the answer's keypoints are read (as a job's network.keypoints): the MPJPE,
@@ -44,7 +44,7 @@ struct NetworkEvalResult {
   int frames = 0;
   double mpjpe_mm = 0, mpvpe_mm = 0;        // mean over frames
   double pa_mpjpe_mm = 0, pa_mpvpe_mm = 0;  // Procrustes-aligned
-  // MPJPE of each reading of the keypoints (core/mesh_keypoints.h AnswerKeypoints:
+  // MPJPE of each reading of the keypoints (hand/mesh_keypoints.h AnswerKeypoints:
   // joints, mesh, mean), and of the mesh reading of the true mesh (that reading's own
   // error, which a perfect mesh would still carry).
   double mpjpe_joints_mm = 0, mpjpe_mesh_mm = 0, mpjpe_mean_mm = 0;

@@ -7,10 +7,10 @@
 
 #include "capture/frame_images.h"
 #include "core/errors.h"
-#include "core/image.h"
-#include "core/sha256.h"
 #include "core/stopwatch.h"
-#include "network/poem_config.h"
+#include "formats/sha256.h"
+#include "image/image.h"
+#include "poem/poem_config.h"
 
 namespace handlabel {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 // The labeling job's network stage (label_stages.h NetworkStage) on the one network
-// interface, network/hand_mesh_predictor.h: per view it reads the image and crops
-// around the hand (the capture's 2D keypoints locate it; network/hand_crop.h), runs the
+// interface, poem/hand_mesh_predictor.h: per view it reads the image and crops
+// around the hand (the capture's 2D keypoints locate it; poem/hand_crop.h), runs the
 // network in batches, and brings the answer back to the job's conventions: 3D points
 // from the master camera's frame to the rig's world frame, 2D keypoints from crop
 // pixels to full-image (distorted) pixels with the heatmap peaks as confidences, and
@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "network/hand_crop.h"
-#include "network/hand_mesh_predictor.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_stages.h"
+#include "poem/hand_crop.h"
+#include "poem/hand_mesh_predictor.h"
 
 namespace handlabel {
 
@@ -74,7 +74,7 @@ NetworkStage LoadNetworkStage(const JobConfig& job,
                               std::shared_ptr<PredictionMemo> memo = nullptr);
 
 // Makes `stage` read its answers' keypoints as the job's network.keypoints says
-// (core/mesh_keypoints.h) and names the reading in stage->keypoints. The mesh readings
+// (hand/mesh_keypoints.h) and names the reading in stage->keypoints. The mesh readings
 // need `hand` in the network's topology (POEM: 778 vertices); with another hand model
 // (the capsule hand) the joints are read, and stage->keypoints says why.
 void ReadAnswerKeypointsAs(const JobConfig& job, const HandModel& hand,

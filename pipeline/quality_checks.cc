@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "core/errors.h"
-#include "core/triangulation.h"
+#include "geometry/triangulation.h"
 
 namespace handlabel {
 namespace {

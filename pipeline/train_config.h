@@ -7,10 +7,10 @@
 #include <string>
 
 #include "capture/synth_capture.h"
-#include "core/hand_model.h"
-#include "network/poem_config.h"
-#include "network/poem_trainer.h"
+#include "hand/hand_model.h"
 #include "pipeline/training_samples.h"
+#include "poem/poem_config.h"
+#include "poem/poem_trainer.h"
 
 namespace handlabel {
 

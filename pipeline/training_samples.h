@@ -32,8 +32,8 @@
 #include <vector>
 
 #include "capture/synth_capture.h"
-#include "core/hand_model.h"
-#include "network/training_sample.h"
+#include "hand/hand_model.h"
+#include "poem/training_sample.h"
 
 namespace handlabel {
 

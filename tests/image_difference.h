@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <utility>
 
-#include "core/image.h"
+#include "image/image.h"
 
 namespace handlabel::testing {
 

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/sha256.h"
+#include "formats/sha256.h"
 
 namespace handlabel::testing {
 namespace {
@@ -66,7 +66,8 @@ ReferenceValues& ReferenceValues::Near(const std::string& label, const double* d
   Exact(label + ".size", size);
   if (size <= kShortArray) {
     // Near(double) adds each entry's bits.
-    for (size_t i = 0; i < size; ++i) Near(label + "[" + std::to_string(i) + "]", data[i]);
+    for (size_t i = 0; i < size; ++i)
+      Near(label + "[" + std::to_string(i) + "]", data[i]);
     return *this;
   }
   bits_.Update(data, size * sizeof(double));
@@ -144,7 +145,8 @@ std::vector<ReferenceValues::Entry> ReferenceValues::ReadFile() const {
   return entries;
 }
 
-::testing::AssertionResult ReferenceValues::Compare(double abs_tol, double rel_tol) const {
+::testing::AssertionResult ReferenceValues::Compare(double abs_tol,
+                                                    double rel_tol) const {
   if (WriteRequested()) {
     WriteFile();
     return ::testing::AssertionSuccess() << "wrote " << Path();

@@ -21,8 +21,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "core/rigid3.h"
-#include "core/sha256.h"
+#include "formats/sha256.h"
+#include "geometry/rigid3.h"
 
 namespace handlabel::testing {
 
@@ -44,8 +44,8 @@ class ReferenceValues {
   ReferenceValues& Near(const std::string& label, double v);
 
   // An array of floating-point values: its length exactly, then every entry of an array
-  // of up to 12; a long one by its sum of |x| and eight sums with pseudo-random +-1 weights,
-  // each within tolerance * sum |x| (so a change of any entry by more than the
+  // of up to 12; a long one by its sum of |x| and eight sums with pseudo-random +-1
+  // weights, each within tolerance * sum |x| (so a change of any entry by more than the
   // tolerance times the array's scale is caught, not only a change of the mean).
   ReferenceValues& Near(const std::string& label, const double* data, size_t size);
   ReferenceValues& Near(const std::string& label, const std::vector<double>& v) {
@@ -65,8 +65,8 @@ class ReferenceValues {
   }
   // Rotation (quaternion coefficients x, y, z, w) and translation.
   ReferenceValues& Near(const std::string& label, const Rigid3& t) {
-    return Near(label + ".rotation", t.rotation.coeffs()).Near(label + ".translation",
-                                                             t.translation);
+    return Near(label + ".rotation", t.rotation.coeffs())
+        .Near(label + ".translation", t.translation);
   }
   // Integer arrays (ids, masks, counts): length and a digest of the values, exactly.
   template <typename T, std::enable_if_t<std::is_integral_v<T>, int> = 0>

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "core/errors.h"
-#include "core/rigid3.h"
+#include "geometry/rigid3.h"
 
 namespace handlabel::testing {
 

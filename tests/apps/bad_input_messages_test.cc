@@ -10,7 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "core/image.h"
+#include "image/image.h"
 #include "pipeline/label_outputs.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/apps/run_command.h"

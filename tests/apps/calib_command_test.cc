@@ -6,9 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include "calib/gray_image.h"
-#include "calib/rig_compare.h"
-#include "calib/rig_json.h"
 #include "calib/synthetic_board_capture.h"
+#include "cameras/rig_compare.h"
+#include "cameras/rig_json.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 

@@ -3,7 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "calib/rig_json.h"
+#include "cameras/rig_json.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 

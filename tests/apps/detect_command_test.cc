@@ -6,8 +6,8 @@
 
 #include "capture/capture_reader.h"
 #include "core/data_dir.h"
-#include "core/image_file.h"
-#include "network/detector_overlay.h"
+#include "detector/detector_overlay.h"
+#include "image/image_file.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_stage_factory.h"
 #include "tests/apps/run_command.h"

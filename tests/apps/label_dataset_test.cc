@@ -8,11 +8,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/capsule_hand.h"
-#include "network/hand_mesh_predictor.h"
-#include "network/poem_config.h"
+#include "hand/capsule_hand.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_record.h"
+#include "poem/hand_mesh_predictor.h"
+#include "poem/poem_config.h"
 #include "tests/apps/run_command.h"
 #include "tests/capture/dexycb_fixture.h"
 #include "tests/test_util.h"

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
+#include "hand/capsule_hand.h"
 
 namespace handlabel::testing {
 

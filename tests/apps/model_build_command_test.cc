@@ -4,7 +4,7 @@
 #include <sstream>
 #include <string>
 
-#include "core/hand_model_io.h"
+#include "hand/hand_model_io.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 

@@ -3,7 +3,7 @@
 #include <array>
 #include <string>
 
-#include "core/hand_model_io.h"
+#include "hand/hand_model_io.h"
 
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"

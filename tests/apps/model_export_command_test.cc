@@ -4,9 +4,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/hand_lbs.h"
-#include "core/hand_model_io.h"
-#include "core/hand_preview.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_model_io.h"
+#include "hand/hand_preview.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 

@@ -10,11 +10,11 @@
 #include <Eigen/Geometry>
 
 #include "capture/native_frame_source.h"
-#include "core/capsule_hand.h"
 #include "core/errors.h"
-#include "core/hand_model_io.h"
-#include "core/image_file.h"
-#include "network/poem_config.h"
+#include "hand/capsule_hand.h"
+#include "hand/hand_model_io.h"
+#include "image/image_file.h"
+#include "poem/poem_config.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/test_util.h"
 

@@ -10,7 +10,7 @@
 #include <map>
 #include <sstream>
 
-#include "core/image.h"
+#include "image/image.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 

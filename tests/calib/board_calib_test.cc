@@ -6,8 +6,8 @@
 #include <iomanip>
 
 #include "calib/board_calib_init.h"
-#include "calib/rig_compare.h"
 #include "calib/synthetic_board_capture.h"
+#include "cameras/rig_compare.h"
 #include "core/errors.h"
 #include "tests/reference_values.h"
 #include "tests/test_util.h"
@@ -94,7 +94,8 @@ testing::ReferenceValues BoardCalibValues() {
   const InitialCamera initial =
       InitialIntrinsics(capture.views[0], kBoard, CameraModelId::kOpenCV);
   values.Near("initial.params", initial.camera.params());
-  for (const auto& [key, pose] : initial.cam_from_board) values.Near("initial." + key, pose);
+  for (const auto& [key, pose] : initial.cam_from_board)
+    values.Near("initial." + key, pose);
   values.Near("initial.rms_px", initial.rms_px);
 
   const BoardCalibResult result = CalibrateInBoardWorld(capture.views);
@@ -102,7 +103,8 @@ testing::ReferenceValues BoardCalibValues() {
   values.Exact("world", result.world).Near("rms_px", result.rms_px);
   for (const auto& [key, pose] : result.world_from_board) values.Near(key, pose);
   for (const CameraCalibStats& s : result.stats) {
-    values.Exact(s.name + ".frames", s.frames).Exact(s.name + ".observations", s.observations);
+    values.Exact(s.name + ".frames", s.frames)
+        .Exact(s.name + ".observations", s.observations);
     values.Exact(s.name + ".outliers", s.outliers).Near(s.name + ".rms_px", s.rms_px);
     values.Near(s.name + ".initial_rms_px", s.initial_rms_px);
   }

@@ -11,7 +11,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
-#include "calib/rig_json.h"
+#include "cameras/rig_json.h"
 #include "capture/capture_reader.h"
 #include "core/errors.h"
 #include "tests/capture/video_fixture.h"

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
+#include "hand/capsule_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

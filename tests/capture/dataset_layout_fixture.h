@@ -14,7 +14,7 @@
 #include <string>
 
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
+#include "hand/capsule_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

@@ -11,8 +11,8 @@
 #include "capture/dexycb_frame_source.h"
 #include "capture/ho3d_frame_source.h"
 #include "capture/oakink_frame_source.h"
-#include "core/image.h"
-#include "core/mask_image.h"
+#include "image/image.h"
+#include "image/mask_image.h"
 #include "tests/capture/dataset_layout_fixture.h"
 #include "tests/test_util.h"
 

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "capture/synth_capture.h"
-#include "core/image_file.h"
-#include "core/npz.h"
+#include "formats/npz.h"
+#include "image/image_file.h"
 
 namespace handlabel::testing {
 

@@ -11,9 +11,9 @@
 #include <fstream>
 #include <functional>
 
-#include "core/capsule_hand.h"
 #include "core/errors.h"
-#include "core/image_file.h"
+#include "hand/capsule_hand.h"
+#include "image/image_file.h"
 #include "tests/capture/dexycb_fixture.h"
 #include "tests/image_difference.h"
 #include "tests/test_util.h"

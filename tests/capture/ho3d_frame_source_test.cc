@@ -13,11 +13,11 @@
 #include <nlohmann/json.hpp>
 
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
 #include "core/errors.h"
-#include "core/image_file.h"
+#include "hand/capsule_hand.h"
+#include "image/image_file.h"
 #include "tests/capture/ho3d_fixture.h"
-#include "tests/core/mano_sized_model.h"  // Py2PickleWriter
+#include "tests/hand/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/test_util.h"
 
 namespace handlabel {

@@ -12,11 +12,11 @@
 
 #include "capture/oakink_frame_source.h"
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
 #include "core/errors.h"
-#include "core/image.h"
-#include "core/image_file.h"
-#include "tests/core/mano_sized_model.h"  // Py2PickleWriter
+#include "hand/capsule_hand.h"
+#include "image/image.h"
+#include "image/image_file.h"
+#include "tests/hand/mano_sized_model.h"  // Py2PickleWriter
 #include "tests/test_util.h"
 
 namespace handlabel {

@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
 #include "core/data_dir.h"
 #include "core/errors.h"
-#include "core/hand_model_io.h"
+#include "hand/capsule_hand.h"
+#include "hand/hand_model_io.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

@@ -8,10 +8,10 @@
 #include <map>
 
 #include "capture/capture_reader.h"
-#include "core/capsule_hand.h"
 #include "core/errors.h"
-#include "core/hand_model_io.h"
-#include "core/mesh_primitives.h"
+#include "hand/capsule_hand.h"
+#include "hand/hand_model_io.h"
+#include "image/mesh_primitives.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

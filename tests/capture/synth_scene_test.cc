@@ -8,8 +8,8 @@
 #include "capture/synth_background.h"
 #include "capture/synth_detections.h"
 #include "capture/synth_view.h"
-#include "core/capsule_hand.h"
 #include "core/errors.h"
+#include "hand/capsule_hand.h"
 #include "tests/reference_values.h"
 #include "tests/test_util.h"
 
@@ -91,8 +91,8 @@ TEST(SynthScene, ObjectProbabilityMixesEmptyAndObjectFrames) {
   int with_objects = 0;
   const int n = 100;
   for (int i = 0; i < n; ++i) {
-    with_objects +=
-        !SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, TestRng()).objects.empty();
+    with_objects += !SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, TestRng())
+                         .objects.empty();
   }
   // Binomial(100, 0.6): mean 60, sd 4.9; 4 sd either side.
   EXPECT_GT(with_objects, 40);
@@ -103,7 +103,8 @@ TEST(SynthScene, ObjectProbabilityMixesEmptyAndObjectFrames) {
 
 void AddMesh(const RenderMesh& m, const std::string& label, testing::ReferenceValues* v) {
   v->Near(label + ".vertices", m.vertices);
-  v->Exact(label + ".faces", std::vector<int>(m.faces.data(), m.faces.data() + m.faces.size()));
+  v->Exact(label + ".faces",
+           std::vector<int>(m.faces.data(), m.faces.data() + m.faces.size()));
   v->Near(label + ".normals", m.normals).Near(label + ".colors", m.colors);
   v->Near(label + ".color", m.color).Near(label + ".uvs", m.uvs);
   if (m.texture) {
@@ -129,7 +130,8 @@ testing::ReferenceValues SynthSceneValues() {
       values.Exact(at + ".side", static_cast<int>(scene.side));
       values.Exact(at + ".pose_kind", scene.pose_kind);
       const HandParams& p = scene.params;
-      values.Near(at + ".global_orient", p.global_orient).Near(at + ".hand_pose", p.hand_pose);
+      values.Near(at + ".global_orient", p.global_orient)
+          .Near(at + ".hand_pose", p.hand_pose);
       values.Near(at + ".betas", p.betas).Near(at + ".transl", p.transl);
       values.Near(at + ".vertices", scene.hand.vertices);
       values.Near(at + ".joints", scene.hand.joints);
@@ -146,7 +148,8 @@ testing::ReferenceValues SynthSceneValues() {
         const std::string object = at + ".object" + std::to_string(k);
         values.Exact(object, b.kind).Near(object + ".size", b.size);
         values.Near(object + ".world_from_object", b.world_from_object);
-        values.Near(object + ".color", b.color).Exact(object + ".texture_kind", b.texture_kind);
+        values.Near(object + ".color", b.color)
+            .Exact(object + ".texture_kind", b.texture_kind);
         AddMesh(b.mesh, object, &values);
       }
       values.Exact(at + ".cameras_seeing_hand", scene.cameras_seeing_hand);

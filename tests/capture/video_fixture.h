@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "core/image.h"
+#include "image/image.h"
 
 namespace handlabel::testing {
 

@@ -4,8 +4,8 @@
 
 #include <Eigen/Geometry>
 
-#include "core/capsule_hand.h"
-#include "core/hand_lbs.h"
+#include "hand/capsule_hand.h"
+#include "hand/hand_lbs.h"
 #include "tests/fitting/fitting_scene.h"
 #include "tests/test_util.h"
 

@@ -2,10 +2,10 @@
 
 #include <gtest/gtest.h>
 
-#include "core/capsule_hand.h"
 #include "core/errors.h"
-#include "core/metrics.h"
 #include "fitting/silhouette_render.h"
+#include "hand/capsule_hand.h"
+#include "hand/metrics.h"
 #include "tests/fitting/fitting_scene.h"
 #include "tests/fitting/tube_hand.h"
 #include "tests/test_util.h"

@@ -7,15 +7,15 @@
 #include <memory>
 #include <utility>
 
-#include "core/hand_anatomy.h"
 #include "fitting/axis_angle_manifold.h"
 #include "fitting/joint_limit_cost.h"
 #include "fitting/keypoint_reprojection_cost.h"
 #include "fitting/points3d_cost.h"
 #include "fitting/prior_costs.h"
 #include "fitting/silhouette_cost.h"
-#include "tests/core/stick_hand.h"
+#include "hand/hand_anatomy.h"
 #include "tests/fitting/fitting_scene.h"
+#include "tests/hand/stick_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

@@ -13,11 +13,11 @@
 #include <chrono>
 #include <cstdio>
 
-#include "core/hand_anatomy.h"
-#include "core/hand_model_io.h"
-#include "core/metrics.h"
 #include "fitting/ceres_hand_fitter.h"
 #include "fitting/silhouette_render.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_model_io.h"
+#include "hand/metrics.h"
 #include "tests/fitting/fitting_scene.h"
 #include "tests/test_util.h"
 

@@ -1,7 +1,7 @@
 #pragma once
 // Synthetic multi-view scenes for fitting tests and benches: a DexYCB-like rig (8
 // cameras, 640x480, f ~ 615 px, mild OpenCV distortion, 0.55-0.8 m from the hand), a
-// hand in a natural random pose (core/hand_pose_sampler.h) with random shape, root
+// hand in a natural random pose (hand/hand_pose_sampler.h) with random shape, root
 // rotation and position, and its exact 2D keypoints in every view. Noise, outliers and
 // occluded views are added by the caller.
 
@@ -11,14 +11,14 @@
 #include <random>
 #include <vector>
 
-#include "core/hand_anatomy.h"
-#include "core/hand_lbs.h"
-#include "core/hand_pose_sampler.h"
-#include "core/mask_image.h"
-#include "core/mesh_primitives.h"
-#include "core/rasterizer.h"
-#include "core/rig.h"
 #include "fitting/keypoint_view.h"
+#include "geometry/rig.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_lbs.h"
+#include "hand/hand_pose_sampler.h"
+#include "image/mask_image.h"
+#include "image/mesh_primitives.h"
+#include "image/rasterizer.h"
 
 namespace handlabel::testing {
 

@@ -1,18 +1,18 @@
 #pragma once
 // A MANO-structured test hand with a surface: the stick hand's 16 joints and 5 tips
-// (tests/core/stick_hand.h) plus closed tubes along every bone (palm bones from the
+// (tests/hand/stick_hand.h) plus closed tubes along every bone (palm bones from the
 // wrist to each finger's first joint included) and balls at the joints and tips.
 // Tube vertices are rigidly skinned to the bone's first joint and follow the joints'
 // shape blend shapes (interpolated along the bone), so betas change bone lengths and
 // the silhouette together. Kept for the silhouette fit test (ceres_hand_fitter_test):
-// with the capsule hand (core/capsule_hand.h) the same noise-free fit stays at
+// with the capsule hand (hand/capsule_hand.h) the same noise-free fit stays at
 // 1.6-2.0 mm vertex error and IoU 0.87-0.90, outside that test's bounds.
 
 #include <Eigen/Geometry>
 #include <vector>
 
-#include "core/mesh_primitives.h"
-#include "tests/core/stick_hand.h"
+#include "image/mesh_primitives.h"
+#include "tests/hand/stick_hand.h"
 
 namespace handlabel::testing {
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "core/point_arrays.h"
 #include "openhand/implicit_mesher.h"
 #include "openhand/mesh_checks.h"
 #include "openhand/mesh_decimation.h"
@@ -12,8 +13,6 @@
 
 namespace handlabel {
 namespace {
-
-using Faces = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 void ToArrays(const TriangleMesh& mesh, Points3d* v, Faces* f) {
   v->resize(static_cast<Eigen::Index>(mesh.vertices.size()), 3);

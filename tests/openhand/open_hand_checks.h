@@ -6,8 +6,8 @@
 
 #include <Eigen/Geometry>
 
-#include "core/hand_anatomy.h"
-#include "core/hand_lbs.h"
+#include "hand/hand_anatomy.h"
+#include "hand/hand_lbs.h"
 #include "openhand/mesh_checks.h"
 
 namespace handlabel::testing {

@@ -3,8 +3,8 @@
 // properties here; the full rebuild within 1e-9 is `scripts/check-open-hand`).
 #include <gtest/gtest.h>
 
-#include "core/hand_model_io.h"
-#include "core/hand_pose_sampler.h"
+#include "hand/hand_model_io.h"
+#include "hand/hand_pose_sampler.h"
 #include "openhand/mesh_checks.h"
 #include "tests/openhand/open_hand_checks.h"
 #include "tests/test_util.h"

@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/capsule_hand.h"
 #include "core/errors.h"
-#include "core/image_file.h"
+#include "hand/capsule_hand.h"
+#include "image/image_file.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_record.h"

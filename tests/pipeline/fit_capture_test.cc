@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "capture/synth_capture.h"
-#include "core/capsule_hand.h"
 #include "core/errors.h"
+#include "hand/capsule_hand.h"
 #include "pipeline/label_record.h"
 #include "tests/test_util.h"
 

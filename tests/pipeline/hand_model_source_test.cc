@@ -11,7 +11,7 @@
 
 #include "core/data_dir.h"
 #include "core/errors.h"
-#include "core/hand_model_io.h"
+#include "hand/hand_model_io.h"
 #include "pipeline/train_config.h"
 #include "tests/test_util.h"
 

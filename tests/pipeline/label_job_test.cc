@@ -8,7 +8,7 @@
 #include <functional>
 
 #include "core/errors.h"
-#include "core/sha256.h"
+#include "formats/sha256.h"
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
 #include "tests/pipeline/label_test_stages.h"

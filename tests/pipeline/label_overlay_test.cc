@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "core/errors.h"
-#include "core/image_file.h"
+#include "image/image_file.h"
 #include "pipeline/label_outputs.h"
 #include "tests/image_difference.h"
 #include "tests/pipeline/label_test_stages.h"

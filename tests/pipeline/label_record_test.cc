@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/capsule_hand.h"
 #include "core/errors.h"
+#include "hand/capsule_hand.h"
 #include "pipeline/label_policy.h"
 #include "tests/test_util.h"
 

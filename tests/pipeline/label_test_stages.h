@@ -1,6 +1,6 @@
 #pragma once
 // In-memory stages for testing the labeling runner without the network, the fitter or
-// files: a synthetic capture of the stick hand (tests/core/stick_hand.h) seen by four
+// files: a synthetic capture of the stick hand (tests/hand/stick_hand.h) seen by four
 // cameras with exact ground truth, a predictor that returns the ground truth with
 // chosen defects, and a fitter that triangulates the 2D evidence. They exercise the
 // orchestration (policy, resume, shards, failure isolation); label quality with the
@@ -14,10 +14,10 @@
 #include <stdexcept>
 #include <thread>
 
-#include "core/triangulation.h"
+#include "geometry/triangulation.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_policy.h"
-#include "tests/core/stick_hand.h"
+#include "tests/hand/stick_hand.h"
 
 namespace handlabel::testing {
 
