@@ -189,113 +189,119 @@ class Converter {
   PickleValue Convert(int id, int depth) {
     Budget(depth);
     const Node& n = N(id);
-    PickleValue v;
-    using K = PickleValue::Kind;
     switch (n.kind) {
-      case NodeKind::kNone:
-        v.kind = K::kNone;
-        v.type_name = "NoneType";
-        break;
-      case NodeKind::kBool:
-        v.kind = K::kBool;
-        v.boolean = n.boolean;
-        v.type_name = "bool";
-        break;
-      case NodeKind::kInt:
-        v.kind = K::kInt;
-        v.integer = n.integer;
-        v.type_name = "int";
-        break;
-      case NodeKind::kFloat:
-        v.kind = K::kFloat;
-        v.real = n.real;
-        v.type_name = "float";
-        break;
-      case NodeKind::kText:
-        v.kind = K::kText;
-        v.text = n.text;
-        v.type_name = "str";
-        break;
-      case NodeKind::kPy2Str:
-        v.kind = K::kText;
-        v.text = Latin1ToUtf8(n.text);
-        v.type_name = "str";
-        break;
-      case NodeKind::kBytes:
-        v.kind = K::kBytes;
-        v.text = n.text;
-        v.type_name = "bytes";
-        break;
       case NodeKind::kList:
       case NodeKind::kTuple:
-      case NodeKind::kSet: {
-        if (n.global_name == "numpy object array" && n.integer == 0 &&
-            n.items.size() == 1) {
-          return Convert(n.items[0], depth + 1);
-        }
-        v.kind = K::kList;
-        v.type_name = n.kind == NodeKind::kList    ? "list"
-                      : n.kind == NodeKind::kTuple ? "tuple"
-                                                   : "set";
-        const std::vector<int> items = n.items;  // nodes_ is stable, but be explicit
-        for (int item : items) v.items.push_back(Convert(item, depth + 1));
-        break;
-      }
-      case NodeKind::kDict: {
-        v.kind = K::kDict;
-        v.type_name = "dict";
-        const auto entries = n.entries;
-        for (const auto& [key, value] : entries) {
-          v.entries.emplace_back(Convert(key, depth + 1), Convert(value, depth + 1));
-        }
-        break;
-      }
-      case NodeKind::kArray:
-        v.kind = K::kArray;
-        v.array = n.array;
-        v.type_name = "numpy.ndarray";
-        break;
-      case NodeKind::kObject: {
-        v.type_name = n.global_name;
-        if (n.global == Global::kCh) {
-          v.kind = K::kArray;
-          v.array = ArrayOf(Attr(id, "x"), depth + 1, n.global_name + ".x");
-        } else if (n.global == Global::kSelect) {
-          v.kind = K::kArray;
-          v.array = Select(id, depth);
-        } else {
-          v.kind = K::kSparse;
-          v.sparse = Sparse(id, depth);
-        }
-        break;
-      }
-      case NodeKind::kTensor:
-        v.kind = K::kTensor;
-        v.tensor = n.tensor;
-        v.type_name = "torch.Tensor";
-        break;
-      case NodeKind::kPendingArray:
-        v.kind = K::kUnsupported;
-        v.type_name = "numpy.ndarray";
-        v.text = "no state";
-        break;
-      case NodeKind::kUnsupported:
-        v.kind = K::kUnsupported;
-        v.type_name = n.global_name;
+      case NodeKind::kSet:
+        return Sequence(n, depth);
+      case NodeKind::kDict:
+        return Dict(n, depth);
+      case NodeKind::kObject:
+        return Object(id, n, depth);
+      default:
+        return Leaf(id, n);
+    }
+  }
+
+ private:
+  // A node without children: scalars, text, arrays, tensors and what is not plain data.
+  PickleValue Leaf(int id, const Node& n) const {
+    using K = PickleValue::Kind;
+    PickleValue v;
+    switch (n.kind) {
+      case NodeKind::kNone:
+        return Value(K::kNone, "NoneType");
+      case NodeKind::kBool:
+        v = Value(K::kBool, "bool");
+        v.boolean = n.boolean;
+        return v;
+      case NodeKind::kInt:
+        v = Value(K::kInt, "int");
+        v.integer = n.integer;
+        return v;
+      case NodeKind::kFloat:
+        v = Value(K::kFloat, "float");
+        v.real = n.real;
+        return v;
+      case NodeKind::kText:
+      case NodeKind::kPy2Str:
+        v = Value(K::kText, "str");
+        v.text = n.kind == NodeKind::kPy2Str ? Latin1ToUtf8(n.text) : n.text;
+        return v;
+      case NodeKind::kBytes:
+        v = Value(K::kBytes, "bytes");
         v.text = n.text;
-        break;
-      case NodeKind::kGlobal:
-      case NodeKind::kDType:
-      case NodeKind::kStorage:
-        v.kind = K::kUnsupported;
-        v.type_name = KindName(id);
+        return v;
+      case NodeKind::kArray:
+        v = Value(K::kArray, "numpy.ndarray");
+        v.array = n.array;
+        return v;
+      case NodeKind::kTensor:
+        v = Value(K::kTensor, "torch.Tensor");
+        v.tensor = n.tensor;
+        return v;
+      case NodeKind::kPendingArray:
+        v = Value(K::kUnsupported, "numpy.ndarray");
+        v.text = "no state";
+        return v;
+      case NodeKind::kUnsupported:
+        v = Value(K::kUnsupported, n.global_name);
+        v.text = n.text;
+        return v;
+      default:  // globals, dtypes, storages
+        v = Value(K::kUnsupported, KindName(id));
         v.text = "not plain data";
-        break;
+        return v;
+    }
+  }
+
+  static PickleValue Value(PickleValue::Kind kind, const std::string& type_name) {
+    PickleValue v;
+    v.kind = kind;
+    v.type_name = type_name;
+    return v;
+  }
+
+  // list, tuple or set (a numpy object array of one item is that item).
+  PickleValue Sequence(const Node& n, int depth) {
+    if (n.global_name == "numpy object array" && n.integer == 0 && n.items.size() == 1) {
+      return Convert(n.items[0], depth + 1);
+    }
+    PickleValue v = Value(PickleValue::Kind::kList, n.kind == NodeKind::kList    ? "list"
+                                                    : n.kind == NodeKind::kTuple ? "tuple"
+                                                                                 : "set");
+    const std::vector<int> items = n.items;  // nodes_ is stable, but be explicit
+    for (int item : items) v.items.push_back(Convert(item, depth + 1));
+    return v;
+  }
+
+  PickleValue Dict(const Node& n, int depth) {
+    PickleValue v = Value(PickleValue::Kind::kDict, "dict");
+    const auto entries = n.entries;
+    for (const auto& [key, value] : entries) {
+      v.entries.emplace_back(Convert(key, depth + 1), Convert(value, depth + 1));
     }
     return v;
   }
 
- private:
+  // chumpy arrays (Ch, Select) become arrays; scipy sparse matrices stay sparse.
+  PickleValue Object(int id, const Node& n, int depth) {
+    using K = PickleValue::Kind;
+    if (n.global == Global::kCh) {
+      PickleValue v = Value(K::kArray, n.global_name);
+      v.array = ArrayOf(Attr(id, "x"), depth + 1, n.global_name + ".x");
+      return v;
+    }
+    if (n.global == Global::kSelect) {
+      PickleValue v = Value(K::kArray, n.global_name);
+      v.array = Select(id, depth);
+      return v;
+    }
+    PickleValue v = Value(K::kSparse, n.global_name);
+    v.sparse = Sparse(id, depth);
+    return v;
+  }
+
   [[noreturn]] void FailConvert(const std::string& where, const std::string& expected,
                                 const std::string& got) const {
     throw InputError(source_, where, expected, got);
