@@ -8,13 +8,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cameras/rig_json.h"
-#include "capture/capture_frame_readers.h"
 #include "capture/capture_import_sources.h"
 #include "capture/capture_manifest_file.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/stopwatch.h"
 #include "core/version.h"
+#include "media/frame_readers.h"
 
 namespace handlabel {
 

@@ -8,15 +8,9 @@
 #include <vector>
 
 #include "capture/capture_import.h"
+#include "media/frame_readers.h"
 
 namespace handlabel {
-
-// One rig camera's recording: an image folder or a video file.
-struct CameraSource {
-  std::string camera;
-  std::filesystem::path path;
-  std::vector<std::filesystem::path> images;  // image folders: the images, sorted by name
-};
 
 // One frame to import: its id and, per camera (rig order), the position of its image
 // in the camera's folder or its video frame index.

@@ -1,6 +1,7 @@
 #pragma once
-// Internal to capture_import.cc: reading a frame of a camera's recording as RGB, from an
-// image folder or a video.
+// Reading a frame of a camera's recording as RGB, from an image folder (any format
+// OpenCV decodes) or a video (OpenCV's FFmpeg backend), for capture import. OpenCV stays
+// inside media/'s .cc files: capture/ links media/, not OpenCV.
 
 #include <exception>
 #include <memory>
@@ -8,10 +9,18 @@
 #include <utility>
 #include <vector>
 
-#include "capture/capture_import_sources.h"
+#include <filesystem>
+
 #include "image/image.h"
 
 namespace handlabel {
+
+// One rig camera's recording: an image folder or a video file.
+struct CameraSource {
+  std::string camera;
+  std::filesystem::path path;
+  std::vector<std::filesystem::path> images;  // image folders: the images, sorted by name
+};
 
 // A video ended before the frame asked for (containers may declare more frames than
 // they hold): the import stops there.

@@ -1,4 +1,4 @@
-#include "capture/capture_frame_readers.h"
+#include "media/frame_readers.h"
 
 #include <algorithm>
 #include <opencv2/core.hpp>
