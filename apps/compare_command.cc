@@ -5,9 +5,9 @@
 #include "apps/cli_util.h"
 #include "apps/commands.h"
 #include "core/errors.h"
-#include "pipeline/compare_qa.h"
-#include "pipeline/compare_report.h"
-#include "pipeline/compare_run.h"
+#include "comparison/compare_qa.h"
+#include "comparison/compare_report.h"
+#include "comparison/compare_run.h"
 #include "pipeline/job_config.h"
 
 namespace handlabel {

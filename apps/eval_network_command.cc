@@ -15,8 +15,8 @@
 #include "core/errors.h"
 #include "core/progress.h"
 #include "hand/hand_model_io.h"
-#include "pipeline/compare_report.h"
-#include "pipeline/network_evaluation.h"
+#include "comparison/compare_report.h"
+#include "comparison/network_evaluation.h"
 #include "pipeline/train_config.h"
 
 namespace handlabel {

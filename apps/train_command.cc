@@ -10,7 +10,7 @@
 #include "apps/commands.h"
 #include "core/errors.h"
 #include "pipeline/train_config.h"
-#include "pipeline/training_samples.h"
+#include "training/training_samples.h"
 #include "poem/loss_plot.h"
 #include "poem/poem_trainer.h"
 

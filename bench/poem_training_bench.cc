@@ -7,7 +7,7 @@
 
 #include "hand/capsule_hand.h"
 #include "openhand/builder.h"
-#include "pipeline/training_samples.h"
+#include "training/training_samples.h"
 #include "poem/poem_loss.h"
 #include "poem/poem_training_batch.h"
 

@@ -8,7 +8,7 @@
 
 #include "capture/synth_capture.h"
 #include "hand/hand_model.h"
-#include "pipeline/training_samples.h"
+#include "training/training_samples.h"
 #include "poem/poem_config.h"
 #include "poem/poem_trainer.h"
 

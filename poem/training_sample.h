@@ -1,7 +1,7 @@
 #pragma once
 // One multi-view training (or evaluation) sample for POEM, in plain C++ (no LibTorch),
 // and the interface of whatever makes them. The trainer (poem_trainer.h) only sees this
-// interface; pipeline/training_samples.h implements it with synthetic captures made on
+// interface; training/training_samples.h implements it with synthetic captures made on
 // the fly, so network/ never depends on pipeline/.
 //
 // Frames: the master frame is camera 0's (after augmentation); pixels are crop pixels

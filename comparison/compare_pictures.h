@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "image/image.h"
-#include "pipeline/compare_qa.h"
-#include "pipeline/compare_run.h"
+#include "comparison/compare_qa.h"
+#include "comparison/compare_run.h"
 
 namespace handlabel {
 

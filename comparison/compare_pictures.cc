@@ -1,7 +1,7 @@
 // The pictures of `handlabel compare` (compare_report.h): PCK curves, per-joint
 // errors, histograms, time vs accuracy, the view ablation, the quality-check study and
 // the worst frames with every method's overlay.
-#include "pipeline/compare_pictures.h"
+#include "comparison/compare_pictures.h"
 
 #include <algorithm>
 #include <cmath>

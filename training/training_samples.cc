@@ -1,4 +1,4 @@
-#include "pipeline/training_samples.h"
+#include "training/training_samples.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "pipeline/compare_qa.h"
-#include "pipeline/compare_run.h"
+#include "comparison/compare_qa.h"
+#include "comparison/compare_run.h"
 
 namespace handlabel {
 

@@ -1,4 +1,4 @@
-#include "pipeline/compare_report.h"
+#include "comparison/compare_report.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "core/json_util.h"
 #include "image/html_report.h"
 #include "pipeline/build_info.h"
-#include "pipeline/compare_pictures.h"
+#include "comparison/compare_pictures.h"
 
 namespace handlabel {
 namespace {

@@ -1,4 +1,4 @@
-#include "pipeline/training_samples.h"
+#include "training/training_samples.h"
 
 #include <gtest/gtest.h>
 

@@ -8,8 +8,8 @@
 #include <fstream>
 
 #include "core/errors.h"
-#include "pipeline/compare_qa.h"
-#include "pipeline/compare_report.h"
+#include "comparison/compare_qa.h"
+#include "comparison/compare_report.h"
 #include "pipeline/label_record.h"
 #include "tests/test_util.h"
 

@@ -1,9 +1,9 @@
-// Which job each compared method runs as (pipeline/compare_run.h).
+// Which job each compared method runs as (comparison/compare_run.h).
 
 #include <gtest/gtest.h>
 
 #include "core/errors.h"
-#include "pipeline/compare_run.h"
+#include "comparison/compare_run.h"
 #include "tests/test_util.h"
 
 namespace handlabel {

@@ -1,4 +1,4 @@
-#include "pipeline/compare_run.h"
+#include "comparison/compare_run.h"
 
 #include <chrono>
 #include <filesystem>

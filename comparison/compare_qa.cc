@@ -1,4 +1,4 @@
-#include "pipeline/compare_qa.h"
+#include "comparison/compare_qa.h"
 
 #include <algorithm>
 #include <cmath>

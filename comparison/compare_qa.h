@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/compare_run.h"
+#include "comparison/compare_run.h"
 #include "pipeline/job_config.h"
 
 namespace handlabel {

@@ -1,4 +1,4 @@
-#include "pipeline/network_evaluation.h"
+#include "comparison/network_evaluation.h"
 
 #include <chrono>
 #include <memory>

@@ -64,7 +64,7 @@ struct CompareOptions {
   double qa_error_mm = 8.0;
   // Quality-check study: earlier compare output folders whose network answers choose
   // the thresholds (every frame of this run is then held out); empty = choose on this
-  // run's frames at even positions, judge on the odd ones (pipeline/compare_qa.h).
+  // run's frames at even positions, judge on the odd ones (comparison/compare_qa.h).
   std::vector<std::string> qa_selection;
   // Throws InputError naming the flag.
   void Check() const;

@@ -7,7 +7,7 @@
 //  - on a capture's frames (EvaluateNetworkOnCapture, `--capture`): the labeling
 //    job's network stage (its detector boxes and crops) on the capture's frames,
 //    scored against the capture's truth. This is `compare`'s `network` row run alone
-//    (pipeline/compare_run.h): one code path, so the numbers are that row's.
+//    (comparison/compare_run.h): one code path, so the numbers are that row's.
 
 #include <cstdint>
 #include <functional>
@@ -17,8 +17,8 @@
 #include "hand/hand_model.h"
 #include "hand/mesh_keypoints.h"
 #include "hand/metrics.h"
-#include "pipeline/compare_run.h"
-#include "pipeline/training_samples.h"
+#include "comparison/compare_run.h"
+#include "training/training_samples.h"
 
 namespace handlabel {
 
