@@ -214,7 +214,8 @@ testing::ReferenceValues KeypointJacobianValues() {
       Eigen::Matrix<double, 63, 1> keypoints;
       ev.KeypointsAndJacobian(x.data(), x.data() + 3, x.data() + 3 + pd,
                               x.data() + 3 + pd + 10, keypoints.data(), jac.data());
-      const std::string at = "pca" + std::to_string(pca) + ".trial" + std::to_string(trial);
+      const std::string at =
+          "pca" + std::to_string(pca) + ".trial" + std::to_string(trial);
       values.Near(at + ".keypoints", keypoints).Near(at + ".jacobian", jac);
     }
   }

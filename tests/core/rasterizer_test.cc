@@ -106,7 +106,8 @@ testing::ReferenceValues RasterizerValues() {
         Eigen::Vector3d(0.01, -0.02, 0.03));
     VisibilityBuffer buffer;
     buffer.Reset(camera.width(), camera.height());
-    values.Exact(name + ".box_faces", RasterizeMesh(box, 0, cam_from_world, rays, &buffer));
+    values.Exact(name + ".box_faces",
+                 RasterizeMesh(box, 0, cam_from_world, rays, &buffer));
     values.Exact(name + ".sphere_faces",
                  RasterizeMesh(sphere, 1, cam_from_world, rays, &buffer));
     values.Near(name + ".depth", buffer.depth).Exact(name + ".mesh_id", buffer.mesh_id);

@@ -108,7 +108,8 @@ TEST(OpenHandBuilder, CoarseBuildKeepsItsValues) {
   testing::ReferenceValues values("open_hand_coarse_build");
   values.Exact("name", m.name).Exact("side", static_cast<int>(m.side));
   values.Near("v_template", m.v_template);
-  values.Exact("faces", std::vector<int>(m.faces.data(), m.faces.data() + m.faces.size()));
+  values.Exact("faces",
+               std::vector<int>(m.faces.data(), m.faces.data() + m.faces.size()));
   values.Near("shapedirs", m.shapedirs).Near("posedirs", m.posedirs);
   values.Near("skinning_weights", m.skinning_weights);
   values.Near("joint_regressor", Eigen::MatrixXd(m.joint_regressor));

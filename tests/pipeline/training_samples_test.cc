@@ -189,8 +189,9 @@ testing::ReferenceValues TrainingSampleValues() {
       values.Near(view + ".intrinsics", v.intrinsics);
       values.Near(view + ".master_from_cam", v.master_from_cam);
       values.Near(view + ".joints_2d", v.joints_2d);
-      values.Near(view + ".joints_2d_weight", std::vector<float>(v.joints_2d_weight.begin(),
-                                                                 v.joints_2d_weight.end()));
+      values.Near(
+          view + ".joints_2d_weight",
+          std::vector<float>(v.joints_2d_weight.begin(), v.joints_2d_weight.end()));
     }
   }
   return values;
