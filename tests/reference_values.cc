@@ -1,19 +1,18 @@
 #include "tests/reference_values.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
-#include "formats/sha256.h"
-
 namespace handlabel::testing {
 namespace {
 
 // Arrays up to this length are kept entry by entry.
 constexpr size_t kShortArray = 12;
-constexpr int kWeightedSums = 8;
+constexpr int kWeightedSums = 4;
 
 std::string Format(double v) {
   char buffer[40];
@@ -21,7 +20,7 @@ std::string Format(double v) {
   return buffer;
 }
 
-// +-1 from a 64-bit LCG (integers only, the same on every machine).
+// +-1 from a 64-bit LCG (integers only: the same weights on every machine).
 double Sign(uint64_t* state) {
   *state = *state * 6364136223846793005ULL + 1442695040888963407ULL;
   return (*state >> 63) ? 1.0 : -1.0;
@@ -38,87 +37,90 @@ std::string ReferenceValues::Path() const {
   return std::string(HANDLABEL_SOURCE_DIR) + "/tests/data/reference/" + name_ + ".txt";
 }
 
-ReferenceValues& ReferenceValues::AddEntry(const std::string& label, Entry::Kind kind,
-                                           std::string text, double value, double scale) {
-  entries_.push_back({label, kind, std::move(text), value, scale});
-  return *this;
-}
-
 std::string ReferenceValues::Bits() const {
   Sha256 copy = bits_;
   return copy.HexDigest();
+}
+
+ReferenceValues& ReferenceValues::AddExact(const std::string& label, std::string text) {
+  Entry e;
+  e.label = label;
+  e.text = std::move(text);
+  entries_.push_back(std::move(e));
+  return *this;
 }
 
 ReferenceValues& ReferenceValues::Exact(const std::string& label, const std::string& s) {
   const uint64_t length = s.size();
   bits_.Update(&length, sizeof(length));
   bits_.Update(s);
-  return AddEntry(label, Entry::kExact, "\"" + s + "\"", 0, 0);
-}
-
-ReferenceValues& ReferenceValues::Near(const std::string& label, double v) {
-  bits_.Update(&v, sizeof(v));
-  return AddEntry(label, Entry::kNear, Format(v), v, std::abs(v));
-}
-
-ReferenceValues& ReferenceValues::Near(const std::string& label, const double* data,
-                                       size_t size) {
-  Exact(label + ".size", size);
-  if (size <= kShortArray) {
-    // Near(double) adds each entry's bits.
-    for (size_t i = 0; i < size; ++i)
-      Near(label + "[" + std::to_string(i) + "]", data[i]);
-    return *this;
-  }
-  bits_.Update(data, size * sizeof(double));
-  // Infinities (a depth buffer's background) are counted, the sums go over the rest.
-  int64_t non_finite = 0;
-  double sum_abs = 0;
-  for (size_t i = 0; i < size; ++i) {
-    if (std::isfinite(data[i])) {
-      sum_abs += std::abs(data[i]);
-    } else {
-      ++non_finite;
-    }
-  }
-  AddEntry(label + ".non_finite", Entry::kExact, std::to_string(non_finite), 0, 0);
-  AddEntry(label + ".sum_abs", Entry::kNear, Format(sum_abs), sum_abs, sum_abs);
-  uint64_t state = size;
-  for (int k = 0; k < kWeightedSums; ++k) {
-    double sum = 0;
-    for (size_t i = 0; i < size; ++i) {
-      const double sign = Sign(&state);
-      if (std::isfinite(data[i])) sum += sign * data[i];
-    }
-    AddEntry(label + ".weighted_sum" + std::to_string(k), Entry::kNear, Format(sum), sum,
-             sum_abs);
-  }
-  return *this;
-}
-
-ReferenceValues& ReferenceValues::Near(const std::string& label,
-                                       const std::vector<float>& v) {
-  const std::vector<double> wide(v.begin(), v.end());
-  return Near(label, wide);
+  return AddExact(label, "\"" + s + "\"");
 }
 
 ReferenceValues& ReferenceValues::ExactInts(const std::string& label,
                                             const std::vector<int64_t>& v) {
-  Exact(label + ".size", v.size());
+  const uint64_t size = v.size();
+  bits_.Update(&size, sizeof(size));
   bits_.Update(v.data(), v.size() * sizeof(int64_t));
   Sha256 sha;
   sha.Update(v.data(), v.size() * sizeof(int64_t));
-  return AddEntry(label + ".sha256", Entry::kExact, sha.HexDigest().substr(0, 16), 0, 0);
+  return AddExact(label, std::to_string(v.size()) + " " + sha.HexDigest().substr(0, 16));
 }
 
+ReferenceValues& ReferenceValues::Near(const std::string& label,
+                                       const std::vector<double>& v) {
+  const uint64_t size = v.size();
+  bits_.Update(&size, sizeof(size));
+  bits_.Update(v.data(), v.size() * sizeof(double));
+  Entry e;
+  e.label = label;
+  e.exact = false;
+  // Infinities (a depth buffer's background) are counted; the sums go over the rest.
+  size_t non_finite = 0;
+  double sum_abs = 0, max_abs = 0;
+  for (double x : v) {
+    if (!std::isfinite(x)) {
+      ++non_finite;
+      continue;
+    }
+    sum_abs += std::abs(x);
+    max_abs = std::max(max_abs, std::abs(x));
+  }
+  e.text = std::to_string(v.size()) + " " + std::to_string(non_finite);
+  if (v.size() <= kShortArray) {
+    e.values = v;
+    e.scale = max_abs;
+  } else {
+    e.values.push_back(sum_abs);
+    uint64_t state = v.size();
+    for (int k = 0; k < kWeightedSums; ++k) {
+      double sum = 0;
+      for (double x : v) {
+        const double sign = Sign(&state);
+        if (std::isfinite(x)) sum += sign * x;
+      }
+      e.values.push_back(sum);
+    }
+    e.scale = sum_abs;
+  }
+  entries_.push_back(std::move(e));
+  return *this;
+}
+
+// Line format: label TAB "exact" TAB text, or label TAB "near" TAB "count non-finite"
+// TAB scale TAB values separated by spaces.
 void ReferenceValues::WriteFile() const {
   std::ofstream out(Path());
   out << "# Reference values of a test (tests/reference_values.h); rewrite with\n"
          "# HANDLABEL_WRITE_REFERENCES=1 and review the diff.\n";
   for (const Entry& e : entries_) {
-    out << e.label << '\t' << (e.kind == Entry::kExact ? "exact" : "near") << '\t'
-        << e.text;
-    if (e.kind == Entry::kNear) out << '\t' << Format(e.scale);
+    out << e.label << '\t' << (e.exact ? "exact" : "near") << '\t' << e.text;
+    if (!e.exact) {
+      out << '\t' << Format(e.scale) << '\t';
+      for (size_t i = 0; i < e.values.size(); ++i) {
+        out << (i ? " " : "") << Format(e.values[i]);
+      }
+    }
     out << '\n';
   }
 }
@@ -131,18 +133,43 @@ std::vector<ReferenceValues::Entry> ReferenceValues::ReadFile() const {
     if (line.empty() || line[0] == '#') continue;
     std::istringstream fields(line);
     Entry e;
-    std::string kind;
+    std::string kind, scale, values;
     std::getline(fields, e.label, '\t');
     std::getline(fields, kind, '\t');
     std::getline(fields, e.text, '\t');
-    e.kind = kind == "exact" ? Entry::kExact : Entry::kNear;
-    e.value = e.kind == Entry::kNear ? std::strtod(e.text.c_str(), nullptr) : 0;
-    std::string scale;
-    std::getline(fields, scale, '\t');
-    e.scale = scale.empty() ? 0 : std::strtod(scale.c_str(), nullptr);
-    entries.push_back(e);
+    e.exact = kind == "exact";
+    if (!e.exact) {
+      std::getline(fields, scale, '\t');
+      std::getline(fields, values, '\t');
+      e.scale = std::strtod(scale.c_str(), nullptr);
+      std::istringstream numbers(values);
+      for (std::string n; numbers >> n;)
+        e.values.push_back(std::strtod(n.c_str(), nullptr));
+    }
+    entries.push_back(std::move(e));
   }
   return entries;
+}
+
+// "" when `got` matches `want`, else what differs.
+std::string ReferenceValues::Differs(const Entry& got, const Entry& want, double abs_tol,
+                                     double rel_tol) const {
+  if (got.label != want.label || got.exact != want.exact || got.text != want.text ||
+      got.values.size() != want.values.size()) {
+    return want.label + ": reference " + want.text + ", got " + got.label + " " +
+           got.text;
+  }
+  const double tol = abs_tol + rel_tol * std::max(got.scale, want.scale);
+  for (size_t i = 0; i < got.values.size(); ++i) {
+    const double diff = std::abs(got.values[i] - want.values[i]);
+    // Equal infinities pass; NaN never does.
+    if (!(got.values[i] == want.values[i] || diff <= tol)) {
+      return want.label + "[" + std::to_string(i) + "]: reference " +
+             Format(want.values[i]) + ", got " + Format(got.values[i]) + " (|diff| " +
+             Format(diff) + " > " + Format(tol) + ")";
+    }
+  }
+  return "";
 }
 
 ::testing::AssertionResult ReferenceValues::Compare(double abs_tol,
@@ -159,30 +186,17 @@ std::vector<ReferenceValues::Entry> ReferenceValues::ReadFile() const {
   }
   if (expected.size() != entries_.size()) {
     return ::testing::AssertionFailure() << Path() << ": " << expected.size()
-                                         << " values, the test gave " << entries_.size();
+                                         << " entries, the test gave " << entries_.size();
   }
   int differ = 0;
   std::ostringstream report;
   for (size_t i = 0; i < entries_.size(); ++i) {
-    const Entry& got = entries_[i];
-    const Entry& want = expected[i];
-    bool same = got.label == want.label && got.kind == want.kind;
-    double diff = 0, tol = 0;
-    if (same && got.kind == Entry::kExact) same = got.text == want.text;
-    if (same && got.kind == Entry::kNear) {
-      diff = std::abs(got.value - want.value);
-      tol = abs_tol + rel_tol * std::max(got.scale, want.scale);
-      same = got.value == want.value || diff <= tol;  // equal infinities; NaN differs
-    }
-    if (!same && ++differ <= 5) {
-      report << "\n  " << want.label << ": reference " << want.text << ", got "
-             << got.label << " " << got.text;
-      if (got.kind == Entry::kNear) report << " (|diff| " << diff << " > " << tol << ")";
-    }
+    const std::string problem = Differs(entries_[i], expected[i], abs_tol, rel_tol);
+    if (!problem.empty() && ++differ <= 5) report << "\n  " << problem;
   }
   if (differ == 0) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure()
-         << Path() << ": " << differ << " of " << entries_.size() << " values differ"
+         << Path() << ": " << differ << " of " << entries_.size() << " entries differ"
          << report.str();
 }
 

@@ -41,17 +41,25 @@ TEST(BoardCalib, DexYcbLikeRigFromNoisyCornersMeetsTheAccuracyTargets) {
 }
 
 void AddRig(const Rig& rig, const std::string& label, testing::ReferenceValues* values) {
-  for (size_t c = 0; c < rig.size(); ++c) {
-    const std::string at = label + "." + rig[c].name;
-    values->Exact(at, rig[c].name).Near(at + ".params", rig[c].camera.params());
-    values->Near(at + ".cam_from_world", rig[c].cam_from_world);
+  std::string names;
+  std::vector<double> cameras;
+  for (const RigCamera& c : rig.cameras()) {
+    names += c.name + " ";
+    testing::AppendValues(c.camera.params(), &cameras);
+    testing::AppendValues(c.cam_from_world, &cameras);
   }
+  values->Exact(label + ".names", names).Near(label + ".cameras", cameras);
 }
 
-Eigen::MatrixXd Stack(const std::vector<Eigen::Vector2d>& points) {
-  Eigen::MatrixXd m(points.size(), 2);
-  for (size_t i = 0; i < points.size(); ++i) m.row(i) = points[i].transpose();
-  return m;
+void AddPoses(const std::map<std::string, Rigid3>& poses, const std::string& label,
+              testing::ReferenceValues* values) {
+  std::string keys;
+  std::vector<double> flat;
+  for (const auto& [key, pose] : poses) {
+    keys += key + " ";
+    testing::AppendValues(pose, &flat);
+  }
+  values->Exact(label + ".keys", keys).Near(label, flat);
 }
 
 // Three cameras, twelve frames (seed 11).
@@ -81,46 +89,48 @@ testing::ReferenceValues BoardCalibValues() {
   SyntheticBoardCapture capture = ThreeCameraCapture();
   testing::ReferenceValues values("board_calib_three_cameras");
   AddRig(capture.rig, "synthetic", &values);
-  for (const auto& [key, pose] : capture.world_from_board) values.Near(key, pose);
+  AddPoses(capture.world_from_board, "synthetic.world_from_board", &values);
   for (const CameraBoardViews& v : capture.views) {
-    values.Exact(v.name + ".width", v.width).Exact(v.name + ".height", v.height);
+    values.Exact(v.name + ".size", std::vector<int>{v.width, v.height});
+    std::vector<int> ids;
+    std::vector<double> pixels;
     for (const auto& [key, obs] : v.frames) {
-      values.Exact(v.name + "." + key + ".ids", obs.ids);
-      values.Near(v.name + "." + key + ".pixels", Stack(obs.pixels));
+      ids.insert(ids.end(), obs.ids.begin(), obs.ids.end());
+      for (const Eigen::Vector2d& p : obs.pixels) testing::AppendValues(p, &pixels);
     }
+    values.Exact(v.name + ".ids", ids).Near(v.name + ".pixels", pixels);
   }
   MoveOneCorner(&capture);
 
   const InitialCamera initial =
       InitialIntrinsics(capture.views[0], kBoard, CameraModelId::kOpenCV);
   values.Near("initial.params", initial.camera.params());
-  for (const auto& [key, pose] : initial.cam_from_board)
-    values.Near("initial." + key, pose);
+  AddPoses(initial.cam_from_board, "initial.cam_from_board", &values);
   values.Near("initial.rms_px", initial.rms_px);
 
   const BoardCalibResult result = CalibrateInBoardWorld(capture.views);
   AddRig(result.rig, "calibrated", &values);
   values.Exact("world", result.world).Near("rms_px", result.rms_px);
-  for (const auto& [key, pose] : result.world_from_board) values.Near(key, pose);
+  AddPoses(result.world_from_board, "calibrated.world_from_board", &values);
   for (const CameraCalibStats& s : result.stats) {
-    values.Exact(s.name + ".frames", s.frames)
-        .Exact(s.name + ".observations", s.observations);
-    values.Exact(s.name + ".outliers", s.outliers).Near(s.name + ".rms_px", s.rms_px);
-    values.Near(s.name + ".initial_rms_px", s.initial_rms_px);
+    values.Exact(s.name + ".counts",
+                 std::vector<int>{s.frames, s.observations, s.outliers});
+    values.Near(s.name + ".rms_px", std::vector<double>{s.rms_px, s.initial_rms_px});
   }
-  std::vector<Eigen::Vector2d> observed, residual;
   std::vector<int> corner;
+  std::vector<double> observed, residual;
   for (const CornerResidual& r : result.residuals) {
     corner.insert(corner.end(), {r.camera, r.corner_id, r.inlier ? 1 : 0});
-    observed.push_back(r.observed);
-    residual.push_back(r.residual);
+    testing::AppendValues(r.observed, &observed);
+    testing::AppendValues(r.residual, &residual);
   }
   values.Exact("residuals.camera_corner_inlier", corner);
-  values.Near("residuals.observed", Stack(observed));
-  values.Near("residuals.residual", Stack(residual));
+  values.Near("residuals.observed", observed).Near("residuals.residual", residual);
+  std::string tree;
   for (const auto& [parent, child, weight] : result.tree) {
-    values.Exact("tree." + parent + "." + child, weight);
+    tree += parent + ">" + child + ":" + std::to_string(weight) + " ";
   }
+  values.Exact("tree", tree);
   return values;
 }
 

@@ -101,18 +101,60 @@ TEST(SynthScene, ObjectProbabilityMixesEmptyAndObjectFrames) {
   EXPECT_THROW(o.Check(), InputError);
 }
 
-void AddMesh(const RenderMesh& m, const std::string& label, testing::ReferenceValues* v) {
-  v->Near(label + ".vertices", m.vertices);
-  v->Exact(label + ".faces",
-           std::vector<int>(m.faces.data(), m.faces.data() + m.faces.size()));
-  v->Near(label + ".normals", m.normals).Near(label + ".colors", m.colors);
-  v->Near(label + ".color", m.color).Near(label + ".uvs", m.uvs);
+// A scene's values pooled by kind, so that each tolerance meets values of one scale.
+struct SceneValues {
+  std::vector<double> geometry;    // parameters, points and normals
+  std::vector<double> appearance;  // colours in [0, 1], texture coordinates, lights
+  std::vector<double> textures;    // 8-bit texels
+  std::vector<int> faces;
+};
+
+void AddMesh(const RenderMesh& m, SceneValues* v) {
+  testing::AppendValues(m.vertices, &v->geometry);
+  testing::AppendValues(m.normals, &v->geometry);
+  testing::AppendValues(m.colors, &v->appearance);
+  testing::AppendValues(m.color, &v->appearance);
+  testing::AppendValues(m.uvs, &v->appearance);
+  v->faces.insert(v->faces.end(), m.faces.data(), m.faces.data() + m.faces.size());
   if (m.texture) {
-    v->Exact(label + ".texture.width", m.texture->width);
-    v->Exact(label + ".texture.height", m.texture->height);
-    v->Near(label + ".texture",
-            std::vector<double>(m.texture->data.begin(), m.texture->data.end()));
+    v->faces.push_back(m.texture->width);
+    v->faces.push_back(m.texture->height);
+    testing::AppendValues(m.texture->data, &v->textures);
   }
+}
+
+void AddScene(const SynthScene& scene, const std::string& at,
+              testing::ReferenceValues* values) {
+  values->Exact(at + ".side", static_cast<int>(scene.side));
+  values->Exact(at + ".pose_kind", scene.pose_kind);
+  values->Exact(at + ".cameras_seeing_hand", scene.cameras_seeing_hand);
+  SceneValues v;
+  const HandParams& p = scene.params;
+  testing::AppendValues(p.global_orient, &v.geometry);
+  testing::AppendValues(p.hand_pose, &v.geometry);
+  testing::AppendValues(p.betas, &v.geometry);
+  testing::AppendValues(p.transl, &v.geometry);
+  testing::AppendValues(scene.hand.vertices, &v.geometry);
+  testing::AppendValues(scene.hand.joints, &v.geometry);
+  testing::AppendValues(scene.hand.keypoints, &v.geometry);
+  AddMesh(scene.hand_render, &v);
+  testing::AppendValues(scene.skin, &v.appearance);
+  testing::AppendValues(scene.lighting.ambient, &v.appearance);
+  for (const DirectionalLight& light : scene.lighting.lights) {
+    testing::AppendValues(light.direction_in_world, &v.appearance);
+    testing::AppendValues(light.color, &v.appearance);
+  }
+  std::string kinds;
+  for (const SynthObject& b : scene.objects) {
+    kinds += b.kind + "/" + std::to_string(b.texture_kind) + " ";
+    testing::AppendValues(b.size, &v.geometry);
+    testing::AppendValues(b.world_from_object, &v.geometry);
+    testing::AppendValues(b.color, &v.appearance);
+    AddMesh(b.mesh, &v);
+  }
+  values->Exact(at + ".objects", kinds).Exact(at + ".faces", v.faces);
+  values->Near(at + ".geometry", v.geometry).Near(at + ".appearance", v.appearance);
+  values->Near(at + ".textures", v.textures);
 }
 
 // A run of scenes (every pose kind, objects on and off).
@@ -124,35 +166,8 @@ testing::ReferenceValues SynthSceneValues() {
     o.objects = objects;
     std::mt19937_64 rng(objects ? 21 : 22);
     for (int i = 0; i < 25; ++i) {
-      const SynthScene scene =
-          SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, rng);
-      const std::string at = (objects ? "objects" : "empty") + std::to_string(i);
-      values.Exact(at + ".side", static_cast<int>(scene.side));
-      values.Exact(at + ".pose_kind", scene.pose_kind);
-      const HandParams& p = scene.params;
-      values.Near(at + ".global_orient", p.global_orient)
-          .Near(at + ".hand_pose", p.hand_pose);
-      values.Near(at + ".betas", p.betas).Near(at + ".transl", p.transl);
-      values.Near(at + ".vertices", scene.hand.vertices);
-      values.Near(at + ".joints", scene.hand.joints);
-      values.Near(at + ".keypoints", scene.hand.keypoints);
-      AddMesh(scene.hand_render, at + ".hand_render", &values);
-      values.Near(at + ".skin", scene.skin).Near(at + ".ambient", scene.lighting.ambient);
-      for (size_t l = 0; l < scene.lighting.lights.size(); ++l) {
-        const DirectionalLight& light = scene.lighting.lights[l];
-        values.Near(at + ".light" + std::to_string(l), light.direction_in_world);
-        values.Near(at + ".light" + std::to_string(l) + ".color", light.color);
-      }
-      for (size_t k = 0; k < scene.objects.size(); ++k) {
-        const SynthObject& b = scene.objects[k];
-        const std::string object = at + ".object" + std::to_string(k);
-        values.Exact(object, b.kind).Near(object + ".size", b.size);
-        values.Near(object + ".world_from_object", b.world_from_object);
-        values.Near(object + ".color", b.color)
-            .Exact(object + ".texture_kind", b.texture_kind);
-        AddMesh(b.mesh, object, &values);
-      }
-      values.Exact(at + ".cameras_seeing_hand", scene.cameras_seeing_hand);
+      AddScene(SampleSynthScene(s.model, s.anatomy, s.limits, s.rig, o, rng),
+               (objects ? "objects" : "empty") + std::to_string(i), &values);
     }
     values.Exact(objects ? "objects.next_draw" : "empty.next_draw",
                  static_cast<int64_t>(rng()));
