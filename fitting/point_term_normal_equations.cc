@@ -37,6 +37,14 @@ void PointTermNormalEquations::Accumulate(const double* point_jacobians, int n,
   using PointJacobian =
       Eigen::Map<const Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>>;
   const std::vector<int> points = UsedPoints();
+  // No point seen (every keypoint of every view at confidence 0: a frame where the
+  // detector found no hand): J^T J and J^T r are zero. Eigen's rank update of an empty
+  // matrix divides by its zero inner size (SIGFPE), so it is not called.
+  if (points.empty()) {
+    jtj->setZero(n, n);
+    jtr->setZero(n);
+    return;
+  }
   // Each H_i = M M^T (M from its eigen-decomposition; H_i is positive semi-definite),
   // so its rows of J^T J are those of M^T dX_i: 3 rows per point in one rank update.
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows(

@@ -326,6 +326,23 @@ TEST_F(CostGradientsTest, PriorsFoldedIntoTheKeypointTerm) {
   }
 }
 
+// Every keypoint of every view undetected (a frame where the detector found no hand):
+// the square-root form has no keypoint rows, as the plain cost has none (it used to end
+// the process with SIGFPE in Eigen's rank update of an empty matrix).
+TEST_F(CostGradientsTest, KeypointTermWithoutDetectedKeypoints) {
+  std::vector<KeypointView> views = frame_.views;
+  for (KeypointView& v : views) v.keypoints.confidence.setZero();
+  const RobustLoss loss{RobustLossType::kCauchy, 1.5};
+  MultiViewKeypointSquareRootCost folded(evaluator_, views, loss, 1.0);
+  std::unique_ptr<ceres::CostFunction> keypoints(
+      MultiViewKeypointCost<>::Create(evaluator_, views, loss, 1.0));
+  Eigen::VectorXd r;
+  Eigen::MatrixXd j;
+  EvaluateFull(*keypoints, params_.Blocks(), &r, &j);
+  EXPECT_EQ(r.squaredNorm(), 0.0);
+  ExpectSameGaussNewton(r, j, folded, params_.Blocks());
+}
+
 TEST_F(CostGradientsTest, Points3d) {
   Points3dTargets targets;
   targets.keypoints = frame_.mesh.keypoints;
