@@ -205,6 +205,43 @@ CeresHandFitter::CeresHandFitter(const HandModel& model, const HandFitConfig& co
 
 namespace {
 
+// Throws InputError unless the masks and occluder masks come one per view (or not at
+// all).
+void CheckMaskCounts(const HandFitInput& input) {
+  if (!input.masks.empty() && input.masks.size() != input.views.size()) {
+    throw InputError("HandFitInput", "masks",
+                     std::to_string(input.views.size()) + " masks (one per view) or none",
+                     std::to_string(input.masks.size()));
+  }
+  if (!input.occluder_masks.empty() &&
+      input.occluder_masks.size() != input.views.size()) {
+    throw InputError("HandFitInput", "occluder_masks",
+                     std::to_string(input.views.size()) + " masks (one per view) or none",
+                     std::to_string(input.occluder_masks.size()));
+  }
+}
+
+// What one Fit() carries from stage to stage.
+struct FitState {
+  explicit FitState(const HandFitInput& input) : input(input) {}
+  const HandFitInput& input;
+  Blocks blocks;              // the parameters being solved
+  Blocks previous;            // input.previous, for the temporal term
+  bool use_kp = false;        // 2D keypoints
+  bool use_3d = false;        // 3D targets
+  bool use_temporal = false;  // pull towards input.previous
+  bool use_sil = false;       // silhouettes (some mask, rounds > 0)
+  HandFitResult result;       // iterations, term costs etc. of the stages so far
+};
+
+// The silhouette term's views (those with a usable mask) and what it matches.
+struct SilhouetteEvidence {
+  std::vector<int> vertex_ids;  // vertices the term uses (every stride-th)
+  std::vector<SilhouetteView> views;
+  std::vector<MaskOutline> outlines;  // per view: samples of the mask's outline
+  std::vector<size_t> input_view;     // per view: its index in HandFitInput::views
+};
+
 // Everything the stages need, templated on the pose block size.
 template <int P>
 class FitRun {
@@ -318,187 +355,24 @@ class FitRun {
     }
   }
 
+  // The staged solve of fitting/ceres_hand_fitter.h from `init`.
   HandFitResult Fit(const HandFitInput& input, const HandParams& init) const {
     const auto start = std::chrono::steady_clock::now();
-    Blocks b = ToBlocks(init);
-    Blocks previous;
-    if (input.previous) previous = ToBlocks(*input.previous);
-    const bool use_kp = config_.use_keypoints && !input.views.empty();
-    const bool use_3d = config_.use_points3d && input.targets3d.has_value();
-    const bool use_temporal = config_.use_temporal && input.previous.has_value();
-    if (!input.masks.empty() && input.masks.size() != input.views.size()) {
-      throw InputError(
-          "HandFitInput", "masks",
-          std::to_string(input.views.size()) + " masks (one per view) or none",
-          std::to_string(input.masks.size()));
+    CheckMaskCounts(input);
+    FitState state = StartFit(input, init);
+    SolveRigid(&state);
+    SolveKeypoints(&state);
+    SilhouetteEvidence silhouettes = BuildSilhouetteViews(state);
+    state.result.view_mask_margin_px.assign(input.views.size(), kNaN);
+    // What the same fit without silhouettes gives, to check the silhouette fit against.
+    if (!silhouettes.views.empty()) {
+      state.result.keypoints_only = Evaluate(input, FromBlocks(state.blocks));
     }
-    if (!input.occluder_masks.empty() &&
-        input.occluder_masks.size() != input.views.size()) {
-      throw InputError(
-          "HandFitInput", "occluder_masks",
-          std::to_string(input.views.size()) + " masks (one per view) or none",
-          std::to_string(input.occluder_masks.size()));
-    }
-    bool use_sil = false;
-    for (const MaskImage& m : input.masks) use_sil |= m.size() > 0;
-    use_sil &= config_.use_silhouettes && options_.silhouette_rounds > 0;
-
-    HandFitResult result;
-    // with_priors: the priors too, folded into the keypoint term when there is one.
-    auto add_evidence = [&](StageProblem* problem, bool with_priors) {
-      if (use_kp) {
-        auto* keypoints = new MultiViewKeypointSquareRootCost(
-            evaluator_, input.views, options_.keypoint_loss, options_.keypoint_sigma_px);
-        if (with_priors) {
-          ForEachPrior([&](const char* name, ceres::CostFunction* cost, int block) {
-            keypoints->folded()->Add(name, cost, block);
-          });
-        }
-        problem->AddFull("keypoints", keypoints, keypoints->folded());
-      } else if (with_priors) {
-        AddPriors(problem, &b);
-      }
-      if (use_3d) {
-        problem->AddFull("points3d",
-                         Points3dCost<P, kBetas>::Create(evaluator_, *input.targets3d,
-                                                         options_.points3d_sigma_m));
-      }
-    };
-    auto add_temporal = [&](StageProblem* problem) {
-      if (!use_temporal) return;
-      problem->Add("temporal",
-                   ParameterPriorCost<P>::Create(previous.pose.data(),
-                                                 options_.temporal_pose_sigma_rad),
-                   b.pose.data());
-      problem->Add("temporal",
-                   ParameterPriorCost<3>::Create(previous.transl,
-                                                 options_.temporal_transl_sigma_m),
-                   b.transl);
-    };
-    auto run = [&](StageProblem* problem, int iterations) {
-      const ceres::Solver::Summary s =
-          problem->Solve(SolverOptions(options_, iterations));
-      result.iterations += static_cast<int>(s.iterations.size()) - 1;
-      result.converged = IsDone(s);
-      result.message = s.message;
-      result.term_costs = problem->TermCosts();
-    };
-
-    // 1. Rigid: brings a far start (a flat hand, another frame's answer) into the
-    // keypoints' basin; a start already aligned to this frame's keypoints skips it.
-    if ((use_kp || use_3d) && options_.rigid_iterations > 0 &&
-        !(use_kp &&
-          MedianKeypointErrorPx(input.views, b) < options_.rigid_skip_below_px)) {
-      StageProblem problem(&b);
-      add_evidence(&problem, /*with_priors=*/false);
-      problem.Hold(b.pose.data());
-      problem.Hold(b.betas);
-      run(&problem, options_.rigid_iterations);
-    }
-    // 2. Pose and shape on keypoints.
-    auto full_problem = [&](StageProblem* problem) {
-      add_evidence(problem, /*with_priors=*/true);
-      add_temporal(problem);
-      if (!config_.optimise_shape) problem->Hold(b.betas);
-    };
-    if (options_.keypoint_iterations > 0) {
-      StageProblem problem(&b);
-      full_problem(&problem);
-      run(&problem, options_.keypoint_iterations);
-    }
-    // 3. With silhouettes: re-match outlines, solve; repeat.
-    std::vector<int> vertex_ids;
-    for (int v = 0; v < evaluator_.num_vertices();
-         v += options_.silhouette_vertex_stride) {
-      vertex_ids.push_back(v);
-    }
-    std::vector<SilhouetteView> sil_views;
-    std::vector<MaskOutline> outlines;
-    std::vector<size_t> sil_view_input;  // index into input.views
-    Points3d keypoint_stage_vertices;
-    if (use_sil) {
-      keypoint_stage_vertices.resize(evaluator_.num_vertices(), 3);
-      evaluator_.AllVertices(b.orient, b.pose.data(), b.betas, b.transl,
-                             keypoint_stage_vertices.data());
-      for (size_t v = 0; v < input.masks.size(); ++v) {
-        if (input.masks[v].size() == 0) continue;
-        SilhouetteView view;
-        view.camera = input.views[v].camera;
-        if (input.masks[v].rows() != view.camera.camera.height() ||
-            input.masks[v].cols() != view.camera.camera.width()) {
-          throw InputError("HandFitInput", "masks[" + std::to_string(v) + "]",
-                           "the camera's image size",
-                           std::to_string(input.masks[v].cols()) + "x" +
-                               std::to_string(input.masks[v].rows()));
-        }
-        const MaskImage* occluder = Occluder(input, v);
-        const PixelWindow window =
-            HandWindow(input.masks[v], view.camera, keypoint_stage_vertices,
-                       options_.silhouette_window_margin_px);
-        if (window.empty()) continue;  // no mask pixels, hand out of view
-        view.distance_to_mask = DistanceToMaskInWindow(input.masks[v], window, occluder);
-        view.distance_origin = Eigen::Vector2i(window.x0, window.y0);
-        if (!std::isfinite(view.distance_to_mask(0, 0))) continue;  // empty mask
-        view.one_sided = occluder == nullptr && input.unknown_occluders;
-        view.cap_px = options_.unknown_occluder_cap_px;
-        outlines.push_back(SampleMaskOutline(input.masks[v],
-                                             options_.silhouette_outline_samples,
-                                             occluder, options_.occluder_reach_px));
-        sil_views.push_back(std::move(view));
-        sil_view_input.push_back(v);
-      }
-    }
-    result.view_mask_margin_px.assign(input.views.size(), kNaN);
-    if (!sil_views.empty()) result.keypoints_only = Evaluate(input, FromBlocks(b));
-    for (int round = 0; !sil_views.empty() && round < options_.silhouette_rounds;
+    for (int round = 0; !silhouettes.views.empty() && round < options_.silhouette_rounds;
          ++round) {
-      // Outline samples are matched only to contour-generator vertices (normal nearly
-      // perpendicular to the viewing ray): matching interior vertices would pull them
-      // outwards and inflate the hand.
-      Points3d all(evaluator_.num_vertices(), 3);
-      evaluator_.AllVertices(b.orient, b.pose.data(), b.betas, b.transl, all.data());
-      const Points3d normals = ComputeVertexNormals(all, model_.faces);
-      for (size_t v = 0; v < sil_views.size(); ++v) {
-        const Eigen::Vector3d centre = sil_views[v].camera.CenterInWorld();
-        std::vector<Eigen::Vector2d> uv(vertex_ids.size());
-        std::vector<char> valid(vertex_ids.size());
-        for (size_t i = 0; i < vertex_ids.size(); ++i) {
-          const Eigen::Vector3d x = all.row(vertex_ids[i]).transpose();
-          const Eigen::Vector3d n = normals.row(vertex_ids[i]).transpose();
-          const double along = std::abs(n.dot((x - centre).normalized()));
-          valid[i] = n.squaredNorm() > 0.5 &&
-                     along < options_.silhouette_contour_cosine &&
-                     sil_views[v].camera.ProjectWorld(x, &uv[i]);
-        }
-        sil_views[v].outline_px = outlines[v].points;
-        sil_views[v].outline_normal = outlines[v].normals;
-        sil_views[v].outline_vertex = MatchOutlineToPoints(outlines[v], uv, valid);
-        if (options_.mask_margin_max_px > 0 && !sil_views[v].one_sided) {
-          const double margin =
-              std::clamp(EstimateMaskMargin(outlines[v], sil_views[v].outline_vertex, uv),
-                         -options_.mask_margin_max_px, options_.mask_margin_max_px);
-          sil_views[v].outline_px = ShiftedOutline(outlines[v], margin);
-          sil_views[v].inside_px = 0.5 + std::max(0.0, -margin);
-          result.view_mask_margin_px[sil_view_input[v]] = margin;
-        }
-      }
-      StageProblem problem(&b);
-      full_problem(&problem);
-      problem.AddFull("silhouette", MultiViewSilhouetteSquareRootCost::Create(
-                                        evaluator_, vertex_ids, sil_views,
-                                        options_.silhouette_sigma_px));
-      run(&problem, options_.silhouette_iterations);
+      SolveSilhouetteRound(&silhouettes, &state);
     }
-
-    const HandFitStageResult final_stage = Evaluate(input, FromBlocks(b));
-    result.params = final_stage.params;
-    result.vertices = final_stage.vertices;
-    result.keypoints = final_stage.keypoints;
-    result.view_rms_px = final_stage.view_rms_px;
-    result.view_iou = final_stage.view_iou;
-    result.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return result;
+    return MakeResult(&state, start);
   }
 
   // The posed hand of `params` and its agreement with the evidence per view.
@@ -584,6 +458,201 @@ class FitRun {
   }
 
  private:
+  // The start's blocks and which terms this input brings.
+  FitState StartFit(const HandFitInput& input, const HandParams& init) const {
+    FitState s(input);
+    s.blocks = ToBlocks(init);
+    if (input.previous) s.previous = ToBlocks(*input.previous);
+    s.use_kp = config_.use_keypoints && !input.views.empty();
+    s.use_3d = config_.use_points3d && input.targets3d.has_value();
+    s.use_temporal = config_.use_temporal && input.previous.has_value();
+    for (const MaskImage& m : input.masks) s.use_sil |= m.size() > 0;
+    s.use_sil &= config_.use_silhouettes && options_.silhouette_rounds > 0;
+    return s;
+  }
+
+  // The keypoints and 3D targets; with_priors: the priors too, folded into the keypoint
+  // term when there is one.
+  void AddEvidence(StageProblem* problem, FitState* s, bool with_priors) const {
+    if (s->use_kp) {
+      auto* keypoints = new MultiViewKeypointSquareRootCost(
+          evaluator_, s->input.views, options_.keypoint_loss, options_.keypoint_sigma_px);
+      if (with_priors) {
+        ForEachPrior([&](const char* name, ceres::CostFunction* cost, int block) {
+          keypoints->folded()->Add(name, cost, block);
+        });
+      }
+      problem->AddFull("keypoints", keypoints, keypoints->folded());
+    } else if (with_priors) {
+      AddPriors(problem, &s->blocks);
+    }
+    if (s->use_3d) {
+      problem->AddFull("points3d",
+                       Points3dCost<P, kBetas>::Create(evaluator_, *s->input.targets3d,
+                                                       options_.points3d_sigma_m));
+    }
+  }
+  // The pull of pose and transl towards input.previous.
+  void AddTemporal(StageProblem* problem, FitState* s) const {
+    if (!s->use_temporal) return;
+    problem->Add("temporal",
+                 ParameterPriorCost<P>::Create(s->previous.pose.data(),
+                                               options_.temporal_pose_sigma_rad),
+                 s->blocks.pose.data());
+    problem->Add("temporal",
+                 ParameterPriorCost<3>::Create(s->previous.transl,
+                                               options_.temporal_transl_sigma_m),
+                 s->blocks.transl);
+  }
+  // Everything but the silhouettes, pose and shape free: the problem of the keypoint
+  // stage, which each silhouette round extends.
+  void AddPoseAndShapeTerms(StageProblem* problem, FitState* s) const {
+    AddEvidence(problem, s, /*with_priors=*/true);
+    AddTemporal(problem, s);
+    if (!config_.optimise_shape) problem->Hold(s->blocks.betas);
+  }
+  // Solves `problem`: iterations add up over the stages; convergence, message and term
+  // costs are the last stage's.
+  void RunStage(StageProblem* problem, int iterations, HandFitResult* result) const {
+    const ceres::Solver::Summary s = problem->Solve(SolverOptions(options_, iterations));
+    result->iterations += static_cast<int>(s.iterations.size()) - 1;
+    result->converged = IsDone(s);
+    result->message = s.message;
+    result->term_costs = problem->TermCosts();
+  }
+
+  // 1. Rigid: brings a far start (a flat hand, another frame's answer) into the
+  // keypoints' basin; a start already aligned to this frame's keypoints skips it.
+  void SolveRigid(FitState* s) const {
+    if ((s->use_kp || s->use_3d) && options_.rigid_iterations > 0 &&
+        !(s->use_kp && MedianKeypointErrorPx(s->input.views, s->blocks) <
+                           options_.rigid_skip_below_px)) {
+      StageProblem problem(&s->blocks);
+      AddEvidence(&problem, s, /*with_priors=*/false);
+      problem.Hold(s->blocks.pose.data());
+      problem.Hold(s->blocks.betas);
+      RunStage(&problem, options_.rigid_iterations, &s->result);
+    }
+  }
+
+  // 2. Pose and shape on keypoints.
+  void SolveKeypoints(FitState* s) const {
+    if (options_.keypoint_iterations > 0) {
+      StageProblem problem(&s->blocks);
+      AddPoseAndShapeTerms(&problem, s);
+      RunStage(&problem, options_.keypoint_iterations, &s->result);
+    }
+  }
+
+  // 3. The views whose masks the silhouette rounds fit: each one's distance transform
+  // (in a window around the mask and the hand after the keypoint stages) and outline
+  // samples. Views without mask pixels or with the hand out of view are left out.
+  SilhouetteEvidence BuildSilhouetteViews(const FitState& s) const {
+    const HandFitInput& input = s.input;
+    SilhouetteEvidence sil;
+    for (int v = 0; v < evaluator_.num_vertices();
+         v += options_.silhouette_vertex_stride) {
+      sil.vertex_ids.push_back(v);
+    }
+    if (!s.use_sil) return sil;
+    Points3d keypoint_stage_vertices(evaluator_.num_vertices(), 3);
+    evaluator_.AllVertices(s.blocks.orient, s.blocks.pose.data(), s.blocks.betas,
+                           s.blocks.transl, keypoint_stage_vertices.data());
+    for (size_t v = 0; v < input.masks.size(); ++v) {
+      if (input.masks[v].size() == 0) continue;
+      SilhouetteView view;
+      view.camera = input.views[v].camera;
+      if (input.masks[v].rows() != view.camera.camera.height() ||
+          input.masks[v].cols() != view.camera.camera.width()) {
+        throw InputError("HandFitInput", "masks[" + std::to_string(v) + "]",
+                         "the camera's image size",
+                         std::to_string(input.masks[v].cols()) + "x" +
+                             std::to_string(input.masks[v].rows()));
+      }
+      const MaskImage* occluder = Occluder(input, v);
+      const PixelWindow window =
+          HandWindow(input.masks[v], view.camera, keypoint_stage_vertices,
+                     options_.silhouette_window_margin_px);
+      if (window.empty()) continue;  // no mask pixels, hand out of view
+      view.distance_to_mask = DistanceToMaskInWindow(input.masks[v], window, occluder);
+      view.distance_origin = Eigen::Vector2i(window.x0, window.y0);
+      if (!std::isfinite(view.distance_to_mask(0, 0))) continue;  // empty mask
+      view.one_sided = occluder == nullptr && input.unknown_occluders;
+      view.cap_px = options_.unknown_occluder_cap_px;
+      sil.outlines.push_back(SampleMaskOutline(input.masks[v],
+                                               options_.silhouette_outline_samples,
+                                               occluder, options_.occluder_reach_px));
+      sil.views.push_back(std::move(view));
+      sil.input_view.push_back(v);
+    }
+    return sil;
+  }
+
+  // Matches each view's outline samples to the hand of `b`, and takes out the view's
+  // mask margin (HandFitOptions::mask_margin_max_px), noted in `view_mask_margin_px`.
+  void RematchOutlines(const Blocks& b, SilhouetteEvidence* sil,
+                       std::vector<double>* view_mask_margin_px) const {
+    // Outline samples are matched only to contour-generator vertices (normal nearly
+    // perpendicular to the viewing ray): matching interior vertices would pull them
+    // outwards and inflate the hand.
+    const std::vector<int>& vertex_ids = sil->vertex_ids;
+    Points3d all(evaluator_.num_vertices(), 3);
+    evaluator_.AllVertices(b.orient, b.pose.data(), b.betas, b.transl, all.data());
+    const Points3d normals = ComputeVertexNormals(all, model_.faces);
+    for (size_t v = 0; v < sil->views.size(); ++v) {
+      SilhouetteView& view = sil->views[v];
+      const MaskOutline& outline = sil->outlines[v];
+      const Eigen::Vector3d centre = view.camera.CenterInWorld();
+      std::vector<Eigen::Vector2d> uv(vertex_ids.size());
+      std::vector<char> valid(vertex_ids.size());
+      for (size_t i = 0; i < vertex_ids.size(); ++i) {
+        const Eigen::Vector3d x = all.row(vertex_ids[i]).transpose();
+        const Eigen::Vector3d n = normals.row(vertex_ids[i]).transpose();
+        const double along = std::abs(n.dot((x - centre).normalized()));
+        valid[i] = n.squaredNorm() > 0.5 && along < options_.silhouette_contour_cosine &&
+                   view.camera.ProjectWorld(x, &uv[i]);
+      }
+      view.outline_px = outline.points;
+      view.outline_normal = outline.normals;
+      view.outline_vertex = MatchOutlineToPoints(outline, uv, valid);
+      if (options_.mask_margin_max_px > 0 && !view.one_sided) {
+        const double margin =
+            std::clamp(EstimateMaskMargin(outline, view.outline_vertex, uv),
+                       -options_.mask_margin_max_px, options_.mask_margin_max_px);
+        view.outline_px = ShiftedOutline(outline, margin);
+        view.inside_px = 0.5 + std::max(0.0, -margin);
+        (*view_mask_margin_px)[sil->input_view[v]] = margin;
+      }
+    }
+  }
+
+  // 3. One silhouette round: outlines re-matched to the current fit, then the keypoint
+  // stage's problem with the silhouette term added.
+  void SolveSilhouetteRound(SilhouetteEvidence* sil, FitState* s) const {
+    RematchOutlines(s->blocks, sil, &s->result.view_mask_margin_px);
+    StageProblem problem(&s->blocks);
+    AddPoseAndShapeTerms(&problem, s);
+    problem.AddFull("silhouette", MultiViewSilhouetteSquareRootCost::Create(
+                                      evaluator_, sil->vertex_ids, sil->views,
+                                      options_.silhouette_sigma_px));
+    RunStage(&problem, options_.silhouette_iterations, &s->result);
+  }
+
+  // The stages' report with the final hand and its agreement with the evidence.
+  HandFitResult MakeResult(FitState* s,
+                           std::chrono::steady_clock::time_point start) const {
+    HandFitResult result = std::move(s->result);
+    const HandFitStageResult final_stage = Evaluate(s->input, FromBlocks(s->blocks));
+    result.params = final_stage.params;
+    result.vertices = final_stage.vertices;
+    result.keypoints = final_stage.keypoints;
+    result.view_rms_px = final_stage.view_rms_px;
+    result.view_iou = final_stage.view_iou;
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
+
   const HandModel& model_;
   const HandEvaluator& evaluator_;
   const HandAnatomy& anatomy_;
