@@ -200,7 +200,7 @@ TEST(TfliteMediapipeModels, PalmDetectorFindsTheRenderedPalm) {
 // Not a test: writes inputs and our outputs for the peer check against TFLite's own
 // runtime (tests/detector/tflite_peer_parity.mjs; docs/model-card-mediapipe-hands.md):
 //   HANDLABEL_TFLITE_PARITY_DIR=/tmp/parity [HANDLABEL_TFLITE_PARITY_IMAGES=a.jpg:b.png]
-//     build/tests/network_tests --gtest_also_run_disabled_tests
+//     build/tests/detector_tests --gtest_also_run_disabled_tests
 //     --gtest_filter='*WritePeerParityFiles'   (one command line)
 // Inputs: the rendered hand, seeded noise, grey, and the listed images, each resized
 // (nearest) to the model's input; files in_<size>_<name>.bin (float32 NHWC) and

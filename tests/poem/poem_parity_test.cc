@@ -32,7 +32,7 @@ OracleRun RunOracle(const PoemConfig& config, int batch, int seed) {
   const std::string cfg = run.dir + "/config.json";
   std::ofstream(cfg) << config.ToJson();
   const std::string script =
-      std::string(HANDLABEL_SOURCE_DIR) + "/tests/network/poem_oracle.py";
+      std::string(HANDLABEL_SOURCE_DIR) + "/tests/poem/poem_oracle.py";
   const std::string cmd = "/usr/bin/python3 " + script + " --config " + cfg + " --out " +
                           run.dir + " --seed " + std::to_string(seed) + " --batch " +
                           std::to_string(batch) + " > " + run.dir + "/oracle.log 2>&1";
@@ -149,7 +149,7 @@ TEST(PoemParity, ReleasedStateDictKeysAndShapesMatchOracle) {
   std::ofstream(dir + "/config.json")
       << ReleasedPoemConfig(PoemDataset::kDexYCB).ToJson();
   const std::string cmd = "/usr/bin/python3 " + std::string(HANDLABEL_SOURCE_DIR) +
-                          "/tests/network/poem_oracle.py --shapes-only --config " + dir +
+                          "/tests/poem/poem_oracle.py --shapes-only --config " + dir +
                           "/config.json --out " + dir + " > " + dir + "/oracle.log 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0)
       << "the Python oracle failed (needs /usr/bin/python3 with torch)";

@@ -46,7 +46,7 @@ from collections import OrderedDict
 import numpy as np
 from PIL import Image
 
-# SNAP keypoint k is MANO (+ tips) keypoint SNAP_FROM_NATIVE[k] (core/hand_model.h).
+# SNAP keypoint k is MANO (+ tips) keypoint SNAP_FROM_NATIVE[k] (hand/hand_model.h).
 SNAP_FROM_NATIVE = [0, 13, 14, 15, 16, 1, 2, 3, 17, 4, 5, 6, 18, 10, 11, 12, 19, 7, 8, 9, 20]
 GL_FROM_CV = np.diag([1.0, -1.0, -1.0])  # OpenGL camera axes from OpenCV's
 

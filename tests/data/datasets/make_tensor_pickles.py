@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes the torch-tensor pickles of tests/core/pickle_reader_test.cc: tensors pickled
+"""Writes the torch-tensor pickles of tests/formats/pickle_reader_test.cc: tensors pickled
 with plain pickle (as OakInk's anno/general_info/*.pkl hold them), whose storages are
 torch.storage._load_from_bytes(<torch.save bytes>), in the legacy form torch writes
 and in the zip form; plus hostile variants. Needs Debian's python3-torch.

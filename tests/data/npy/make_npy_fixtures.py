@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Writes small .npy / .npz / zip files with numpy, zipfile and torch, for the C++
-readers' tests (tests/core/npy_test.cc, zip_test.cc, pickle_reader_test.cc).
+readers' tests (tests/formats/npy_test.cc, zip_test.cc, pickle_reader_test.cc).
 
 Run with /usr/bin/python3 (Debian numpy; torch optional):
     /usr/bin/python3 make_npy_fixtures.py
