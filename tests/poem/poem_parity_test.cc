@@ -15,11 +15,15 @@
 #include "poem/poem_loss.h"
 #include "poem/poem_model.h"
 #include "poem/poem_modules.h"
+#include "tests/poem/poem_test_util.h"
 #include "tests/poem/tensor_bundle.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
 namespace {
+
+using testing::ExpectDecoderCoordsNear;
+using testing::MaxAbsDiff;
 
 struct OracleRun {
   std::map<std::string, torch::Tensor> weights, inputs, outputs, targets, losses;
@@ -54,12 +58,6 @@ OracleRun RunOracle(const PoemConfig& config, int batch, int seed) {
   return run;
 }
 
-double MaxAbsDiff(const torch::Tensor& a, const torch::Tensor& b) {
-  EXPECT_EQ(a.sizes(), b.sizes());
-  if (a.sizes() != b.sizes()) return 1e30;
-  return (a.to(torch::kFloat64) - b.to(torch::kFloat64)).abs().max().item<double>();
-}
-
 // Returns the oracle's folder (with its torch.save checkpoint) for further checks.
 std::string ExpectParity(const PoemConfig& config, int batch, int seed) {
   at::set_num_threads(1);  // as the oracle
@@ -89,20 +87,7 @@ std::string ExpectParity(const PoemConfig& config, int batch, int seed) {
     EXPECT_EQ(out.points_inside_ball[i], ref.at("points_inside_ball")[i].item<int64_t>());
   }
   EXPECT_LT(MaxAbsDiff(out.sampled_points, ref.at("sampled_points")), 1e-6);
-  // A decoder point's neighbours are a k-nearest choice: where two distances differ by
-  // a rounding error, the folded norms or another CPU's kernels can pick the other one
-  // and move that point (and, a layer later, its neighbours) by a few 1e-4. On a Zen 3
-  // machine 3 of 4794 coordinates did in layer 0, 35 in layer 1. A wrong weight or order
-  // moves them all, so: nearly every coordinate to 1e-5, none beyond 1e-3.
-  for (int64_t l = 0; l < out.layer_coords.size(0); ++l) {
-    // MaxAbsDiff first: it checks the sizes, which the subtraction would broadcast.
-    const double max_diff = MaxAbsDiff(out.layer_coords[l], ref.at("layer_coords")[l]);
-    EXPECT_LT(max_diff, 1e-3) << "decoder layer " << l;
-    if (max_diff >= 1e30) continue;  // sizes differ
-    const torch::Tensor diff = (out.layer_coords[l] - ref.at("layer_coords")[l]).abs();
-    const double far_share = (diff > 1e-5).to(torch::kFloat64).mean().item<double>();
-    EXPECT_LT(far_share, 0.02) << "decoder layer " << l;
-  }
+  ExpectDecoderCoordsNear(out.layer_coords, ref.at("layer_coords"), 1e-5);
 
   // The training losses agree with the oracle's implementation of the reference's.
   PoemTargets t;
