@@ -5,6 +5,7 @@
 #include <random>
 
 #include "core/errors.h"
+#include "core/random.h"
 
 namespace handlabel {
 namespace {
@@ -34,33 +35,27 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// A uniform draw from `rng` (one fresh distribution per draw, as the seeds expect).
-auto UniformFrom(std::mt19937_64& rng) {
-  return [&rng](double lo, double hi) {
-    return std::uniform_real_distribution<double>(lo, hi)(rng);
-  };
-}
-
 // Cameras on a ring around the table looking at its centre, with OpenCV distortion.
 void AddRingCameras(const SyntheticBoardCaptureOptions& o, std::mt19937_64& rng,
                     SyntheticBoardCapture* capture) {
-  const auto uniform = UniformFrom(rng);
   for (int c = 0; c < o.num_cameras; ++c) {
-    const double azimuth = 2 * kPi * c / o.num_cameras + uniform(-0.15, 0.15);
-    const double radius = uniform(o.ring_radius_min, o.ring_radius_max);
+    const double azimuth = 2 * kPi * c / o.num_cameras + Uniform(rng, -0.15, 0.15);
+    const double radius = Uniform(rng, o.ring_radius_min, o.ring_radius_max);
     const Eigen::Vector3d eye(radius * std::cos(azimuth), radius * std::sin(azimuth),
-                              uniform(o.height_min, o.height_max));
-    const Eigen::Vector3d target(uniform(-0.05, 0.05), uniform(-0.05, 0.05), 0.05);
-    const double f = uniform(600, 630);
+                              Uniform(rng, o.height_min, o.height_max));
+    const Eigen::Vector3d target(Uniform(rng, -0.05, 0.05), Uniform(rng, -0.05, 0.05),
+                                 0.05);
+    const double f = Uniform(rng, 600, 630);
     RigCamera rc;
     char name[16];
     std::snprintf(name, sizeof(name), "cam%d", c);
     rc.name = name;
     rc.camera =
         Camera(CameraModelId::kOpenCV, o.width, o.height,
-               {f, f * uniform(0.997, 1.003), o.width / 2.0 + uniform(-8, 8),
-                o.height / 2.0 + uniform(-8, 8), uniform(0.03, 0.1),
-                uniform(-0.15, -0.05), uniform(-0.001, 0.001), uniform(-0.001, 0.001)});
+               {f, f * Uniform(rng, 0.997, 1.003), o.width / 2.0 + Uniform(rng, -8, 8),
+                o.height / 2.0 + Uniform(rng, -8, 8), Uniform(rng, 0.03, 0.1),
+                Uniform(rng, -0.15, -0.05), Uniform(rng, -0.001, 0.001),
+                Uniform(rng, -0.001, 0.001)});
     rc.cam_from_world = LookAt(eye, target, Eigen::Vector3d::UnitZ());
     capture->rig.Add(rc);
     capture->views.push_back({rc.name, o.width, o.height, {}});
@@ -70,21 +65,20 @@ void AddRingCameras(const SyntheticBoardCaptureOptions& o, std::mt19937_64& rng,
 // Board poses lying on the table, tilted, seen by several cameras.
 void AddTableFrames(const BoardSpec& board, const SyntheticBoardCaptureOptions& o,
                     std::mt19937_64& rng, SyntheticBoardCapture* capture) {
-  const auto uniform = UniformFrom(rng);
   // A board lying printed side up has z (into the board) pointing down.
   Eigen::Matrix3d flat;
   flat << 1, 0, 0, 0, -1, 0, 0, 0, -1;
   const Eigen::Vector3d board_centre(board.Width() / 2, board.Height() / 2, 0);
   const double max_tilt = o.max_board_tilt_deg * kPi / 180;
   for (int f = 0; f < o.num_frames; ++f) {
-    const double tilt_axis = uniform(0, 2 * kPi);
+    const double tilt_axis = Uniform(rng, 0, 2 * kPi);
     const Eigen::Quaterniond rotation(
-        Eigen::AngleAxisd(uniform(0, max_tilt),
+        Eigen::AngleAxisd(Uniform(rng, 0, max_tilt),
                           Eigen::Vector3d(std::cos(tilt_axis), std::sin(tilt_axis), 0)) *
-        Eigen::AngleAxisd(uniform(0, 2 * kPi), Eigen::Vector3d::UnitZ()) *
+        Eigen::AngleAxisd(Uniform(rng, 0, 2 * kPi), Eigen::Vector3d::UnitZ()) *
         Eigen::Quaterniond(flat));
-    const Eigen::Vector3d centre(uniform(-0.12, 0.12), uniform(-0.12, 0.12),
-                                 uniform(0.02, 0.2));
+    const Eigen::Vector3d centre(Uniform(rng, -0.12, 0.12), Uniform(rng, -0.12, 0.12),
+                                 Uniform(rng, 0.02, 0.2));
     capture->world_from_board[FrameKey(f)] =
         Rigid3(rotation, centre - rotation * board_centre);
   }
@@ -93,7 +87,6 @@ void AddTableFrames(const BoardSpec& board, const SyntheticBoardCaptureOptions& 
 // Close-ups held in front of each camera (they pin its principal point down).
 void AddNearFrames(const BoardSpec& board, const SyntheticBoardCaptureOptions& o,
                    std::mt19937_64& rng, SyntheticBoardCapture* capture) {
-  const auto uniform = UniformFrom(rng);
   const Eigen::Vector3d board_centre(board.Width() / 2, board.Height() / 2, 0);
   for (size_t c = 0; c < capture->rig.size(); ++c) {
     const Rigid3 world_from_cam = capture->rig[c].cam_from_world.Inverse();
@@ -101,17 +94,18 @@ void AddNearFrames(const BoardSpec& board, const SyntheticBoardCaptureOptions& o
       // Board facing the camera (its z, into the board, along the optical axis), at
       // an offset that moves it around the image.
       const Eigen::Vector3d direction =
-          Eigen::Vector3d(uniform(-0.25, 0.25), uniform(-0.2, 0.2), 1.0).normalized();
+          Eigen::Vector3d(Uniform(rng, -0.25, 0.25), Uniform(rng, -0.2, 0.2), 1.0)
+              .normalized();
       const Eigen::Vector3d centre =
           world_from_cam *
-          (uniform(o.near_distance_min, o.near_distance_max) * direction);
+          (Uniform(rng, o.near_distance_min, o.near_distance_max) * direction);
       const double tilt = o.near_tilt_deg * kPi / 180;
       const Eigen::Quaterniond rotation =
           world_from_cam.rotation *
           Eigen::Quaterniond(
-              Eigen::AngleAxisd(uniform(-tilt, tilt), Eigen::Vector3d::UnitX()) *
-              Eigen::AngleAxisd(uniform(-tilt, tilt), Eigen::Vector3d::UnitY()) *
-              Eigen::AngleAxisd(uniform(-kPi, kPi), Eigen::Vector3d::UnitZ()));
+              Eigen::AngleAxisd(Uniform(rng, -tilt, tilt), Eigen::Vector3d::UnitX()) *
+              Eigen::AngleAxisd(Uniform(rng, -tilt, tilt), Eigen::Vector3d::UnitY()) *
+              Eigen::AngleAxisd(Uniform(rng, -kPi, kPi), Eigen::Vector3d::UnitZ()));
       char key[64];
       std::snprintf(key, sizeof(key), "near%zu_%02d", c, f);
       capture->world_from_board[key] = Rigid3(rotation, centre - rotation * board_centre);

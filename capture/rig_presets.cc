@@ -4,6 +4,7 @@
 #include <random>
 
 #include "core/errors.h"
+#include "core/random.h"
 
 namespace handlabel {
 namespace {
@@ -97,32 +98,29 @@ Camera ScaledCamera(const std::array<double, 4>& k, int native_w, int native_h, 
 
 Rig RandomRig(const RigPresetOptions& o, uint64_t seed) {
   std::mt19937_64 rng(seed ^ 0x5eedc0ffee123457ULL);
-  auto uniform = [&](double lo, double hi) {
-    return std::uniform_real_distribution<double>(lo, hi)(rng);
-  };
   const int w = o.width > 0 ? o.width : 640;
   const int h = o.height > 0 ? o.height : 480;
   Rig rig;
-  const double start = uniform(0, 360);
+  const double start = Uniform(rng, 0, 360);
   for (int i = 0; i < o.num_cameras; ++i) {
     Placement p;
     // Spread over the span with jitter so cameras do not bunch up.
     const double slot = o.azimuth_span_deg / o.num_cameras;
-    p.azimuth_deg = start + slot * (i + uniform(0.2, 0.8));
-    p.elevation_deg = uniform(o.min_elevation_deg, o.max_elevation_deg);
-    p.distance = uniform(o.min_distance, o.max_distance);
-    p.target =
-        Eigen::Vector3d(uniform(-0.03, 0.03), uniform(-0.03, 0.03), uniform(-0.02, 0.02));
-    const double fov = uniform(o.min_fov_deg, o.max_fov_deg) * kDeg;
+    p.azimuth_deg = start + slot * (i + Uniform(rng, 0.2, 0.8));
+    p.elevation_deg = Uniform(rng, o.min_elevation_deg, o.max_elevation_deg);
+    p.distance = Uniform(rng, o.min_distance, o.max_distance);
+    p.target = Eigen::Vector3d(Uniform(rng, -0.03, 0.03), Uniform(rng, -0.03, 0.03),
+                               Uniform(rng, -0.02, 0.02));
+    const double fov = Uniform(rng, o.min_fov_deg, o.max_fov_deg) * kDeg;
     const double fx = 0.5 * w / std::tan(0.5 * fov);
-    const double fy = fx * uniform(0.995, 1.005);
-    const double cx = 0.5 * w - 0.5 + uniform(-0.02, 0.02) * w;
-    const double cy = 0.5 * h - 0.5 + uniform(-0.02, 0.02) * h;
+    const double fy = fx * Uniform(rng, 0.995, 1.005);
+    const double cx = 0.5 * w - 0.5 + Uniform(rng, -0.02, 0.02) * w;
+    const double cy = 0.5 * h - 0.5 + Uniform(rng, -0.02, 0.02) * h;
     Camera camera;
     if (o.distortion) {
       camera = Camera(CameraModelId::kOpenCV, w, h,
-                      {fx, fy, cx, cy, uniform(-0.3, 0.1), uniform(-0.05, 0.1),
-                       uniform(-0.002, 0.002), uniform(-0.002, 0.002)},
+                      {fx, fy, cx, cy, Uniform(rng, -0.3, 0.1), Uniform(rng, -0.05, 0.1),
+                       Uniform(rng, -0.002, 0.002), Uniform(rng, -0.002, 0.002)},
                       "random rig");
     } else {
       camera = Camera::Pinhole(fx, fy, cx, cy, w, h);

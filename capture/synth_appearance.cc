@@ -9,13 +9,10 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/random.h"
 
 namespace handlabel {
 namespace {
-
-double Uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
 
 float Smoothstep(float lo, float hi, float x) {
   const float t = std::clamp((x - lo) / (hi - lo), 0.0f, 1.0f);

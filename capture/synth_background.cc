@@ -5,12 +5,10 @@
 #include <cmath>
 #include <vector>
 
+#include "core/random.h"
+
 namespace handlabel {
 namespace {
-
-double Uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
 
 Eigen::Vector3f RandomColor(std::mt19937_64& rng) {
   return Eigen::Vector3f(Uniform(rng, 0, 1), Uniform(rng, 0, 1), Uniform(rng, 0, 1));

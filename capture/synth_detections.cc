@@ -5,15 +5,12 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/random.h"
 #include "image/distance_transform.h"
 #include "image/mask_image.h"
 
 namespace handlabel {
 namespace {
-
-double Uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
 
 // Square erosion (radius < 0) or dilation (radius > 0), separable.
 ImageU8 Morph(const ImageU8& mask, int radius) {

@@ -5,19 +5,13 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/random.h"
 #include "image/mesh_primitives.h"
 
 namespace handlabel {
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-
-double Uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(rng);
-}
-double Gaussian(std::mt19937_64& rng, double sigma) {
-  return std::normal_distribution<double>(0.0, sigma)(rng);
-}
 
 Eigen::Quaterniond RandomRotation(std::mt19937_64& rng) {
   Eigen::Vector4d q;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/random.h"
 
 namespace handlabel {
 
@@ -47,8 +48,7 @@ SynthView RenderSynthView(const SynthScene& scene, const RigCamera& camera,
                        : MakeBackground(w, h, options.background, background_rng);
   ShadeVisible(meshes, buffer, camera.cam_from_world, rays, scene.lighting, &view.rgb);
   if (realistic) {
-    const double noise = std::uniform_real_distribution<double>(
-        1.0, options.realistic.max_noise)(background_rng);
+    const double noise = Uniform(background_rng, 1.0, options.realistic.max_noise);
     ApplyCameraBlurAndNoise(options.realistic.blur, noise, background_rng, &view.rgb);
   }
   view.hand_mask = ImageU8(w, h, 1);

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "core/random.h"
 #include "geometry/rigid3.h"
 
 namespace handlabel::testing {
@@ -45,11 +46,9 @@ std::string ReadFileBytes(const std::string& path);
 std::map<std::string, std::string> FilesUnder(const std::string& dir);
 
 inline double Uniform(double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(TestRng());
+  return handlabel::Uniform(TestRng(), lo, hi);
 }
-inline double Gaussian(double sigma) {
-  return std::normal_distribution<double>(0.0, sigma)(TestRng());
-}
+inline double Gaussian(double sigma) { return handlabel::Gaussian(TestRng(), sigma); }
 inline Eigen::Vector3d RandomVector3(double lo, double hi) {
   return {Uniform(lo, hi), Uniform(lo, hi), Uniform(lo, hi)};
 }

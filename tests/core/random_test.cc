@@ -65,5 +65,17 @@ TEST(Random, FrameSeedPartsMatchTheOldFormula) {
   EXPECT_EQ(Fnv1a64("a"), 0x44bd8ad473cd9906ull);
 }
 
+// The synthetic generators' draws as each file wrote them before core/random had them:
+// a fresh distribution per draw, so a Gaussian's unused second value is dropped.
+TEST(Random, DrawsMatchTheOldFreshDistributionPerDraw) {
+  std::mt19937_64 shared(7), old(7);
+  for (int i = 0; i < 50; ++i) {
+    EXPECT_EQ(Uniform(shared, -0.3, 2.5),
+              std::uniform_real_distribution<double>(-0.3, 2.5)(old));
+    EXPECT_EQ(Gaussian(shared, 0.2), std::normal_distribution<double>(0.0, 0.2)(old));
+  }
+  EXPECT_EQ(shared(), old());
+}
+
 }  // namespace
 }  // namespace handlabel
