@@ -26,7 +26,8 @@ int RunModelBuild(int argc, char** argv) {
   std::string side = "right", out;
   OpenHandBuildOptions options;
   app.add_option("--side", side, "right or left (the left hand is the exact mirror)")
-      ->check(CLI::IsMember({"left", "right"}));
+      ->check(
+          CLI::IsMember({HandSideName(HandSide::kLeft), HandSideName(HandSide::kRight)}));
   app.add_option("--out", out, "model file to write (.npz)")->required();
   app.add_option("--seed", options.seed, "seed of the shape and pose sampling")
       ->capture_default_str();
@@ -44,7 +45,7 @@ int RunModelBuild(int argc, char** argv) {
       ->capture_default_str();
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("model build", [&] {
-    options.side = side == "left" ? HandSide::kLeft : HandSide::kRight;
+    options.side = ParseHandSide(side, "--side", "value");
     OpenHandBuildReport report;
     const HandModel model = BuildOpenHand(DefaultOpenHandDesign(), options, &report);
     SaveHandModel(model, out);

@@ -43,7 +43,7 @@ void PrintInfo(const std::string& path, const LoadedHandModel& loaded,
   out << "file:          " << path << "\n"
       << "format:        " << HandModelFormatName(loaded.format) << "\n"
       << "name:          " << m.name << "\n"
-      << "side:          " << (m.side == HandSide::kLeft ? "left" : "right") << "\n"
+      << "side:          " << HandSideName(m.side) << "\n"
       << "vertices:      " << m.num_vertices() << "\n"
       << "faces:         " << m.num_faces() << "\n"
       << "joints:        " << kNumHandJoints << " (+5 fingertips = 21 keypoints)\n"
@@ -132,9 +132,9 @@ int RunModelConvert(int argc, char** argv) {
     const std::string changes = ApplyModelFileFlags(flags, &loaded.model);
     SaveHandModel(loaded.model, out);
     std::cout << "wrote " << out << " (" << loaded.model.name << ", "
-              << (loaded.model.side == HandSide::kLeft ? "left" : "right") << ", "
-              << loaded.model.num_vertices() << " vertices, from "
-              << HandModelFormatName(loaded.format) << changes << ")\n";
+              << HandSideName(loaded.model.side) << ", " << loaded.model.num_vertices()
+              << " vertices, from " << HandModelFormatName(loaded.format) << changes
+              << ")\n";
     return 0;
   });
 }

@@ -20,7 +20,8 @@ struct ModelFileFlags {
     app.add_option("--side", side,
                    "side for files that do not record it (MANO pickles, smplx npz); "
                    "default: from the file name (MANO_LEFT / MANO_RIGHT)")
-        ->check(CLI::IsMember({"left", "right"}));
+        ->check(CLI::IsMember(
+            {HandSideName(HandSide::kLeft), HandSideName(HandSide::kRight)}));
     app.add_option("--tips", tips,
                    "fingertip vertex ids thumb,index,middle,ring,pinky for files without "
                    "them; default for 778-vertex MANO: 745,317,444,556,673 (manopth)")
@@ -30,7 +31,7 @@ struct ModelFileFlags {
 
   HandModelLoadOptions Options() const {
     HandModelLoadOptions options;
-    if (!side.empty()) options.side = side == "left" ? HandSide::kLeft : HandSide::kRight;
+    if (!side.empty()) options.side = ParseHandSide(side, "--side", "value");
     if (!tips.empty()) {
       std::array<int, 5> t;
       std::copy(tips.begin(), tips.end(), t.begin());

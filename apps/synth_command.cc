@@ -85,16 +85,13 @@ int RunSynth(int argc, char** argv) {
       o.rig.width = w;
       o.rig.height = h;
     }
-    if (side != "right" && side != "left") {
-      throw InputError("--side", "value", "right or left", side);
-    }
+    const HandSide hand_side = ParseHandSide(side, "--side", "value");
     o.scene.objects = objects;
     o.write_detections = !no_detections;
     o.view.background.clutter = !no_clutter;
     o.view.appearance = SynthAppearanceFromName(appearance, "--appearance", "value");
     o.Check();
-    const ResolvedHandModel hand =
-        ResolveHandModel(hand_model, side == "left" ? HandSide::kLeft : HandSide::kRight);
+    const ResolvedHandModel hand = ResolveHandModel(hand_model, hand_side);
     if (!hand.note.empty()) std::cerr << "handlabel synth: note: " << hand.note << "\n";
     Progress progress(o.num_frames, std::cerr, Progress::IsTerminal(STDERR_FILENO),
                       "synth");

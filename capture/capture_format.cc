@@ -81,9 +81,7 @@ CaptureManifest ManifestFromJson(const json& j, const std::string& source) {
   if (j.contains("world")) m.world = JsonString(j, "world", source);
   if (j.contains("hand_side")) {
     m.hand_side = JsonString(j, "hand_side", source);
-    if (m.hand_side != "right" && m.hand_side != "left") {
-      throw InputError(source, "hand_side", "\"right\" or \"left\"", m.hand_side);
-    }
+    ParseHandSide(m.hand_side, source, "hand_side");  // refuses other spellings
   }
   if (j.contains("generator")) m.generator = j["generator"];
   return m;

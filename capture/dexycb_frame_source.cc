@@ -124,16 +124,14 @@ DexYcbSequence ReadDexYcbSequence(const std::string& dir) {
   if (seq.num_frames < 1)
     throw InputError(m, "num_frames", "an integer >= 1", Shown(frames));
   const YAML::Node sides = meta["mano_sides"];
-  const std::string side =
-      sides && sides.IsSequence() && sides.size() > 0 && sides[0].IsScalar()
-          ? sides[0].Scalar()
-          : "";
-  if (side != "right" && side != "left") {
-    throw InputError(
-        m, "mano_sides", "a list whose first entry is right or left",
-        sides && sides.IsSequence() && sides.size() > 0 ? Shown(sides[0]) : Shown(sides));
+  const bool listed = sides && sides.IsSequence() && sides.size() > 0;
+  const std::optional<HandSide> side =
+      listed && sides[0].IsScalar() ? HandSideFromName(sides[0].Scalar()) : std::nullopt;
+  if (!side) {
+    throw InputError(m, "mano_sides", "a list whose first entry is right or left",
+                     listed ? Shown(sides[0]) : Shown(sides));
   }
-  seq.side = side == "left" ? HandSide::kLeft : HandSide::kRight;
+  seq.side = *side;
   seq.rig = ReadDatasetRig("dexycb", m);  // serials + <root>/calibration
   for (const RigCamera& camera : seq.rig.cameras()) {
     if (!fs::is_directory(fs::path(dir) / camera.name)) {
@@ -191,7 +189,7 @@ DexYcbFrameSource::DexYcbFrameSource(const std::string& path,
       throw InputError((dir / "meta.yml").string(), "mano_sides",
                        "the same hand as " + sequences_.front().dir +
                            " (one job labels one hand side; split the job)",
-                       seq.side == HandSide::kLeft ? "left" : "right");
+                       HandSideName(seq.side));
     }
     by_prefix_[seq.prefix] = sequences_.size();
     sequences_.push_back(std::move(seq));
@@ -221,8 +219,7 @@ std::string DexYcbFrameSource::Describe() const {
   return "DexYCB " + path_ + " (" + std::to_string(sequences_.size()) + " sequence" +
          (sequences_.size() == 1 ? "" : "s") + ", " +
          std::to_string(sequences_.front().rig.size()) + " cameras, " +
-         std::to_string(frames) + " frames, " +
-         (side() == HandSide::kLeft ? "left" : "right") +
+         std::to_string(frames) + " frames, " + HandSideName(sequences_.front().side) +
          " hand, 2D keypoints and ground truth keypoints: " +
          (labels ? "labels_*.npz" : "none") +
          ", hand and object masks: " + (labels ? "labels_*.npz seg" : "none") + ")";

@@ -68,7 +68,8 @@ std::string NativeFrameSource::KeypointsSource() const {
 }
 
 std::optional<HandSide> NativeFrameSource::side() const {
-  return reader_.manifest().hand_side == "left" ? HandSide::kLeft : HandSide::kRight;
+  return ParseHandSide(reader_.manifest().hand_side,
+                       reader_.dir() + "/" + kCaptureManifestFile, "hand_side");
 }
 
 FrameInput NativeFrameSource::Load(const std::string& id) const {

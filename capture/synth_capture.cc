@@ -177,7 +177,7 @@ CaptureManifest MakeManifest(const HandModel& model, const SynthCaptureOptions& 
   CaptureManifest manifest;
   manifest.colmap_dir = "colmap";
   manifest.world = "table frame: z up, origin at the workspace centre, metres";
-  manifest.hand_side = model.side == HandSide::kLeft ? "left" : "right";
+  manifest.hand_side = HandSideName(model.side);
   for (const RigCamera& cam : rig.cameras()) manifest.cameras.push_back(cam.name);
   for (int f = 0; f < options.num_frames; ++f) manifest.frames.push_back(FrameId(f));
   manifest.files[kFileImage] = "images/{camera}/{frame}.png";

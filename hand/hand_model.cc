@@ -19,6 +19,24 @@ void ExpectShape(const std::string& source, const char* field, Eigen::Index rows
 
 }  // namespace
 
+std::string HandSideName(HandSide side) {
+  return side == HandSide::kLeft ? "left" : "right";
+}
+
+std::optional<HandSide> HandSideFromName(const std::string& name) {
+  for (const HandSide side : {HandSide::kRight, HandSide::kLeft}) {
+    if (name == HandSideName(side)) return side;
+  }
+  return std::nullopt;
+}
+
+HandSide ParseHandSide(const std::string& text, const std::string& source,
+                       const std::string& field) {
+  const std::optional<HandSide> side = HandSideFromName(text);
+  if (!side) throw InputError(source, field, "\"right\" or \"left\"", text);
+  return *side;
+}
+
 void HandModel::Check(const std::string& source) const {
   const Eigen::Index v = v_template.rows();
   if (v < 4)

@@ -17,11 +17,20 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <array>
+#include <optional>
 #include <string>
 
 namespace handlabel {
 
 enum class HandSide { kRight, kLeft };
+
+// "right" or "left": the spelling of every file, flag and message that names a side.
+std::string HandSideName(HandSide side);
+// The side `name` spells (exactly "right" or "left"), or nullopt.
+std::optional<HandSide> HandSideFromName(const std::string& name);
+// As HandSideFromName, but anything else throws InputError(source, field, ...).
+HandSide ParseHandSide(const std::string& text, const std::string& source,
+                       const std::string& field);
 
 constexpr int kNumHandJoints = 16;     // MANO native joints
 constexpr int kNumHandKeypoints = 21;  // 16 joints + 5 fingertips

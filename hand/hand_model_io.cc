@@ -310,11 +310,7 @@ void ReadHandlabelMetadata(const Entries& entries, HandModel* m) {
                      "a version up to " + std::to_string(kHandModelFileVersion),
                      std::to_string(version[0]));
   }
-  const std::string side = entries.Text("handlabel_side");
-  if (side != "right" && side != "left") {
-    throw InputError(path, "handlabel_side", "'right' or 'left'", "'" + side + "'");
-  }
-  m->side = side == "left" ? HandSide::kLeft : HandSide::kRight;
+  m->side = ParseHandSide(entries.Text("handlabel_side"), path, "handlabel_side");
   m->name = entries.Text("handlabel_name");
   const std::vector<int64_t> tips = entries.Ints("handlabel_tip_vertex_ids", {5});
   for (int t = 0; t < 5; ++t) m->tip_vertex_ids[t] = static_cast<int>(tips[t]);
@@ -459,9 +455,7 @@ void SaveHandModel(const HandModel& model, const std::string& path) {
   arrays.emplace_back("bs_type", NdArray::FromText("lrotmin"));
   const int64_t version = kHandModelFileVersion;
   arrays.emplace_back("handlabel_version", IntArray({}, {version}));
-  arrays.emplace_back(
-      "handlabel_side",
-      NdArray::FromText(model.side == HandSide::kLeft ? "left" : "right"));
+  arrays.emplace_back("handlabel_side", NdArray::FromText(HandSideName(model.side)));
   arrays.emplace_back("handlabel_name", NdArray::FromText(model.name));
   arrays.emplace_back("handlabel_tip_vertex_ids",
                       IntArray({5}, std::vector<int64_t>(model.tip_vertex_ids.begin(),

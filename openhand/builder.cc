@@ -294,8 +294,7 @@ HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions
 HandModel MirrorHandModel(const HandModel& in) {
   HandModel out = in;
   out.side = in.side == HandSide::kRight ? HandSide::kLeft : HandSide::kRight;
-  const std::string from = in.side == HandSide::kRight ? "right" : "left";
-  const std::string to = in.side == HandSide::kRight ? "left" : "right";
+  const std::string from = HandSideName(in.side), to = HandSideName(out.side);
   const size_t at = out.name.rfind(from);
   if (at != std::string::npos) out.name.replace(at, from.size(), to);
   out.v_template.col(0) *= -1.0;

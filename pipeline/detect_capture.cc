@@ -18,10 +18,6 @@ namespace {
 
 constexpr char kDetectionsPattern[] = "detections/{frame}.json";
 
-std::string SideName(HandSide side) {
-  return side == HandSide::kRight ? "right" : "left";
-}
-
 // The capture's manifest with the detections kind listed (written atomically, last).
 void ListDetections(const CaptureReader& capture) {
   CaptureManifest manifest = capture.manifest();
@@ -74,7 +70,7 @@ nlohmann::json FrameDetectionsJson(const std::string& frame,
     if (r.detected) {
       jv["source"] = r.source;
       jv["presence"] = r.hand.presence;
-      jv["handedness"] = {{"side", SideName(r.hand.side())},
+      jv["handedness"] = {{"side", HandSideName(r.hand.side())},
                           {"score", r.hand.side_score()}};
       jv["median_reprojection_px"] = JsonNumberOrNull(r.median_reprojection_px);
     } else {
@@ -84,7 +80,7 @@ nlohmann::json FrameDetectionsJson(const std::string& frame,
   }
   out["detector"] = "mediapipe_hands";
   out["hand"] = {{"found", result.found},
-                 {"side", SideName(result.side)},
+                 {"side", HandSideName(result.side)},
                  {"side_score", result.side_score},
                  {"palm_views", result.palm_views}};
   return out;

@@ -55,7 +55,7 @@ nlohmann::json HandJson(const HandDetection& d) {
           {"handedness",
            {{"label", left_label ? "Left" : "Right"},
             {"score", h.side_score()},
-            {"side", h.side() == HandSide::kRight ? "right" : "left"}}}};
+            {"side", HandSideName(h.side())}}}};
 }
 
 }  // namespace

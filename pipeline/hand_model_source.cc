@@ -12,8 +12,6 @@
 namespace handlabel {
 namespace {
 
-const char* SideName(HandSide side) { return side == HandSide::kLeft ? "left" : "right"; }
-
 // A file given by flag, field or variable, checked against the side asked for.
 ResolvedHandModel FromFile(const std::string& path, std::optional<HandSide> side,
                            const HandModelOrigin& origin) {
@@ -34,8 +32,8 @@ ResolvedHandModel FromFile(const std::string& path, std::optional<HandSide> side
   }
   if (side && out.model.side != *side) {
     throw InputError(origin.source, origin.field,
-                     std::string("a ") + SideName(*side) + " hand model",
-                     path + " (a " + SideName(out.model.side) + " hand)");
+                     "a " + HandSideName(*side) + " hand model",
+                     path + " (a " + HandSideName(out.model.side) + " hand)");
   }
   out.source = path;
   return out;
@@ -56,7 +54,7 @@ ResolvedHandModel BuildDefaultOpenHand(HandSide side, const std::string& shipped
   options.side = side;
   ResolvedHandModel out;
   out.model = BuildOpenHand(DefaultOpenHandDesign(), options);
-  out.source = std::string("builtin:open_hand_") + SideName(side) + " (built in memory)";
+  out.source = "builtin:open_hand_" + HandSideName(side) + " (built in memory)";
   out.note = "no hand model file given and " +
              (shipped.empty() ? "no data folder" : shipped) +
              " not found (set HANDLABEL_DATA_DIR): built the open hand in memory";
@@ -73,7 +71,7 @@ ResolvedHandModel ResolveHandModel(const std::string& value, std::optional<HandS
   }
   const HandSide shipped_side = side.value_or(HandSide::kRight);
   const std::string shipped =
-      ShippedModelPath(std::string("open_hand_") + SideName(shipped_side) + ".npz");
+      ShippedModelPath("open_hand_" + HandSideName(shipped_side) + ".npz");
   if (!shipped.empty() && std::filesystem::exists(shipped)) {
     return FromFile(shipped, shipped_side, {shipped, "hand model"});
   }

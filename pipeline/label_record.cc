@@ -56,7 +56,7 @@ json LabelToJson(const LabelRecord& label) {
   j["format"] = "handlabel-label";
   j["format_version"] = kLabelFormatVersion;
   j["frame"] = label.frame;
-  j["hand_side"] = label.side == HandSide::kLeft ? "left" : "right";
+  j["hand_side"] = HandSideName(label.side);
   j["path"] = ToString(label.path);
   if (label.params) {
     Eigen::VectorXd betas =
@@ -99,8 +99,7 @@ LabelRecord LabelFromJson(const json& j, const std::string& source) {
   LabelRecord label;
   try {
     label.frame = j.at("frame").get<std::string>();
-    label.side = j.at("hand_side").get<std::string>() == "left" ? HandSide::kLeft
-                                                                : HandSide::kRight;
+    label.side = ParseHandSide(j.at("hand_side").get<std::string>(), source, "hand_side");
     label.path = ParseLabelPath(j.at("path").get<std::string>(), source);
     const json& mano = j.at("mano");
     if (!mano.is_null()) {

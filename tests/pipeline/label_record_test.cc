@@ -88,6 +88,17 @@ TEST(LabelRecord, BadJsonNamesTheField) {
   }
 }
 
+TEST(LabelRecord, UnknownHandSideIsRefused) {
+  nlohmann::json j = LabelToJson(MakeLabel());
+  EXPECT_EQ(j["hand_side"], "right");
+  j["hand_side"] = "left";
+  EXPECT_EQ(LabelFromJson(j, "x.json").side, HandSide::kLeft);
+  j["hand_side"] = "Left";  // was read as a right hand
+  const std::string error = testing::InputErrorOf([&] { LabelFromJson(j, "x.json"); });
+  EXPECT_THAT(error, HasSubstr("x.json"));
+  EXPECT_THAT(error, HasSubstr("hand_side"));
+}
+
 TEST(LabelRecord, FrameIdsBecomeSafeFileNames) {
   EXPECT_EQ(FrameFileStem("20200709-subject-01/20200709_141754/000012", "x"),
             "20200709-subject-01__20200709_141754__000012");
