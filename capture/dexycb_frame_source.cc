@@ -292,14 +292,9 @@ FrameInput DexYcbFrameSource::Load(const std::string& id) const {
     frame.keypoints_2d.push_back(view);
     AddSegmentation(arrays, file, seq.rig[v].camera, &frame);
     if (!frame.ground_truth && HasHand(xyz)) {
-      const Rigid3 world_from_cam = seq.rig[v].cam_from_world.Inverse();
+      const Eigen::Map<const Points3d> in_camera(xyz.data(), kNumHandKeypoints, 3);
       FrameGroundTruth truth;
-      truth.keypoints.resize(kNumHandKeypoints, 3);
-      for (int k = 0; k < kNumHandKeypoints; ++k) {
-        truth.keypoints.row(k) =
-            (world_from_cam * Eigen::Vector3d(xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]))
-                .transpose();
-      }
+      truth.keypoints = TransformPoints(seq.rig[v].cam_from_world.Inverse(), in_camera);
       frame.ground_truth = truth;
     }
   }

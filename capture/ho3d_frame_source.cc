@@ -240,13 +240,8 @@ FrameInput Ho3dFrameSource::Load(const std::string& id) const {
     const std::optional<Points3d> in_camera =
         JointsInCamera(fs::path(seq.camera_dirs[v]) / "meta" / (fid + ".pkl"));
     if (!in_camera) continue;
-    const Rigid3 world_from_cam = seq.rig[v].cam_from_world.Inverse();
     FrameGroundTruth truth;
-    truth.keypoints.resize(kNumHandKeypoints, 3);
-    for (int k = 0; k < kNumHandKeypoints; ++k) {
-      truth.keypoints.row(k) =
-          (world_from_cam * Eigen::Vector3d(in_camera->row(k).transpose())).transpose();
-    }
+    truth.keypoints = TransformPoints(seq.rig[v].cam_from_world.Inverse(), *in_camera);
     frame.ground_truth = truth;
   }
   return frame;

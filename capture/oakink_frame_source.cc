@@ -46,15 +46,6 @@ std::optional<Points3d> ReadPoints(const fs::path& file, int rows) {
   return points;
 }
 
-Points3d ToWorld(const Points3d& in_camera, const Rigid3& cam_from_world) {
-  const Rigid3 world_from_cam = cam_from_world.Inverse();
-  Points3d out(in_camera.rows(), 3);
-  for (Eigen::Index i = 0; i < in_camera.rows(); ++i)
-    out.row(i) =
-        (world_from_cam * Eigen::Vector3d(in_camera.row(i).transpose())).transpose();
-  return out;
-}
-
 }  // namespace
 
 std::string OakInkStreamName(const std::string& cam) {
@@ -139,11 +130,12 @@ FrameInput OakInkFrameSource::Load(const std::string& id) const {
     const std::optional<Points3d> joints =
         ReadPoints(dir / "anno" / "hand_j" / name, kNumHandKeypoints);
     if (!joints) continue;
+    const Rigid3 world_from_cam = frame.rig[v].cam_from_world.Inverse();
     FrameGroundTruth truth;
-    truth.keypoints = ToWorld(*joints, frame.rig[v].cam_from_world);
+    truth.keypoints = TransformPoints(world_from_cam, *joints);
     if (const std::optional<Points3d> vertices =
             ReadPoints(dir / "anno" / "hand_v" / name, 0))
-      truth.vertices = ToWorld(*vertices, frame.rig[v].cam_from_world);
+      truth.vertices = TransformPoints(world_from_cam, *vertices);
     frame.ground_truth = truth;
   }
   return frame;

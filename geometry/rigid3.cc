@@ -5,6 +5,15 @@
 
 namespace handlabel {
 
+Points3d TransformPoints(const Rigid3& target_from_source, const Points3d& points) {
+  Points3d out(points.rows(), 3);
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    out.row(i) =
+        (target_from_source * Eigen::Vector3d(points.row(i).transpose())).transpose();
+  }
+  return out;
+}
+
 Matrix3x4d Rigid3::ToMatrix() const {
   Matrix3x4d m;
   m.leftCols<3>() = rotation.toRotationMatrix();

@@ -10,6 +10,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "core/point_arrays.h"
+
 namespace handlabel {
 
 using Matrix3x4d = Eigen::Matrix<double, 3, 4>;
@@ -41,6 +43,11 @@ struct Rigid3 {
   // For cam_from_world: the camera centre in world coordinates (-R^T t).
   Eigen::Vector3d SourceOrigin() const { return -(rotation.conjugate() * translation); }
 };
+
+// Every row of `points` (in the source frame) in the target frame, as
+// target_from_source * p: e.g. keypoints from a camera to the world with the camera's
+// cam_from_world.Inverse().
+Points3d TransformPoints(const Rigid3& target_from_source, const Points3d& points);
 
 // cam_from_world of an OpenCV camera (z forward, y down) at `eye` looking at `target`;
 // `up` is the world direction that should appear upwards in the image.

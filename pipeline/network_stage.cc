@@ -15,15 +15,6 @@
 namespace handlabel {
 namespace {
 
-// Points from the master camera's frame to the world frame.
-Points3d ToWorld(const Rigid3& world_from_master, const Points3d& points) {
-  Points3d out(points.rows(), 3);
-  for (int i = 0; i < points.rows(); ++i) {
-    out.row(i) = (world_from_master * points.row(i).transpose()).transpose();
-  }
-  return out;
-}
-
 // A crop pixel is a ray of the view's camera (same rotation, pinhole K_crop);
 // projecting that ray with the real camera gives the full-image pixel.
 Keypoints2d CropKeypointsToImage(const Keypoints2d& in_crop, const ViewCrop& crop,
@@ -81,8 +72,8 @@ MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& 
   const Rig& rig = frame.rig;
   const Rigid3 world_from_master = rig[0].cam_from_world.Inverse();
   MeshPrediction p;
-  p.keypoints = ToWorld(world_from_master, out.joints);
-  p.vertices = ToWorld(world_from_master, out.vertices);
+  p.keypoints = TransformPoints(world_from_master, out.joints);
+  p.vertices = TransformPoints(world_from_master, out.vertices);
   for (size_t v = 0; v < rig.size(); ++v) {
     p.keypoints_2d.push_back(
         CropKeypointsToImage(out.joints_2d[v], crops[v], rig[v].camera));

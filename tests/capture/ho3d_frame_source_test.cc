@@ -97,15 +97,13 @@ TEST(Ho3dFrameSource, NumpyWrittenMetaGivesOpenCvAxesAndSnapOrder) {
   ASSERT_TRUE(frame.ground_truth.has_value());
   std::ifstream in(kData + "/expected.json");
   const nlohmann::json expected = nlohmann::json::parse(in)["keypoints_in_camera_snap"];
-  const Rigid3 world_from_cam = fx.rig[1].cam_from_world.Inverse();
+  Points3d in_camera(kNumHandKeypoints, 3);
   for (int k = 0; k < kNumHandKeypoints; ++k) {
-    const Eigen::Vector3d in_camera(expected[k][0].get<double>(),
-                                    expected[k][1].get<double>(),
-                                    expected[k][2].get<double>());
-    EXPECT_THAT(frame.ground_truth->keypoints.row(k),
-                testing::MatrixNear((world_from_cam * in_camera).transpose(), 1e-12))
-        << k;
+    for (int c = 0; c < 3; ++c) in_camera(k, c) = expected[k][c].get<double>();
   }
+  EXPECT_THAT(frame.ground_truth->keypoints,
+              testing::MatrixNear(
+                  TransformPoints(fx.rig[1].cam_from_world.Inverse(), in_camera), 1e-12));
 }
 
 TEST(Ho3dFrameSource, SplitFolderListsCalibratedSequences) {

@@ -27,6 +27,23 @@ TEST(Rigid3, ComposeAndInverseAgreeWithMatrices) {
   }
 }
 
+// Bit for bit what applying the transform to each point gives: the labels' ground truth
+// went through that arithmetic before TransformPoints existed.
+TEST(Rigid3, TransformPointsAppliesTheTransformToEveryRow) {
+  const Rigid3 b_from_a(RandomRotation(), RandomVector3(-2, 2));
+  Points3d points(21, 3);
+  for (int i = 0; i < points.rows(); ++i)
+    points.row(i) = RandomVector3(-1, 1).transpose();
+  const Points3d moved = TransformPoints(b_from_a, points);
+  ASSERT_EQ(moved.rows(), points.rows());
+  for (int i = 0; i < points.rows(); ++i) {
+    const Eigen::Vector3d expected =
+        b_from_a * Eigen::Vector3d(points.row(i).transpose());
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(moved(i, c), expected[c]) << i;
+  }
+  EXPECT_EQ(TransformPoints(b_from_a, Points3d(0, 3)).rows(), 0);
+}
+
 TEST(Rigid3, FromMatrixRoundTripsAndRepairsSlightlyNonOrthogonalInput) {
   const Rigid3 t(RandomRotation(), RandomVector3(-1, 1));
   EXPECT_THAT(Rigid3::FromMatrix(t.ToMatrix()), Rigid3Near(t, 1e-12, 1e-12));
