@@ -11,17 +11,12 @@
 #include <set>
 
 #include "core/errors.h"
+#include "poem/tensor_shape.h"
 
 namespace handlabel {
 namespace {
 
 constexpr const char* kFormat = "handlabel-poem-checkpoint-1";
-
-std::string ShapeString(const torch::Tensor& t) {
-  std::string s = "(";
-  for (int64_t i = 0; i < t.dim(); ++i) s += (i ? ", " : "") + std::to_string(t.size(i));
-  return s + ")";
-}
 
 std::string JoinLimited(const std::vector<std::string>& items, size_t limit = 20) {
   std::string s;

@@ -6,6 +6,7 @@
 #include "core/stopwatch.h"
 #include "poem/poem_geometry.h"
 #include "poem/point_ops.h"
+#include "poem/tensor_shape.h"
 
 namespace handlabel {
 namespace {
@@ -14,23 +15,12 @@ namespace F = torch::nn::functional;
 using torch::indexing::Ellipsis;
 using torch::indexing::Slice;
 
-std::string ShapeString(const torch::Tensor& t) {
-  if (!t.defined()) return "undefined";
-  std::string s = "(";
-  for (int64_t i = 0; i < t.dim(); ++i) s += (i ? ", " : "") + std::to_string(t.size(i));
-  return s + ")";
-}
-
 void ExpectShape(const torch::Tensor& t, const std::vector<int64_t>& shape,
                  const std::string& field) {
   bool ok = t.defined() && t.dim() == static_cast<int64_t>(shape.size());
   for (size_t i = 0; ok && i < shape.size(); ++i) ok = t.size(i) == shape[i];
   if (!ok) {
-    std::string want = "(";
-    for (size_t i = 0; i < shape.size(); ++i) {
-      want += (i ? ", " : "") + std::to_string(shape[i]);
-    }
-    throw InputError("POEM batch", field, "shape " + want + ")", ShapeString(t));
+    throw InputError("POEM batch", field, "shape " + ShapeString(shape), ShapeString(t));
   }
   if (t.scalar_type() != torch::kFloat32) {
     throw InputError("POEM batch", field, "float32",
