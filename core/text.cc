@@ -1,6 +1,7 @@
 #include "core/text.h"
 
 #include <cctype>
+#include <sstream>
 
 namespace handlabel {
 
@@ -8,6 +9,12 @@ std::string Join(const std::vector<std::string>& items, const std::string& separ
   std::string out;
   for (size_t i = 0; i < items.size(); ++i) out += (i ? separator : "") + items[i];
   return out;
+}
+
+std::string FormatNumber(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
 }
 
 std::string Lower(std::string s) {

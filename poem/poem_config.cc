@@ -1,29 +1,24 @@
 #include "poem/poem_config.h"
 
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "core/errors.h"
+#include "core/text.h"
 
 namespace handlabel {
 namespace {
 
 using Json = nlohmann::json;
 
-std::string Str(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 std::string RangeString(const std::array<double, 6>& r) {
-  std::string s = "[";
-  for (int i = 0; i < 6; ++i) s += (i ? ", " : "") + Str(r[i]);
-  return s + "]";
+  std::vector<std::string> items;
+  for (const double value : r) items.push_back(FormatNumber(value));
+  return "[" + Join(items) + "]";
 }
 
 void Positive(const std::string& source, const std::string& field, double value) {
-  if (!(value > 0)) throw InputError(source, field, "a positive value", Str(value));
+  if (!(value > 0))
+    throw InputError(source, field, "a positive value", FormatNumber(value));
 }
 
 }  // namespace
@@ -157,18 +152,22 @@ std::vector<std::string> PoemConfig::Differences(const PoemConfig& o) const {
   auto cmp = [&](const char* name, const std::string& a, const std::string& b) {
     if (a != b) d.push_back(std::string(name) + ": " + a + " vs " + b);
   };
+  // Numbers compare as their message text (6 significant digits).
+  auto cmp_number = [&](const char* name, double a, double b) {
+    cmp(name, FormatNumber(a), FormatNumber(b));
+  };
   cmp("backbone", backbone, o.backbone);
-  cmp("backbone_width", Str(backbone_width), Str(o.backbone_width));
-  cmp("num_views", Str(num_views), Str(o.num_views));
-  cmp("crop_size", Str(crop_size), Str(o.crop_size));
-  cmp("depth_bins", Str(depth_bins), Str(o.depth_bins));
-  cmp("embed_dim", Str(embed_dim), Str(o.embed_dim));
-  cmp("transformer_dim", Str(transformer_dim), Str(o.transformer_dim));
-  cmp("num_decoder_blocks", Str(num_decoder_blocks), Str(o.num_decoder_blocks));
-  cmp("point_neighbors", Str(point_neighbors), Str(o.point_neighbors));
-  cmp("query_neighbors", Str(query_neighbors), Str(o.query_neighbors));
-  cmp("num_sampled_points", Str(num_sampled_points), Str(o.num_sampled_points));
-  cmp("ball_radius", Str(ball_radius), Str(o.ball_radius));
+  cmp_number("backbone_width", backbone_width, o.backbone_width);
+  cmp_number("num_views", num_views, o.num_views);
+  cmp_number("crop_size", crop_size, o.crop_size);
+  cmp_number("depth_bins", depth_bins, o.depth_bins);
+  cmp_number("embed_dim", embed_dim, o.embed_dim);
+  cmp_number("transformer_dim", transformer_dim, o.transformer_dim);
+  cmp_number("num_decoder_blocks", num_decoder_blocks, o.num_decoder_blocks);
+  cmp_number("point_neighbors", point_neighbors, o.point_neighbors);
+  cmp_number("query_neighbors", query_neighbors, o.query_neighbors);
+  cmp_number("num_sampled_points", num_sampled_points, o.num_sampled_points);
+  cmp_number("ball_radius", ball_radius, o.ball_radius);
   cmp("position_range", RangeString(position_range), RangeString(o.position_range));
   cmp("mask_head", mask_head ? "true" : "false", o.mask_head ? "true" : "false");
   return d;

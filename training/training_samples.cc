@@ -6,6 +6,7 @@
 
 #include "core/errors.h"
 #include "core/random.h"
+#include "core/text.h"
 
 namespace handlabel {
 namespace {
@@ -14,12 +15,14 @@ constexpr uint64_t kAugmentStream = 0xA06E;
 
 using Affine2 = Eigen::Matrix<double, 2, 3>;  // crop pixel = A * (x, y, 1)
 
-std::string Str(double v) { return std::to_string(v); }
+// The name the option structs' Check() bodies below use for FormatNumber.
+std::string Str(double v) { return FormatNumber(v); }
 
 void InRange(const std::string& source, const char* field, double v, double lo,
              double hi) {
   if (!(v >= lo && v <= hi)) {
-    throw InputError(source, field, Str(lo) + ".." + Str(hi), Str(v));
+    throw InputError(source, field, FormatNumber(lo) + ".." + FormatNumber(hi),
+                     FormatNumber(v));
   }
 }
 
