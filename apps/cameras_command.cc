@@ -6,22 +6,16 @@
 #include "calib/rig_plot.h"
 #include "cameras/rig_compare.h"
 #include "cameras/rig_io.h"
+#include "core/text.h"
 
 namespace handlabel {
 namespace {
-
-std::string FormatList(const std::vector<std::string>& formats) {
-  std::string out;
-  for (const std::string& f : formats) out += (out.empty() ? "" : ", ") + f;
-  return out;
-}
 
 int RunCamerasConvert(int argc, char** argv) {
   CLI::App app(
       "Convert a rig between formats.\n"
       "Readable: " +
-          FormatList(ReadableRigFormats()) + "\n" +
-          "Writable: " + FormatList(WritableRigFormats()) +
+          Join(ReadableRigFormats()) + "\n" + "Writable: " + Join(WritableRigFormats()) +
           "\n"
           "Example: handlabel cameras convert --from colmap:sparse/0 --to json:rig.json",
       "cameras convert");
@@ -47,7 +41,7 @@ int RunCamerasShow(int argc, char** argv) {
       "Print a rig as a table and optionally draw its camera frusta (from above and from "
       "the side) into a PNG.\n"
       "Formats: " +
-          FormatList(ReadableRigFormats()) + "\n" +
+          Join(ReadableRigFormats()) + "\n" +
           "Example: handlabel cameras show json:rig.json --plot rig.png",
       "cameras show");
   std::string spec, plot;
@@ -108,7 +102,7 @@ void PrintCamerasUsage(std::ostream& out) {
          "  compare  FORMAT:PATH FORMAT:PATH              per-camera differences of two "
          "rigs\n"
          "Formats: "
-      << FormatList(ReadableRigFormats())
+      << Join(ReadableRigFormats())
       << "\nRun 'handlabel cameras <convert|show|compare> --help' for the options. "
          "Guide: docs/cameras.md\n";
 }

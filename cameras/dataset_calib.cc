@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/text.h"
 #include "formats/pickle_reader.h"
 
 namespace handlabel {
@@ -86,17 +87,17 @@ Camera DexYcbIntrinsics(const fs::path& folder, const std::string& serial) {
   }
   size_t pick = 0;
   if (found.size() > 1) {
-    std::string sizes;
+    std::vector<std::string> files;
     pick = found.size();
     for (size_t i = 0; i < found.size(); ++i) {
-      sizes += (i ? ", " : "") + found[i].file.filename().string();
+      files.push_back(found[i].file.filename().string());
       if (found[i].width == 640 && found[i].height == 480) pick = i;
     }
     if (pick == found.size()) {
       throw InputError(folder.string(), serial + "_<W>x<H>.yml",
                        "one intrinsics size, or " + serial +
                            "_640x480.yml (the size DexYCB's toolkit reads)",
-                       sizes);
+                       Join(files));
     }
   }
   const fs::path& file = found[pick].file;

@@ -9,6 +9,7 @@
 
 #include "cameras/dataset_calib.h"
 #include "core/errors.h"
+#include "core/text.h"
 #include "formats/npz.h"
 
 namespace handlabel {
@@ -43,10 +44,10 @@ const NdArray& FindArray(const NamedArrays& arrays, const std::string& name,
   for (const auto& [key, array] : arrays) {
     if (key != name) continue;
     if (array.shape != shape || !IsNumeric(array.dtype)) {
-      std::string expected = "a numeric array of shape (";
-      for (size_t i = 0; i < shape.size(); ++i)
-        expected += (i ? ", " : "") + std::to_string(shape[i]);
-      throw InputError(file, name, expected + ")", array.ShapeString());
+      std::vector<std::string> sizes;
+      for (const int64_t size : shape) sizes.push_back(std::to_string(size));
+      throw InputError(file, name, "a numeric array of shape (" + Join(sizes) + ")",
+                       array.ShapeString());
     }
     return array;
   }

@@ -9,6 +9,7 @@
 #include "capture/capture_format.h"
 #include "core/errors.h"
 #include "core/stopwatch.h"
+#include "core/text.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_stage_factory.h"
 #include "pipeline/network_stage.h"
@@ -18,12 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-std::string Join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& item : items) out += (out.empty() ? "" : ",") + item;
-  return out;
-}
 
 // A refine.min_views no rig reaches: the enough_views check then fails on every
 // frame and the fallback policy fits every frame from the 2D evidence alone.
@@ -435,7 +430,7 @@ class ComparisonRun {
           continue;
         }
         JobConfig base = base_;
-        base.frames = Join(frames);
+        base.frames = Join(frames, ",");
         base.max_frames = 0;
         base.ignore_views.assign(result_.cameras.begin() + k, result_.cameras.end());
         const std::string dir =

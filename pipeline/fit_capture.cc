@@ -5,6 +5,7 @@
 #include <map>
 
 #include "core/errors.h"
+#include "core/text.h"
 #include "hand/hand_anatomy.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"
@@ -13,12 +14,6 @@
 
 namespace handlabel {
 namespace {
-
-std::string Join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& item : items) out += (out.empty() ? "" : ",") + item;
-  return out;
-}
 
 double Mean(const LabelSummary& s, const std::string& metric) {
   const auto group = s.metrics.find("labels");
@@ -99,7 +94,7 @@ JobConfig FitJob(const FitCaptureOptions& o) {
   job.name = "fit";
   job.input_format = "native";
   job.input_path = std::filesystem::path(o.capture_dir).lexically_normal().string();
-  if (!o.frames.empty()) job.frames = Join(o.frames);
+  if (!o.frames.empty()) job.frames = Join(o.frames, ",");
   job.max_frames = o.max_frames;
   job.hand_model = o.hand_model;
   job.threads = o.num_threads;
