@@ -5,6 +5,7 @@
 
 #include "core/errors.h"
 #include "core/file_bytes.h"
+#include "core/option_checks.h"
 #include "formats/pickle_machine.h"
 #include "formats/utf8.h"
 
@@ -234,18 +235,16 @@ int PickleMachine::Execute() {
 
 }  // namespace pickle
 
-bool PickleLimits::Check(std::string* error) const {
-  if (max_values < 1 || max_depth < 1 || max_total_bytes < 0) {
-    *error = "PickleLimits: max_values and max_depth must be positive";
-    return false;
-  }
-  return true;
+void PickleLimits::Check(const std::string& source) const {
+  // The fields name the struct: `source` is the pickle, which has no such fields.
+  RequireAtLeast(source, "PickleLimits.max_values", max_values, 1);
+  RequireAtLeast(source, "PickleLimits.max_depth", max_depth, 1);
+  RequireAtLeast(source, "PickleLimits.max_total_bytes", max_total_bytes, 0);
 }
 
 PickleValue ReadPickle(const std::string& bytes, const std::string& source,
                        const PickleLimits& limits) {
-  std::string error;
-  if (!limits.Check(&error)) throw InputError(source, "PickleLimits", error);
+  limits.Check(source);
   return pickle::PickleMachine(bytes, source, limits).Run();
 }
 

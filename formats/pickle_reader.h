@@ -35,7 +35,8 @@ struct PickleLimits {
   int64_t max_values = int64_t{1} << 22;       // objects created while reading
   int max_depth = 64;                          // nesting of containers and objects
   int64_t max_total_bytes = int64_t{4} << 30;  // decoded array and string payload
-  bool Check(std::string* error) const;
+  // Throws InputError naming `source` (the pickle) and the field.
+  void Check(const std::string& source) const;
 };
 
 // Decodes one pickle. `source` names the file (and archive entry) in errors.

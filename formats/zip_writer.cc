@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -60,18 +61,14 @@ uint32_t Crc32(const std::string& data) {
 
 }  // namespace
 
-bool ZipWriterOptions::Check(std::string* error) const {
-  if (deflate_level < 1 || deflate_level > 9) {
-    *error = "deflate_level must be in 1..9, got " + std::to_string(deflate_level);
-    return false;
-  }
-  return true;
+void ZipWriterOptions::Check(const std::string& source) const {
+  // The field names the struct: `source` is the archive, which has no such field.
+  RequireInRange(source, "ZipWriterOptions.deflate_level", deflate_level, 1, 9);
 }
 
 ZipWriter::ZipWriter(const std::string& path, const ZipWriterOptions& options)
     : path_(path), options_(options) {
-  std::string error;
-  if (!options_.Check(&error)) throw InputError(path, "ZipWriterOptions", error);
+  options_.Check(path);
   out_.open(path, std::ios::binary | std::ios::trunc);
   if (!out_) throw InputError(path, "", "a writable file", "cannot create");
 }

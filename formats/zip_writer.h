@@ -19,7 +19,8 @@ struct ZipWriterOptions {
   // for readers that want them); they are always written when needed.
   bool force_zip64 = false;
   int deflate_level = 6;  // zlib level 1-9 for kDeflate entries
-  bool Check(std::string* error) const;
+  // Throws InputError naming `source` (the archive) and the field.
+  void Check(const std::string& source) const;
 };
 
 class ZipWriter {
