@@ -73,7 +73,7 @@ CompareOptions Options(const CompareFlags& f, const JobConfig& base) {
   }
   o.ablation_views = AblationViews(f.ablation);
   if (!f.qa_selection.empty()) o.qa_selection = SplitCommas(f.qa_selection);
-  o.Check();
+  o.Check("command line");
   return o;
 }
 

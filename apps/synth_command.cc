@@ -107,7 +107,7 @@ SynthCaptureOptions ToOptions(const SynthFlags& f, HandSide* side) {
   o.write_detections = !f.no_detections;
   o.view.background.clutter = !f.no_clutter;
   o.view.appearance = SynthAppearanceFromName(f.appearance, "--appearance", "value");
-  o.Check();
+  o.Check("synth options");
   return o;
 }
 

@@ -6,6 +6,7 @@
 #include "calib/board_calib_init.h"
 #include "calib/board_corner_cost.h"
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -88,17 +89,16 @@ void Solve(State* s, const std::vector<CameraModelId>& models, const BoardSpec& 
 
 }  // namespace
 
-void BoardCalibOptions::Check() const {
-  const std::string src = "BoardCalibOptions";
-  if (!(huber_px > 0)) throw InputError(src, "huber_px", "> 0");
-  if (outlier_rounds < 0) throw InputError(src, "outlier_rounds", ">= 0");
-  if (!(outlier_sigmas > 0)) throw InputError(src, "outlier_sigmas", "> 0");
-  if (!(min_outlier_px > 0)) throw InputError(src, "min_outlier_px", "> 0");
-  if (min_frames_per_camera < 1) throw InputError(src, "min_frames_per_camera", ">= 1");
-  if (max_iterations < 1) throw InputError(src, "max_iterations", ">= 1");
-  if (num_threads < 1) throw InputError(src, "num_threads", ">= 1");
+void BoardCalibOptions::Check(const std::string& source) const {
+  RequireGreater(source, "huber_px", huber_px, 0);
+  RequireAtLeast(source, "outlier_rounds", outlier_rounds, 0);
+  RequireGreater(source, "outlier_sigmas", outlier_sigmas, 0);
+  RequireGreater(source, "min_outlier_px", min_outlier_px, 0);
+  RequireAtLeast(source, "min_frames_per_camera", min_frames_per_camera, 1);
+  RequireAtLeast(source, "max_iterations", max_iterations, 1);
+  RequireAtLeast(source, "num_threads", num_threads, 1);
   if (world != "camera" && world != "board" && world.rfind("board:", 0) != 0) {
-    throw InputError(src, "world", "camera, board or board:FRAME", "'" + world + "'");
+    throw InputError(source, "world", "camera, board or board:FRAME", "'" + world + "'");
   }
 }
 
@@ -283,8 +283,8 @@ void AddStatistics(const std::vector<CameraBoardViews>& views,
 BoardCalibResult CalibrateBoardRig(const std::vector<CameraBoardViews>& views,
                                    const BoardSpec& board,
                                    const BoardCalibOptions& options) {
-  options.Check();
-  board.Check();
+  options.Check("BoardCalibOptions");
+  board.Check("board");
   if (views.empty())
     throw InputError("board calibration", "cameras", "at least one camera");
   const size_t master = MasterIndex(views, options);

@@ -53,7 +53,7 @@ struct BoardCalibOptions {
   int max_iterations = 200;
   // Ceres threads (keep small on shared machines).
   int num_threads = 1;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct CameraCalibStats {

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -89,16 +90,13 @@ BoardObservation DetectCheckerboard(const cv::Mat& gray, const BoardSpec& board)
 
 }  // namespace
 
-void BoardDetectOptions::Check() const {
-  if (min_corners < 4) {
-    throw InputError("BoardDetectOptions", "min_corners", ">= 4",
-                     std::to_string(min_corners));
-  }
+void BoardDetectOptions::Check(const std::string& source) const {
+  RequireAtLeast(source, "min_corners", min_corners, 4);
 }
 
 BoardObservation DetectBoard(const GrayImage& image, const BoardSpec& board,
                              const BoardDetectOptions& options) {
-  options.Check();
+  options.Check("BoardDetectOptions");
   const cv::Mat gray(image.height, image.width, CV_8UC1,
                      const_cast<uint8_t*>(image.pixels.data()));
   BoardObservation obs = board.type == BoardType::kCharuco

@@ -24,7 +24,7 @@ struct BoardDetectOptions {
   // Fewer corners than this count as "board not seen" (a homography needs 4; more
   // keeps wrong detections out).
   int min_corners = 6;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Empty observation if the board is not found.

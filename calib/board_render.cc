@@ -5,20 +5,15 @@
 #include <random>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 
-void BoardRenderOptions::Check() const {
-  if (supersampling < 1 || supersampling > 16) {
-    throw InputError("BoardRenderOptions", "supersampling", "1..16",
-                     std::to_string(supersampling));
-  }
-  if (!(white_margin >= 0))
-    throw InputError("BoardRenderOptions", "white_margin", ">= 0");
-  if (!(noise_sigma >= 0)) throw InputError("BoardRenderOptions", "noise_sigma", ">= 0");
-  if (texture_pixels_per_square < 10) {
-    throw InputError("BoardRenderOptions", "texture_pixels_per_square", ">= 10");
-  }
+void BoardRenderOptions::Check(const std::string& source) const {
+  RequireInRange(source, "supersampling", supersampling, 1, 16);
+  RequireAtLeast(source, "white_margin", white_margin, 0);
+  RequireAtLeast(source, "noise_sigma", noise_sigma, 0);
+  RequireAtLeast(source, "texture_pixels_per_square", texture_pixels_per_square, 10);
 }
 
 struct BoardRenderer::Impl {
@@ -59,8 +54,8 @@ struct BoardRenderer::Impl {
 BoardRenderer::BoardRenderer(const BoardSpec& board, const Camera& camera,
                              const BoardRenderOptions& options)
     : impl_(std::make_unique<Impl>()) {
-  board.Check();
-  options.Check();
+  board.Check("board");
+  options.Check("BoardRenderOptions");
   impl_->board = board;
   impl_->camera = camera;
   impl_->options = options;

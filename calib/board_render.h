@@ -22,7 +22,7 @@ struct BoardRenderOptions {
   uint8_t white = 230;        // grey level of white paper
   double noise_sigma = 2.0;   // Gaussian pixel noise, grey levels
   int texture_pixels_per_square = 100;  // resolution of the ChArUco texture
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // One camera and one board; renders any number of board poses.

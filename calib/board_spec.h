@@ -27,7 +27,7 @@ struct BoardSpec {
   std::string dictionary = "DICT_4X4_50";  // ChArUco only
 
   // Throws InputError naming `source` when the numbers cannot make a board.
-  void Check(const std::string& source = "board") const;
+  void Check(const std::string& source) const;
   int NumCorners() const { return (cols - 1) * (rows - 1); }
   int NumMarkers() const { return cols * rows / 2; }
   Eigen::Vector3d Corner(int id) const;

@@ -9,6 +9,7 @@
 #include <ostream>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -33,15 +34,14 @@ void RunStep(const std::string& name, const std::string& command,
 
 }  // namespace
 
-void ColmapSfmOptions::Check() const {
-  const std::string src = "ColmapSfmOptions";
-  if (work_dir.empty()) throw InputError(src, "work_dir", "a folder for the database");
-  if (num_threads < 1) throw InputError(src, "num_threads", ">= 1");
+void ColmapSfmOptions::Check(const std::string& source) const {
+  if (work_dir.empty()) throw InputError(source, "work_dir", "a folder for the database");
+  RequireAtLeast(source, "num_threads", num_threads, 1);
   if (camera_a.empty() != camera_b.empty()) {
-    throw InputError(src, "camera_a/camera_b", "both camera names or neither");
+    throw InputError(source, "camera_a/camera_b", "both camera names or neither");
   }
-  if (!camera_a.empty() && !(distance_m > 0)) {
-    throw InputError(src, "distance_m", "a positive distance in metres");
+  if (!camera_a.empty()) {
+    RequireGreater(source, "distance_m", distance_m, 0, "a positive distance in metres");
   }
 }
 
@@ -59,7 +59,7 @@ double FixRigScale(Rig* rig, const std::string& a, const std::string& b, double 
 
 ColmapSfmResult CalibrateWithColmap(const std::string& images_dir,
                                     const ColmapSfmOptions& options, std::ostream* log) {
-  options.Check();
+  options.Check("ColmapSfmOptions");
   if (!fs::is_directory(images_dir)) {
     throw InputError(images_dir, "--images", "a folder with one sub-folder per camera",
                      "not a folder");

@@ -30,7 +30,7 @@ struct ColmapSfmOptions {
   double distance_m = 0;
   // World frame: this camera ("" = the first folder).
   std::string master;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct ColmapSfmResult {

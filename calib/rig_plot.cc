@@ -11,6 +11,7 @@
 
 #include "calib/cv_image_file.h"
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -171,18 +172,15 @@ double AutoDepth(const Rig& rig) {
 
 }  // namespace
 
-void RigPlotOptions::Check() const {
-  if (panel_size < 100 || panel_size > 4000) {
-    throw InputError("RigPlotOptions", "panel_size", "100..4000 pixels",
-                     std::to_string(panel_size));
-  }
+void RigPlotOptions::Check(const std::string& source) const {
+  RequireInRange(source, "panel_size", panel_size, 100, 4000, "100..4000 pixels");
   if (!std::isfinite(frustum_depth)) {
-    throw InputError("RigPlotOptions", "frustum_depth", "a finite number (<= 0 = auto)");
+    throw InputError(source, "frustum_depth", "a finite number (<= 0 = auto)");
   }
 }
 
 void PlotRig(const Rig& rig, const std::string& png_path, const RigPlotOptions& options) {
-  options.Check();
+  options.Check("RigPlotOptions");
   HL_CHECK(!rig.empty(), "plotting an empty rig");
   const double depth = options.frustum_depth > 0 ? options.frustum_depth : AutoDepth(rig);
   std::vector<Frustum> frusta;

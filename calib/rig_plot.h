@@ -18,7 +18,7 @@ struct RigPlotOptions {
   std::vector<Eigen::Vector3d> points;
   // Title printed above the panels.
   std::string title;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Writes a PNG with two orthographic views of the camera frusta: from above (looking

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 
 namespace handlabel {
@@ -18,17 +19,18 @@ std::string FrameKey(int i) {
 
 }  // namespace
 
-void SyntheticBoardCaptureOptions::Check() const {
-  const std::string src = "SyntheticBoardCaptureOptions";
-  if (num_cameras < 1) throw InputError(src, "num_cameras", ">= 1");
-  if (width < 16 || height < 16) throw InputError(src, "width/height", ">= 16");
-  if (num_frames < 1) throw InputError(src, "num_frames", ">= 1");
-  if (!(corner_noise_px >= 0)) throw InputError(src, "corner_noise_px", ">= 0");
+void SyntheticBoardCaptureOptions::Check(const std::string& source) const {
+  RequireAtLeast(source, "num_cameras", num_cameras, 1);
+  if (width < 16 || height < 16) throw InputError(source, "width/height", ">= 16");
+  RequireAtLeast(source, "num_frames", num_frames, 1);
+  RequireAtLeast(source, "corner_noise_px", corner_noise_px, 0);
   if (!(ring_radius_min > 0 && ring_radius_max >= ring_radius_min)) {
-    throw InputError(src, "ring_radius_min/max", "0 < min <= max");
+    throw InputError(source, "ring_radius_min/max", "0 < min <= max");
   }
-  if (!(height_max >= height_min)) throw InputError(src, "height_min/max", "min <= max");
-  if (min_corners < 4) throw InputError(src, "min_corners", ">= 4");
+  if (!(height_max >= height_min)) {
+    throw InputError(source, "height_min/max", "min <= max");
+  }
+  RequireAtLeast(source, "min_corners", min_corners, 4);
 }
 
 namespace {
@@ -150,8 +152,8 @@ void ObserveCorners(const BoardSpec& board, const SyntheticBoardCaptureOptions& 
 
 SyntheticBoardCapture SynthesizeBoardCapture(const BoardSpec& board,
                                              const SyntheticBoardCaptureOptions& o) {
-  o.Check();
-  board.Check();
+  o.Check("SyntheticBoardCaptureOptions");
+  board.Check("board");
   std::mt19937_64 rng(o.seed);
   SyntheticBoardCapture capture;
   AddRingCameras(o, rng, &capture);

@@ -33,7 +33,7 @@ struct SyntheticBoardCaptureOptions {
   double max_view_angle_deg = 70;  // cameras seeing the board more obliquely skip it
   int min_corners = 6;             // fewer visible corners: the camera skips the frame
   uint64_t seed = 1;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct SyntheticBoardCapture {

@@ -12,6 +12,7 @@
 #include "capture/capture_manifest_file.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/stopwatch.h"
 #include "core/version.h"
 #include "media/frame_readers.h"
@@ -23,8 +24,7 @@ std::string CaptureImportOptions::Matching() const {
   return videos_dir.empty() ? "name" : "index";
 }
 
-void CaptureImportOptions::Check() const {
-  const char* source = "capture import options";
+void CaptureImportOptions::Check(const std::string& source) const {
   if (images_dir.empty() == videos_dir.empty()) {
     throw InputError(source, "--images / --videos", "exactly one of them",
                      images_dir.empty() ? "neither" : "both");
@@ -39,27 +39,18 @@ void CaptureImportOptions::Check() const {
     throw InputError(source, "--offset", "--match index (offsets shift frame indices)",
                      "--match " + Matching());
   }
-  if (start < 0) throw InputError(source, "--start", ">= 0", std::to_string(start));
+  RequireAtLeast(source, "--start", start, 0);
   if (end != -1 && end <= start) {
     throw InputError(source, "--end", "-1 (to the end) or > --start",
                      std::to_string(end));
   }
-  if (stride < 1) throw InputError(source, "--stride", ">= 1", std::to_string(stride));
-  if (max_frames < 0) {
-    throw InputError(source, "--max-frames", ">= 0 (0 = all)",
-                     std::to_string(max_frames));
-  }
+  RequireAtLeast(source, "--stride", stride, 1);
+  RequireAtLeast(source, "--max-frames", max_frames, 0, ">= 0 (0 = all)");
   if (resume && overwrite) {
     throw InputError(source, "--resume / --overwrite", "at most one of them", "both");
   }
-  if (checkpoint_frames < 1) {
-    throw InputError(source, "checkpoint_frames", ">= 1",
-                     std::to_string(checkpoint_frames));
-  }
-  if (num_threads < 0) {
-    throw InputError(source, "--threads", ">= 0 (0 = all cores)",
-                     std::to_string(num_threads));
-  }
+  RequireAtLeast(source, "checkpoint_frames", checkpoint_frames, 1);
+  RequireAtLeast(source, "--threads", num_threads, 0, ">= 0 (0 = all cores)");
 }
 
 namespace {
@@ -254,7 +245,7 @@ CaptureImportReport ImportCapture(const std::string& capture_dir,
                                   const CaptureImportOptions& o,
                                   const CaptureImportCallbacks& callbacks) {
   const auto start_time = std::chrono::steady_clock::now();
-  o.Check();
+  o.Check("capture import options");
   CaptureImportReport report;
   auto note = [&](const std::string& text) {
     report.notes.push_back(text);

@@ -37,7 +37,7 @@ struct CaptureInitOptions {
   std::string rig_source;
   // Replace a capture already in the folder (its images/ folder is removed).
   bool overwrite = false;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // The rig named by `text`: FORMAT:PATH (cameras/rig_io.h), or a bare path: a `.json` rig
@@ -83,7 +83,7 @@ struct CaptureImportOptions {
   // Worker threads over the cameras of a frame; 0 = TBB's default (all cores).
   int num_threads = 0;
   PngWriteOptions png;
-  void Check() const;
+  void Check(const std::string& source) const;
   // `match` with its default resolved.
   std::string Matching() const;
 };

@@ -29,9 +29,9 @@ void CheckCameraNames(const Rig& rig, const std::string& source) {
 
 }  // namespace
 
-void CaptureInitOptions::Check() const {
+void CaptureInitOptions::Check(const std::string& source) const {
   if (hand_side != "right" && hand_side != "left") {
-    throw InputError("capture init options", "hand_side", "right or left", hand_side);
+    throw InputError(source, "hand_side", "right or left", hand_side);
   }
 }
 
@@ -65,7 +65,7 @@ RigSpec ResolveRigSpec(const std::string& text, const std::string& flag) {
 
 void InitCapture(const Rig& rig, const RigFileInfo& rig_info, const std::string& out_dir,
                  const CaptureInitOptions& options) {
-  options.Check();
+  options.Check("capture init options");
   if (rig.empty()) {
     throw InputError(options.rig_source, "cameras", "at least one camera", "none");
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "hand/hand_skeleton.h"
 #include "image/draw.h"
 #include "image/mask_outline.h"
@@ -121,18 +122,14 @@ void DrawDetections(const ViewKeypoints& d, const TileWindow& w, ImageU8* tile) 
 
 }  // namespace
 
-void ContactSheetOptions::Check() const {
-  if (columns < 1)
-    throw InputError("contact sheet options", "columns", ">= 1", std::to_string(columns));
-  if (tile_width < 16 || tile_width > 4096) {
-    throw InputError("contact sheet options", "tile_width", "16..4096",
-                     std::to_string(tile_width));
-  }
+void ContactSheetOptions::Check(const std::string& source) const {
+  RequireAtLeast(source, "columns", columns, 1);
+  RequireInRange(source, "tile_width", tile_width, 16, 4096);
 }
 
 ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,
                          const ContactSheetOptions& o) {
-  o.Check();
+  o.Check("contact sheet options");
   const int n = capture.num_cameras();
   // Tiles share the largest aspect ratio of the rig.
   double aspect = 0;

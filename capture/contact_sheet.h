@@ -19,7 +19,7 @@ struct ContactSheetOptions {
   bool keypoints = true;    // draw keypoints and skeleton
   bool detections = false;  // also draw simulated detections (crosses), if present
   // Throws InputError naming the field.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 ImageU8 MakeContactSheet(const CaptureReader& capture, int frame,

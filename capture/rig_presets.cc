@@ -4,6 +4,7 @@
 #include <random>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 
 namespace handlabel {
@@ -132,33 +133,30 @@ Rig RandomRig(const RigPresetOptions& o, uint64_t seed) {
 
 }  // namespace
 
-void RigPresetOptions::Check() const {
-  const std::string src = "rig options";
+void RigPresetOptions::Check(const std::string& source) const {
   bool known = false;
   for (const std::string& n : RigPresetNames()) known |= n == preset;
   if (!known) {
-    throw InputError(src, "preset", "one of dexycb, oakink, ho3d, random", preset);
+    throw InputError(source, "preset", "one of dexycb, oakink, ho3d, random", preset);
   }
   if (width < 0 || height < 0 || (width == 0) != (height == 0) || width > 16384 ||
       height > 16384) {
-    throw InputError(src, "size", "both 0 (preset size) or both in 1..16384",
+    throw InputError(source, "size", "both 0 (preset size) or both in 1..16384",
                      std::to_string(width) + "x" + std::to_string(height));
   }
-  if (num_cameras < 1 || num_cameras > 256) {
-    throw InputError(src, "num_cameras", "1..256", std::to_string(num_cameras));
-  }
+  RequireInRange(source, "num_cameras", num_cameras, 1, 256);
   if (!(min_distance > 0.05 && max_distance >= min_distance)) {
-    throw InputError(src, "min_distance/max_distance", "0.05 < min <= max");
+    throw InputError(source, "min_distance/max_distance", "0.05 < min <= max");
   }
   if (!(min_elevation_deg >= -90 && max_elevation_deg <= 90 &&
         min_elevation_deg <= max_elevation_deg)) {
-    throw InputError(src, "min/max_elevation_deg", "-90 <= min <= max <= 90");
+    throw InputError(source, "min/max_elevation_deg", "-90 <= min <= max <= 90");
   }
   if (!(azimuth_span_deg > 0 && azimuth_span_deg <= 360)) {
-    throw InputError(src, "azimuth_span_deg", "in (0, 360]");
+    throw InputError(source, "azimuth_span_deg", "in (0, 360]");
   }
   if (!(min_fov_deg >= 10 && max_fov_deg <= 150 && min_fov_deg <= max_fov_deg)) {
-    throw InputError(src, "min/max_fov_deg", "10 <= min <= max <= 150");
+    throw InputError(source, "min/max_fov_deg", "10 <= min <= max <= 150");
   }
 }
 
@@ -167,7 +165,7 @@ std::vector<std::string> RigPresetNames() {
 }
 
 Rig MakePresetRig(const RigPresetOptions& options, uint64_t seed) {
-  options.Check();
+  options.Check("rig options");
   if (options.preset == "random") return RandomRig(options, seed);
   const Preset p = options.preset == "dexycb"   ? DexYcb()
                    : options.preset == "oakink" ? OakInk()

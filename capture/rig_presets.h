@@ -45,7 +45,7 @@ struct RigPresetOptions {
   // (k1 in [-0.3, 0.1], k2 in [-0.05, 0.1], |p1|, |p2| <= 0.002) instead of PINHOLE.
   bool distortion = false;
   // Throws InputError naming the field.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 std::vector<std::string> RigPresetNames();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 
 namespace handlabel {
@@ -325,17 +326,15 @@ ShadingOptions RealisticLighting(std::mt19937_64& rng) {
 
 }  // namespace
 
-void RealisticLookOptions::Check() const {
-  const std::string src = "realistic look options";
+void RealisticLookOptions::Check(const std::string& source) const {
+  // Open at both ends, so not RequireInRange.
   if (!(forearm_length > 0.02 && forearm_length < 1)) {
-    throw InputError(src, "forearm_length", "0.02..1 m", std::to_string(forearm_length));
+    throw InputError(source, "forearm_length", "0.02..1 m",
+                     OptionValueText(forearm_length));
   }
-  if (!std::isfinite(table_height)) throw InputError(src, "table_height", "finite");
-  if (!(blur >= 0 && blur <= 3))
-    throw InputError(src, "blur", "0..3 px", std::to_string(blur));
-  if (!(max_noise >= 1 && max_noise <= 30)) {
-    throw InputError(src, "max_noise", "1..30 levels", std::to_string(max_noise));
-  }
+  if (!std::isfinite(table_height)) throw InputError(source, "table_height", "finite");
+  RequireInRange(source, "blur", blur, 0, 3, "0..3 px");
+  RequireInRange(source, "max_noise", max_noise, 1, 30, "1..30 levels");
 }
 
 void ApplyRealisticLook(const HandModel& model, const RealisticLookOptions& options,

@@ -44,7 +44,7 @@ struct RealisticLookOptions {
   double blur = 0.6;            // sigma (px) of the camera blur, 0 = none
   double max_noise = 4.0;       // sensor noise sigma (8-bit levels), drawn in [1, this]
   // Throws InputError naming the field.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Re-skins the scene's hand, replaces its lighting and adds the scenery. Deterministic

@@ -15,6 +15,7 @@
 #include "capture/capture_format.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 #include "core/version.h"
 
@@ -49,28 +50,21 @@ ImageU16 DepthToU16(const ImageF& depth, double unit) {
 
 }  // namespace
 
-void SynthCaptureOptions::Check() const {
-  rig.Check();
-  scene.Check();
-  view.Check();
-  detections.Check();
-  if (num_frames < 1 || num_frames > 100000000) {
-    throw InputError("synth options", "num_frames", "1..1e8", std::to_string(num_frames));
-  }
-  if (num_threads < 0) {
-    throw InputError("synth options", "num_threads", ">= 0 (0 = all cores)",
-                     std::to_string(num_threads));
-  }
-  if (png.compression_level < 0 || png.compression_level > 9) {
-    throw InputError("synth options", "png.compression_level", "0..9",
-                     std::to_string(png.compression_level));
-  }
+void SynthCaptureOptions::Check(const std::string& source) const {
+  // The parts keep their own names in messages, as their fields are theirs.
+  rig.Check("rig options");
+  scene.Check("synthetic scene options");
+  view.Check("synthetic view options");
+  detections.Check("detection noise options");
+  RequireInRange(source, "num_frames", num_frames, 1, 100000000, "1..1e8");
+  RequireAtLeast(source, "num_threads", num_threads, 0, ">= 0 (0 = all cores)");
+  RequireInRange(source, "png.compression_level", png.compression_level, 0, 9);
 }
 
 SynthGenerator::SynthGenerator(const HandModel& model, Rig rig,
                                const SynthCaptureOptions& options)
     : model_(model), rig_(std::move(rig)), options_(options) {
-  options_.Check();
+  options_.Check("synth options");
   if (rig_.empty()) throw InputError("synth", "rig", "at least one camera", "none");
   anatomy_ = ComputeHandAnatomy(model_);
   limits_ = DefaultHandLimits();
@@ -289,7 +283,7 @@ SynthCaptureSummary WriteSynthCapture(const HandModel& model,
                                       bool overwrite,
                                       const std::function<void(int, int)>& progress) {
   const auto start = std::chrono::steady_clock::now();
-  options.Check();
+  options.Check("synth options");
   PrepareOutputFolder(out_dir, overwrite);
   const fs::path root(out_dir);
   const SynthGenerator generator(model, MakePresetRig(options.rig, options.seed),

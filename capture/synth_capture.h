@@ -38,7 +38,7 @@ struct SynthCaptureOptions {
   bool write_detections = true;      // detections/ (keypoints + noisy masks)
   int num_threads = 0;               // 0 = TBB's default (all cores)
   PngWriteOptions png;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // One generated frame.

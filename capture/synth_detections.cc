@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 #include "image/distance_transform.h"
 #include "image/mask_image.h"
@@ -46,32 +47,17 @@ ImageU8 Morph(const ImageU8& mask, int radius) {
 
 }  // namespace
 
-void DetectionNoiseOptions::Check() const {
-  const std::string src = "detection noise options";
-  if (!(keypoint_sigma_px >= 0 && keypoint_sigma_px <= 1000)) {
-    throw InputError(src, "keypoint_sigma_px", "0..1000",
-                     std::to_string(keypoint_sigma_px));
-  }
+void DetectionNoiseOptions::Check(const std::string& source) const {
+  RequireInRange(source, "keypoint_sigma_px", keypoint_sigma_px, 0, 1000);
   for (double rate : {outlier_rate, dropout_rate, occluded_dropout_rate}) {
-    if (!(rate >= 0 && rate <= 1)) {
-      throw InputError(src, "outlier_rate/dropout_rate", "probabilities in [0, 1]",
-                       std::to_string(rate));
-    }
+    RequireInRange(source, "outlier_rate/dropout_rate", rate, 0, 1,
+                   "probabilities in [0, 1]");
   }
-  if (!(object_sigma_per_px >= 0)) {
-    throw InputError(src, "object_sigma_per_px", ">= 0",
-                     std::to_string(object_sigma_per_px));
-  }
-  if (!(object_confidence_px > 0)) {
-    throw InputError(src, "object_confidence_px", "> 0",
-                     std::to_string(object_confidence_px));
-  }
-  if (!(object_depth_cap_px >= 0)) {
-    throw InputError(src, "object_depth_cap_px", ">= 0",
-                     std::to_string(object_depth_cap_px));
-  }
+  RequireAtLeast(source, "object_sigma_per_px", object_sigma_per_px, 0);
+  RequireGreater(source, "object_confidence_px", object_confidence_px, 0);
+  RequireAtLeast(source, "object_depth_cap_px", object_depth_cap_px, 0);
   if (mask_morph_radius < 0 || mask_morph_radius > 50 || mask_blobs < 0) {
-    throw InputError(src, "mask_morph_radius/mask_blobs", "0..50 and >= 0");
+    throw InputError(source, "mask_morph_radius/mask_blobs", "0..50 and >= 0");
   }
 }
 

@@ -43,7 +43,7 @@ struct DetectionNoiseOptions {
   double object_depth_cap_px = 60.0;
   int mask_morph_radius = 2;  // max erosion/dilation of the noisy mask (px)
   int mask_blobs = 3;         // max boundary blobs added or removed
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct ViewDetections {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 #include "image/mesh_primitives.h"
 
@@ -150,38 +151,26 @@ RenderMesh MakeObjectMesh(const std::string& kind, const Eigen::Vector3d& size) 
   throw InputError("object", "kind", "sphere, box or cylinder", kind);
 }
 
-void SynthSceneOptions::Check() const {
-  const std::string src = "synthetic scene options";
+void SynthSceneOptions::Check(const std::string& source) const {
   const double w[] = {weight_open,   weight_fist,  weight_pinch, weight_point,
                       weight_random, weight_grasp, weight_pca};
   double total = 0;
   for (double x : w) {
-    if (!(x >= 0)) throw InputError(src, "weight_*", ">= 0", std::to_string(x));
+    RequireAtLeast(source, "weight_*", x, 0);
     total += x;
   }
-  if (!(total > 0)) throw InputError(src, "weight_*", "at least one weight > 0");
-  if (!(jitter_deg >= 0 && jitter_deg <= 45)) {
-    throw InputError(src, "jitter_deg", "0..45", std::to_string(jitter_deg));
-  }
+  if (!(total > 0)) throw InputError(source, "weight_*", "at least one weight > 0");
+  RequireInRange(source, "jitter_deg", jitter_deg, 0, 45);
   if (!(pca_sigma >= 0) || pca_components < 1) {
-    throw InputError(src, "pca_sigma/pca_components", "sigma >= 0 and >= 1 component");
+    throw InputError(source, "pca_sigma/pca_components", "sigma >= 0 and >= 1 component");
   }
-  if (!(betas_sigma >= 0 && betas_sigma <= 5)) {
-    throw InputError(src, "betas_sigma", "0..5", std::to_string(betas_sigma));
-  }
-  if (!(object_probability >= 0 && object_probability <= 1)) {
-    throw InputError(src, "object_probability", "0..1",
-                     std::to_string(object_probability));
-  }
-  if (max_objects < 1 || max_objects > 8) {
-    throw InputError(src, "max_objects", "1..8", std::to_string(max_objects));
-  }
+  RequireInRange(source, "betas_sigma", betas_sigma, 0, 5);
+  RequireInRange(source, "object_probability", object_probability, 0, 1);
+  RequireInRange(source, "max_objects", max_objects, 1, 8);
   if (!(workspace_radius >= 0) || !workspace_center.allFinite()) {
-    throw InputError(src, "workspace_radius/center", "finite, radius >= 0");
+    throw InputError(source, "workspace_radius/center", "finite, radius >= 0");
   }
-  if (placement_tries < 1) {
-    throw InputError(src, "placement_tries", ">= 1", std::to_string(placement_tries));
-  }
+  RequireAtLeast(source, "placement_tries", placement_tries, 1);
 }
 
 std::vector<std::string> SynthPoseKindNames() {

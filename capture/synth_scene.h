@@ -52,7 +52,7 @@ struct SynthSceneOptions {
   // Placement attempts; the one where the most cameras see all 21 keypoints wins.
   int placement_tries = 12;
   // Throws InputError naming the field.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 std::vector<std::string> SynthPoseKindNames();  // open fist pinch point random grasp pca

@@ -3,19 +3,16 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 
 namespace handlabel {
 
-void SynthViewOptions::Check() const {
-  if (!(self_occlusion_tolerance > 0)) {
-    throw InputError("synthetic view options", "self_occlusion_tolerance", "> 0",
-                     std::to_string(self_occlusion_tolerance));
-  }
-  realistic.Check();
+void SynthViewOptions::Check(const std::string& source) const {
+  RequireGreater(source, "self_occlusion_tolerance", self_occlusion_tolerance, 0);
+  realistic.Check("realistic look options");
   if (background.max_shapes < 0 || !(background.max_noise >= 0)) {
-    throw InputError("synthetic view options", "background",
-                     "max_shapes, max_noise >= 0");
+    throw InputError(source, "background", "max_shapes, max_noise >= 0");
   }
 }
 

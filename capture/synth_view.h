@@ -46,7 +46,7 @@ struct SynthViewOptions {
   // drawn in both.
   SynthAppearance appearance = SynthAppearance::kBasic;
   RealisticLookOptions realistic;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct SynthView {

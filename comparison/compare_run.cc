@@ -8,6 +8,7 @@
 
 #include "capture/capture_format.h"
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/stopwatch.h"
 #include "core/text.h"
 #include "pipeline/label_job.h"
@@ -125,29 +126,19 @@ CompareMethod ParseCompareMethod(const std::string& name, const std::string& sou
                    "'" + name + "'");
 }
 
-void CompareOptions::Check() const {
-  const char* cli = "command line";
-  if (out_dir.empty()) throw InputError(cli, "--out", "an output folder");
-  if (auc_max_mm < 0) {
-    throw InputError(cli, "--auc-max-mm", ">= 0 (0: from the input)",
-                     std::to_string(auc_max_mm));
-  }
-  if (auc_steps < 2)
-    throw InputError(cli, "--auc-steps", ">= 2", std::to_string(auc_steps));
+void CompareOptions::Check(const std::string& source) const {
+  if (out_dir.empty()) throw InputError(source, "--out", "an output folder");
+  RequireAtLeast(source, "--auc-max-mm", auc_max_mm, 0, ">= 0 (0: from the input)");
+  RequireAtLeast(source, "--auc-steps", auc_steps, 2);
   for (int v : ablation_views) {
-    if (v < 1)
-      throw InputError(cli, "--ablation-views", "view counts >= 1", std::to_string(v));
+    RequireAtLeast(source, "--ablation-views", v, 1, "view counts >= 1");
   }
-  if (ablation_frames < 1) {
-    throw InputError(cli, "--ablation-frames", ">= 1", std::to_string(ablation_frames));
-  }
-  if (worst_frames < 0)
-    throw InputError(cli, "--worst-frames", ">= 0", std::to_string(worst_frames));
-  if (!(qa_error_mm > 0))
-    throw InputError(cli, "--qa-error-mm", "> 0", std::to_string(qa_error_mm));
+  RequireAtLeast(source, "--ablation-frames", ablation_frames, 1);
+  RequireAtLeast(source, "--worst-frames", worst_frames, 0);
+  RequireGreater(source, "--qa-error-mm", qa_error_mm, 0);
   for (const std::string& dir : qa_selection) {
     if (!fs::exists(fs::path(dir) / "compare.json")) {
-      throw InputError(cli, "--qa-selection", "compare output folders (compare.json)",
+      throw InputError(source, "--qa-selection", "compare output folders (compare.json)",
                        dir);
     }
   }
@@ -231,7 +222,7 @@ JobConfig MethodJob(const JobConfig& base, CompareMethod method, const std::stri
       job.mask_files = files.count(kFileMask) ? "truth" : "auto";
       break;
   }
-  job.Check();
+  job.Check(job.source_file);
   return job;
 }
 
@@ -299,7 +290,7 @@ class ComparisonRun {
 
   CompareResult Run() {
     const Clock::time_point start = Clock::now();
-    options_.Check();
+    options_.Check("command line");
     fs::create_directories(options_.out_dir);
     LoadFramesAndTruth();
     const std::vector<CompareMethod> methods =

@@ -67,7 +67,7 @@ struct CompareOptions {
   // run's frames at even positions, judge on the odd ones (comparison/compare_qa.h).
   std::vector<std::string> qa_selection;
   // Throws InputError naming the flag.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Errors of one method on the compared frames (metres inside, mm in the table).

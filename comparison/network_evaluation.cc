@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/stopwatch.h"
 #include "hand/mesh_keypoints.h"
 #include "image/line_plot.h"
@@ -40,23 +41,19 @@ PoemPrediction MaskGrids(const HandMeshPrediction& prediction) {
 
 }  // namespace
 
-void NetworkEvalOptions::Check() const {
-  if (weights.empty()) throw InputError("eval-network", "--weights", "a checkpoint", "");
-  if (frames < 1)
-    throw InputError("eval-network", "--frames", ">= 1", std::to_string(frames));
-  if (batch_size < 1) {
-    throw InputError("eval-network", "--batch", ">= 1", std::to_string(batch_size));
-  }
-  if (threads < 1) {
-    throw InputError("eval-network", "--threads", ">= 1", std::to_string(threads));
-  }
-  synth.Check();
-  pck.Check();
+void NetworkEvalOptions::Check(const std::string& source) const {
+  if (weights.empty()) throw InputError(source, "--weights", "a checkpoint", "");
+  RequireAtLeast(source, "--frames", frames, 1);
+  RequireAtLeast(source, "--batch", batch_size, 1);
+  RequireAtLeast(source, "--threads", threads, 1);
+  // The parts keep their own names in messages, as their fields are theirs.
+  synth.Check("synth options");
+  pck.Check("PckOptions");
 }
 
 NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOptions& o,
                                       const std::function<void(int, int)>& progress) {
-  o.Check();
+  o.Check("eval-network");
   HandMeshPredictorOptions po;
   po.weights = o.weights;
   po.num_threads = o.threads;
@@ -137,21 +134,18 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   return r;
 }
 
-void CaptureNetworkEvalOptions::Check() const {
-  const char* cli = "command line";
-  if (capture.empty()) throw InputError(cli, "--capture", "a capture folder");
-  if (weights.empty()) throw InputError(cli, "--weights", "a checkpoint");
-  if (out_dir.empty()) throw InputError(cli, "--out", "an output folder");
-  if (max_frames < 0)
-    throw InputError(cli, "--max-frames", ">= 0", std::to_string(max_frames));
-  if (threads < 0) throw InputError(cli, "--threads", ">= 0", std::to_string(threads));
-  if (auc_max_mm < 0)
-    throw InputError(cli, "--auc-max-mm", ">= 0", std::to_string(auc_max_mm));
+void CaptureNetworkEvalOptions::Check(const std::string& source) const {
+  if (capture.empty()) throw InputError(source, "--capture", "a capture folder");
+  if (weights.empty()) throw InputError(source, "--weights", "a checkpoint");
+  if (out_dir.empty()) throw InputError(source, "--out", "an output folder");
+  RequireAtLeast(source, "--max-frames", max_frames, 0);
+  RequireAtLeast(source, "--threads", threads, 0);
+  RequireAtLeast(source, "--auc-max-mm", auc_max_mm, 0);
 }
 
 CompareResult EvaluateNetworkOnCapture(const CaptureNetworkEvalOptions& o,
                                        std::ostream* log) {
-  o.Check();
+  o.Check("command line");
   JobConfig base =
       CompareCaptureJob(o.capture, o.weights, o.frames, o.max_frames, o.threads, o.seed);
   base.hand_model = o.hand_model;

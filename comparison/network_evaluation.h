@@ -37,7 +37,7 @@ struct NetworkEvalOptions {
   // How the answer's keypoints are read (as a job's network.keypoints): the MPJPE,
   // PA-MPJPE and joint PCK are of these.
   AnswerKeypoints keypoints = AnswerKeypoints::kMean;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct NetworkEvalResult {
@@ -76,7 +76,7 @@ struct CaptureNetworkEvalOptions {
   double auc_max_mm = 0;   // PCK / AUC range; 0 = 50 for HO3D-like input, else 20
   AnswerKeypoints keypoints = AnswerKeypoints::kMean;  // the job's network.keypoints
   // Throws InputError naming the flag.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // The comparison with the network row alone (result.methods has one entry).

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "geometry/triangulation.h"
 
 namespace handlabel {
@@ -246,22 +247,14 @@ void VoteSide(FrameHandResult* frame) {
 }  // namespace
 
 void MultiViewDetectorOptions::Check(const std::string& source) const {
-  if (min_palm_views < 2)
-    throw InputError(source, "min_palm_views", ">= 2", std::to_string(min_palm_views));
-  const auto positive = [&](double v, const char* field) {
-    if (!(v > 0)) throw InputError(source, field, "> 0", std::to_string(v));
-  };
-  positive(palm_agreement, "palm_agreement");
-  positive(keypoint_inlier, "keypoint_inlier");
-  positive(max_reprojection, "max_reprojection");
-  if (!(min_presence_from_3d >= 0 && min_presence_from_3d <= 1)) {
-    throw InputError(source, "min_presence_from_3d", "a value in [0, 1]",
-                     std::to_string(min_presence_from_3d));
-  }
-  if (!(min_keypoints_in_view >= 0 && min_keypoints_in_view <= 1)) {
-    throw InputError(source, "min_keypoints_in_view", "a value in [0, 1]",
-                     std::to_string(min_keypoints_in_view));
-  }
+  RequireAtLeast(source, "min_palm_views", min_palm_views, 2);
+  RequireGreater(source, "palm_agreement", palm_agreement, 0);
+  RequireGreater(source, "keypoint_inlier", keypoint_inlier, 0);
+  RequireGreater(source, "max_reprojection", max_reprojection, 0);
+  RequireInRange(source, "min_presence_from_3d", min_presence_from_3d, 0, 1,
+                 "a value in [0, 1]");
+  RequireInRange(source, "min_keypoints_in_view", min_keypoints_in_view, 0, 1,
+                 "a value in [0, 1]");
 }
 
 FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& rig,

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -51,13 +52,9 @@ void SsdAnchorOptions::Check(const std::string& source) const {
     throw InputError(source, "input size", "positive width and height");
   }
   if (strides.empty()) throw InputError(source, "strides", "at least one stride");
-  for (int s : strides) {
-    if (s <= 0)
-      throw InputError(source, "strides", "positive strides", std::to_string(s));
-  }
-  if (anchors_per_layer_cell <= 0) {
-    throw InputError(source, "anchors_per_layer_cell", "a positive count");
-  }
+  for (int s : strides) RequireGreater(source, "strides", s, 0, "positive strides");
+  RequireGreater(source, "anchors_per_layer_cell", anchors_per_layer_cell, 0,
+                 "a positive count");
 }
 
 std::vector<Eigen::Vector2d> MakeSsdAnchors(const SsdAnchorOptions& options) {
@@ -88,11 +85,9 @@ std::vector<Eigen::Vector2d> MakeSsdAnchors(const SsdAnchorOptions& options) {
 }
 
 void PalmDecodeOptions::Check(const std::string& source) const {
-  if (!(coordinate_scale > 0)) throw InputError(source, "coordinate_scale", "> 0");
-  if (!(score_clipping > 0)) throw InputError(source, "score_clipping", "> 0");
-  if (!(min_score >= 0 && min_score <= 1)) {
-    throw InputError(source, "min_score", "a value in [0, 1]", std::to_string(min_score));
-  }
+  RequireGreater(source, "coordinate_scale", coordinate_scale, 0);
+  RequireGreater(source, "score_clipping", score_clipping, 0);
+  RequireInRange(source, "min_score", min_score, 0, 1, "a value in [0, 1]");
 }
 
 std::vector<PalmDetection> DecodePalms(const std::vector<float>& boxes,
@@ -205,7 +200,7 @@ void HandRoiOptions::Check(const std::string& source) const {
   if (!valid(rotation_start_keypoint) || !valid(rotation_end_keypoint)) {
     throw InputError(source, "rotation keypoints", "indices in [0, 7)");
   }
-  if (!(scale > 0)) throw InputError(source, "scale", "> 0", std::to_string(scale));
+  RequireGreater(source, "scale", scale, 0);
 }
 
 NormalizedRect HandRoiFromPalm(const PalmDetection& palm, int image_width,

@@ -5,6 +5,7 @@
 
 #include "core/data_dir.h"
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "detector/tflite_model.h"
 
 namespace handlabel {
@@ -43,17 +44,11 @@ void MediapipeHandsOptions::Check(const std::string& source) const {
   if (model != "full" && model != "lite") {
     throw InputError(source, "model", "full or lite", model);
   }
-  const auto unit = [&](double v, const char* field) {
-    if (!(v >= 0 && v <= 1))
-      throw InputError(source, field, "a value in [0, 1]", std::to_string(v));
-  };
-  unit(min_palm_score, "min_palm_score");
-  unit(nms_iou, "nms_iou");
-  unit(min_presence, "min_presence");
-  if (max_hands < 1)
-    throw InputError(source, "max_hands", ">= 1", std::to_string(max_hands));
-  if (num_threads < 0)
-    throw InputError(source, "num_threads", ">= 0", std::to_string(num_threads));
+  RequireInRange(source, "min_palm_score", min_palm_score, 0, 1, "a value in [0, 1]");
+  RequireInRange(source, "nms_iou", nms_iou, 0, 1, "a value in [0, 1]");
+  RequireInRange(source, "min_presence", min_presence, 0, 1, "a value in [0, 1]");
+  RequireAtLeast(source, "max_hands", max_hands, 1);
+  RequireAtLeast(source, "num_threads", num_threads, 0);
 }
 
 std::string MediapipeModelPath(const MediapipeHandsOptions& options,

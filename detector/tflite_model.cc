@@ -12,6 +12,7 @@
 
 #include "core/errors.h"
 #include "core/file_bytes.h"
+#include "core/option_checks.h"
 #include "detector/tflite_model.h"
 #include "detector/tflite_reader.h"
 #include "detector/tflite_steps.h"
@@ -191,10 +192,8 @@ int64_t TfliteTensorInfo::num_elements() const {
 }
 
 void TfliteModelOptions::Check(const std::string& source) const {
-  if (num_threads < 0) {
-    throw InputError(source, "num_threads", ">= 0 (0 = keep the current setting)",
-                     std::to_string(num_threads));
-  }
+  RequireAtLeast(source, "num_threads", num_threads, 0,
+                 ">= 0 (0 = keep the current setting)");
 }
 
 std::unique_ptr<TfliteModel> TfliteModel::FromBytes(const std::string& bytes,

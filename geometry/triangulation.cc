@@ -6,19 +6,14 @@
 #include <random>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 
-void RobustTriangulationOptions::Check() const {
-  const std::string src = "RobustTriangulationOptions";
-  if (!(inlier_threshold_px > 0)) {
-    throw InputError(src, "inlier_threshold_px", "> 0",
-                     std::to_string(inlier_threshold_px));
-  }
-  if (min_inliers < 2)
-    throw InputError(src, "min_inliers", ">= 2", std::to_string(min_inliers));
-  if (max_pairs < 1)
-    throw InputError(src, "max_pairs", ">= 1", std::to_string(max_pairs));
+void RobustTriangulationOptions::Check(const std::string& source) const {
+  RequireGreater(source, "inlier_threshold_px", inlier_threshold_px, 0);
+  RequireAtLeast(source, "min_inliers", min_inliers, 2);
+  RequireAtLeast(source, "max_pairs", max_pairs, 1);
 }
 
 namespace {
@@ -94,7 +89,7 @@ double ReprojectionErrorPx(const Rig& rig, const ViewObservation& observation,
 RobustTriangulation TriangulateRobust(const Rig& rig,
                                       const std::vector<ViewObservation>& observations,
                                       const RobustTriangulationOptions& options) {
-  options.Check();
+  options.Check("RobustTriangulationOptions");
   std::vector<int> usable;
   for (size_t i = 0; i < observations.size(); ++i) {
     if (observations[i].confidence > 0) usable.push_back(static_cast<int>(i));

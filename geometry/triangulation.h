@@ -32,7 +32,7 @@ struct RobustTriangulationOptions {
   int max_pairs = 100;
   uint64_t seed = 0;
   // Throws InputError naming the field if a value is out of range.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct RobustTriangulation {

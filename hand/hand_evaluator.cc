@@ -4,18 +4,13 @@
 #include <algorithm>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 
-void HandEvaluatorOptions::Check() const {
-  if (num_betas < -1) {
-    throw InputError("HandEvaluatorOptions", "num_betas", ">= 0, or -1 for all",
-                     std::to_string(num_betas));
-  }
-  if (num_pca_comps < 0) {
-    throw InputError("HandEvaluatorOptions", "num_pca_comps", ">= 0",
-                     std::to_string(num_pca_comps));
-  }
+void HandEvaluatorOptions::Check(const std::string& source) const {
+  RequireAtLeast(source, "num_betas", num_betas, -1, ">= 0, or -1 for all");
+  RequireAtLeast(source, "num_pca_comps", num_pca_comps, 0);
 }
 
 HandEvaluator::HandEvaluator(const HandModel& model, const HandEvaluatorOptions& options)
@@ -23,7 +18,7 @@ HandEvaluator::HandEvaluator(const HandModel& model, const HandEvaluatorOptions&
       num_vertices_(model.num_vertices()),
       parents_(model.parents),
       tip_vertex_ids_(model.tip_vertex_ids) {
-  options.Check();
+  options.Check("HandEvaluatorOptions");
   const std::string source = "HandEvaluatorOptions (model " + model.name + ")";
   num_betas_ = options.num_betas < 0 ? model.num_betas() : options.num_betas;
   if (num_betas_ > model.num_betas() || num_betas_ > kMaxHandBetas) {

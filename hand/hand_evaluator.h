@@ -51,7 +51,7 @@ struct HandEvaluatorOptions {
   bool flat_hand_mean = false;
   // Model-independent checks (the evaluator's constructor also checks against the
   // model); throws InputError.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Most shape coefficients an evaluator reads (MANO has 10).

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -86,27 +87,20 @@ std::string HandPoseKindName(HandPoseKind kind) {
   return "unknown";
 }
 
-void HandPoseSamplerOptions::Check() const {
+void HandPoseSamplerOptions::Check(const std::string& source) const {
   const double weights[5] = {weight_open, weight_fist, weight_pinch, weight_point,
                              weight_random};
   const char* const names[5] = {"weight_open", "weight_fist", "weight_pinch",
                                 "weight_point", "weight_random"};
   double total = 0;
   for (int i = 0; i < 5; ++i) {
-    if (!(weights[i] >= 0.0)) {
-      throw InputError("HandPoseSamplerOptions", names[i], ">= 0",
-                       std::to_string(weights[i]));
-    }
+    RequireAtLeast(source, names[i], weights[i], 0);
     total += weights[i];
   }
   if (!(total > 0.0)) {
-    throw InputError("HandPoseSamplerOptions", "weight_*", "at least one weight > 0",
-                     "all zero");
+    throw InputError(source, "weight_*", "at least one weight > 0", "all zero");
   }
-  if (!(jitter_deg >= 0.0)) {
-    throw InputError("HandPoseSamplerOptions", "jitter_deg", ">= 0",
-                     std::to_string(jitter_deg));
-  }
+  RequireAtLeast(source, "jitter_deg", jitter_deg, 0);
 }
 
 SampledHandPose SampleHandPoseOfKind(const HandAnatomy& anatomy, const HandLimits& limits,
@@ -136,7 +130,7 @@ SampledHandPose SampleHandPoseOfKind(const HandAnatomy& anatomy, const HandLimit
 SampledHandPose SampleHandPose(const HandAnatomy& anatomy, const HandLimits& limits,
                                const HandPoseSamplerOptions& options,
                                std::mt19937_64& rng) {
-  options.Check();
+  options.Check("HandPoseSamplerOptions");
   std::discrete_distribution<int> pick({options.weight_open, options.weight_fist,
                                         options.weight_pinch, options.weight_point,
                                         options.weight_random});

@@ -24,7 +24,7 @@ struct HandPoseSamplerOptions {
   // Standard deviation of the Gaussian jitter added to each archetype angle, degrees
   // (the result is clamped to the limits).
   double jitter_deg = 6.0;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct SampledHandPose {

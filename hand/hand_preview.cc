@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "hand/hand_anatomy.h"
 
 namespace handlabel {
@@ -30,15 +31,12 @@ void Chain(std::array<std::array<double, 3>, kNumHandJoints>* d, int first,
 
 }  // namespace
 
-void HandPreviewOptions::Check() const {
-  if (tile_size < 32 || tile_size > 4096) {
-    throw InputError("preview options", "tile_size", "32 to 4096 pixels",
-                     std::to_string(tile_size));
-  }
-  if (views.empty()) throw InputError("preview options", "views", "at least one view");
+void HandPreviewOptions::Check(const std::string& source) const {
+  RequireInRange(source, "tile_size", tile_size, 32, 4096, "32 to 4096 pixels");
+  if (views.empty()) throw InputError(source, "views", "at least one view");
   for (const std::string& v : views) {
     if (v != "palm" && v != "back" && v != "thumb" && v != "pinky" && v != "tip") {
-      throw InputError("preview options", "views", "palm, back, thumb, pinky or tip", v);
+      throw InputError(source, "views", "palm, back, thumb, pinky or tip", v);
     }
   }
 }
@@ -92,7 +90,7 @@ Eigen::Vector3d JointColor(int joint) {
 
 ImageU8 RenderHandSheet(const HandModel& model, const std::vector<NamedHandPose>& poses,
                         const HandPreviewOptions& options) {
-  options.Check();
+  options.Check("preview options");
   const int tile = options.tile_size;
   const int cols = static_cast<int>(options.views.size());
   const int rows = static_cast<int>(poses.size());

@@ -28,7 +28,7 @@ struct HandPreviewOptions {
   HandPreviewColoring coloring = HandPreviewColoring::kSkin;
   // Views (columns): "palm", "back", "thumb", "pinky", "tip".
   std::vector<std::string> views = {"palm", "back", "thumb"};
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // One row per pose; every tile uses the same scale so sizes compare.

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -72,16 +73,13 @@ double ProcrustesMeanPointError(const Points3d& predicted, const Points3d& truth
   return MeanPointError(s.Apply(predicted), truth);
 }
 
-void PckOptions::Check() const {
-  if (!(min_threshold >= 0.0)) {
-    throw InputError("PckOptions", "min_threshold", ">= 0",
-                     std::to_string(min_threshold));
-  }
+void PckOptions::Check(const std::string& source) const {
+  RequireAtLeast(source, "min_threshold", min_threshold, 0);
   if (!(max_threshold > min_threshold)) {
-    throw InputError("PckOptions", "max_threshold", "> min_threshold",
-                     std::to_string(max_threshold));
+    throw InputError(source, "max_threshold", "> min_threshold",
+                     OptionValueText(max_threshold));
   }
-  if (steps < 2) throw InputError("PckOptions", "steps", ">= 2", std::to_string(steps));
+  RequireAtLeast(source, "steps", steps, 2);
 }
 
 double PckAt(const Eigen::MatrixXd& errors, double threshold) {
@@ -92,7 +90,7 @@ double PckAt(const Eigen::MatrixXd& errors, double threshold) {
 }
 
 PckCurve ComputePck(const Eigen::MatrixXd& errors, const PckOptions& options) {
-  options.Check();
+  options.Check("PckOptions");
   PckCurve curve;
   const double span = options.max_threshold - options.min_threshold;
   for (int i = 0; i < options.steps; ++i) {

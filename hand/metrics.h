@@ -56,7 +56,7 @@ struct PckOptions {
   double max_threshold = 0.02;  // metres; last threshold (POEM: 20 mm)
   int steps = 20;               // number of thresholds, linspace(min, max, steps)
   // Throws InputError unless 0 <= min < max and steps >= 2.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct PckCurve {

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "hand/hand_anatomy.h"
 #include "hand/hand_pose_sampler.h"
 #include "openhand/implicit_mesher.h"
@@ -136,30 +137,22 @@ Eigen::SparseVector<double> FitRegressorRow(const std::vector<Eigen::Vector3d>& 
 
 }  // namespace
 
-void OpenHandBuildOptions::Check() const {
-  const char* src = "open hand build options";
-  if (!(grid_step >= 2e-4 && grid_step <= 5e-3))
-    throw InputError(src, "grid_step", "a spacing in [0.0002, 0.005] m",
-                     std::to_string(grid_step));
-  if (target_vertices < 200 || target_vertices > 20000)
-    throw InputError(src, "target_vertices", "200 to 20000",
-                     std::to_string(target_vertices));
-  if (relax_iterations < 0 || relax_iterations > 100)
-    throw InputError(src, "relax_iterations", "0 to 100",
-                     std::to_string(relax_iterations));
-  if (num_betas < 1 || num_betas > 20)
-    throw InputError(src, "num_betas", "1 to 20", std::to_string(num_betas));
-  if (num_shape_samples < num_betas || num_shape_samples > 5000)
-    throw InputError(src, "num_shape_samples", "num_betas to 5000",
+void OpenHandBuildOptions::Check(const std::string& source) const {
+  RequireInRange(source, "grid_step", grid_step, 2e-4, 5e-3,
+                 "a spacing in [0.0002, 0.005] m");
+  RequireInRange(source, "target_vertices", target_vertices, 200, 20000, "200 to 20000");
+  RequireInRange(source, "relax_iterations", relax_iterations, 0, 100, "0 to 100");
+  RequireInRange(source, "num_betas", num_betas, 1, 20, "1 to 20");
+  if (num_shape_samples < num_betas || num_shape_samples > 5000) {
+    throw InputError(source, "num_shape_samples", "num_betas to 5000",
                      std::to_string(num_shape_samples));
-  if (num_pose_samples < 100 || num_pose_samples > 100000)
-    throw InputError(src, "num_pose_samples", "100 to 100000",
-                     std::to_string(num_pose_samples));
-  if (!(regressor_radius >= 0.5 && regressor_radius <= 5.0))
-    throw InputError(src, "regressor_radius", "0.5 to 5",
-                     std::to_string(regressor_radius));
-  variation.Check();
-  skinning.Check();
+  }
+  RequireInRange(source, "num_pose_samples", num_pose_samples, 100, 100000,
+                 "100 to 100000");
+  RequireInRange(source, "regressor_radius", regressor_radius, 0.5, 5, "0.5 to 5");
+  // The parts keep their own names in messages, as their fields are theirs.
+  variation.Check("open hand variation");
+  skinning.Check("skinning options");
 }
 
 namespace {
@@ -255,7 +248,7 @@ void BuildPosePca(const OpenHandBuildOptions& options, std::mt19937_64& rng,
 
 HandModel BuildOpenHand(const OpenHandDesign& design, const OpenHandBuildOptions& options,
                         OpenHandBuildReport* report) {
-  options.Check();
+  options.Check("open hand build options");
   OpenHandBuildReport local_report;
   if (!report) report = &local_report;
   const OpenHandShape shape = ShapeFromDesign(design);

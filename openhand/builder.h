@@ -37,7 +37,7 @@ struct OpenHandBuildOptions {
                                   // local radii of the joint (axial offsets count 3x)
   OpenHandVariation variation;
   OpenHandSkinningOptions skinning;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Diagnostics of one build.

@@ -5,12 +5,12 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-const char* const kSource = "open hand design";
 
 OpenHandFingerDesign Finger(Eigen::Vector3d mcp, double spread_deg,
                             std::array<double, 3> lengths_mm,
@@ -66,10 +66,9 @@ double PalmSlabValue(const OpenHandShape& s, const Eigen::Vector3d& p) {
 
 }  // namespace
 
-void OpenHandDesign::Check() const {
-  auto positive = [](double v, const std::string& field) {
-    if (!(v > 0.0))
-      throw InputError(kSource, field, "a positive value", std::to_string(v));
+void OpenHandDesign::Check(const std::string& source) const {
+  auto positive = [&](double v, const std::string& field) {
+    RequireGreater(source, field, v, 0, "a positive value");
   };
   for (int f = 0; f < 4; ++f) {
     for (double l : fingers[f].lengths) positive(l, "fingers.lengths");
@@ -138,7 +137,7 @@ OpenHandSkeleton SkeletonFromDesign(const OpenHandDesign& design) {
 }
 
 OpenHandShape ShapeFromDesign(const OpenHandDesign& design) {
-  design.Check();
+  design.Check("open hand design");
   const OpenHandSkeleton sk = SkeletonFromDesign(design);
   OpenHandShape s;
   s.wrist = design.wrist;
@@ -280,19 +279,16 @@ void OpenHandShape::Bounds(Eigen::Vector3d* lo, Eigen::Vector3d* hi) const {
   *hi += margin;
 }
 
-void OpenHandVariation::Check() const {
+void OpenHandVariation::Check(const std::string& source) const {
   for (double v : {scale, palm_width, palm_length, thickness, finger_girth, finger_length,
                    each_finger, thumb_length, thumb_abduction_deg}) {
-    if (!(v >= 0.0) || v > 50.0) {
-      throw InputError("open hand variation", "standard deviations", "values in [0, 50]",
-                       std::to_string(v));
-    }
+    RequireInRange(source, "standard deviations", v, 0, 50, "values in [0, 50]");
   }
 }
 
 OpenHandDesign SampleOpenHandDesign(const OpenHandDesign& mean,
                                     const OpenHandVariation& v, std::mt19937_64& rng) {
-  v.Check();
+  v.Check("open hand variation");
   std::normal_distribution<double> normal(0.0, 1.0);
   // Factors are drawn in a fixed order so the same seed gives the same designs.
   auto factor = [&](double sd) { return std::max(0.5, 1.0 + sd * normal(rng)); };

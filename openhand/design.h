@@ -61,7 +61,7 @@ struct OpenHandDesign {
   double thumb_blend = 0.012;
 
   // Throws InputError (source "open hand design") on non-positive sizes.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Default adult right hand, wrist to middle fingertip ~18.6 cm.
@@ -127,7 +127,7 @@ struct OpenHandVariation {
   double each_finger = 0.020;    // each finger on its own
   double thumb_length = 0.040;
   double thumb_abduction_deg = 6.0;  // thumb swung away from / towards the index
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // One random design around `mean`: each factor is a Gaussian with the SD above.

@@ -6,14 +6,12 @@
 #include <unordered_map>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 
-void ImplicitMesherOptions::Check() const {
-  if (!(step > 0.0)) {
-    throw InputError("implicit mesher options", "step", "a positive grid spacing",
-                     std::to_string(step));
-  }
+void ImplicitMesherOptions::Check(const std::string& source) const {
+  RequireGreater(source, "step", step, 0, "a positive grid spacing");
 }
 
 namespace {
@@ -161,7 +159,7 @@ class TetMesher {
 TriangleMesh MeshImplicitSurface(
     const std::function<double(const Eigen::Vector3d&)>& field, const Eigen::Vector3d& lo,
     const Eigen::Vector3d& hi, const ImplicitMesherOptions& options) {
-  options.Check();
+  options.Check("implicit mesher options");
   const SampleGrid grid(lo, hi, options.step);
   return TetMesher(grid, grid.Sample(field)).Run();
 }

@@ -18,7 +18,7 @@ struct TriangleMesh {
 
 struct ImplicitMesherOptions {
   double step = 0.0015;  // grid spacing (metres); must be > 0
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Samples `field` on the grid covering [lo, hi] and extracts its zero set. The field

@@ -9,6 +9,7 @@
 #include <algorithm>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 namespace {
@@ -61,23 +62,18 @@ void ImproveByFlips(OMesh* om) {
 
 }  // namespace
 
-void DecimationOptions::Check() const {
-  if (target_vertices < 4) {
-    throw InputError("decimation options", "target_vertices", "at least 4",
-                     std::to_string(target_vertices));
-  }
+void DecimationOptions::Check(const std::string& source) const {
+  RequireAtLeast(source, "target_vertices", target_vertices, 4, "at least 4");
+  // Open below, so not RequireInRange.
   if (!(max_normal_deviation_deg > 0.0 && max_normal_deviation_deg <= 180.0)) {
-    throw InputError("decimation options", "max_normal_deviation_deg", "(0, 180]",
-                     std::to_string(max_normal_deviation_deg));
+    throw InputError(source, "max_normal_deviation_deg", "(0, 180]",
+                     OptionValueText(max_normal_deviation_deg));
   }
-  if (!(min_aspect_ratio >= 0.0)) {
-    throw InputError("decimation options", "min_aspect_ratio", ">= 0",
-                     std::to_string(min_aspect_ratio));
-  }
+  RequireAtLeast(source, "min_aspect_ratio", min_aspect_ratio, 0);
 }
 
 TriangleMesh DecimateMesh(const TriangleMesh& mesh, const DecimationOptions& options) {
-  options.Check();
+  options.Check("decimation options");
   OMesh om;
   std::vector<OMesh::VertexHandle> handles;
   handles.reserve(mesh.vertices.size());

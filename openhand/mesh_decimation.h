@@ -15,7 +15,7 @@ struct DecimationOptions {
   // Afterwards, flip edges between nearly coplanar faces (dihedral < 20 degrees) when
   // that raises their minimum angle.
   bool improve_by_flips = false;
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Collapses edges in order of quadric error until `target_vertices` remain. The input

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "openhand/mesh_decimation.h"
 
 namespace handlabel {
@@ -23,18 +24,14 @@ double SegmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
 
 }  // namespace
 
-void OpenHandSkinningOptions::Check() const {
+void OpenHandSkinningOptions::Check(const std::string& source) const {
   if (!(finger_blend > 0.0) || !(thumb_cmc_blend > 0.0)) {
-    throw InputError("skinning options", "finger_blend / thumb_cmc_blend",
-                     "positive values");
+    throw InputError(source, "finger_blend / thumb_cmc_blend", "positive values");
   }
-  if (smoothing_rounds < 0) {
-    throw InputError("skinning options", "smoothing_rounds", ">= 0",
-                     std::to_string(smoothing_rounds));
-  }
+  RequireAtLeast(source, "smoothing_rounds", smoothing_rounds, 0);
+  // Open above, so not RequireInRange.
   if (!(min_weight >= 0.0 && min_weight < 0.1)) {
-    throw InputError("skinning options", "min_weight", "[0, 0.1)",
-                     std::to_string(min_weight));
+    throw InputError(source, "min_weight", "[0, 0.1)", OptionValueText(min_weight));
   }
 }
 
@@ -45,7 +42,7 @@ std::array<std::array<int, 3>, 5> OpenHandChains() {
 SkinningWeights OpenHandSkinningWeights(const TriangleMesh& mesh,
                                         const OpenHandSkeleton& sk,
                                         const OpenHandSkinningOptions& options) {
-  options.Check();
+  options.Check("skinning options");
   const auto chains = OpenHandChains();
   const int num_vertices = static_cast<int>(mesh.vertices.size());
   SkinningWeights w = SkinningWeights::Zero(num_vertices, kNumHandJoints);

@@ -22,7 +22,7 @@ struct OpenHandSkinningOptions {
   double thumb_cmc_blend = 1.2;  // same for the thumb CMC (the thenar is soft)
   int smoothing_rounds = 4;      // Laplacian smoothing rounds over the mesh
   double min_weight = 1e-4;      // smaller weights are dropped (rows renormalised)
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 SkinningWeights OpenHandSkinningWeights(const TriangleMesh& mesh,

@@ -83,7 +83,7 @@ CeresLabelFitter::CeresLabelFitter(const HandModel& model,
     : fitter_(model, options.config, options.fit),
       num_vertices_(model.num_vertices()),
       options_(options) {
-  options.silhouette_check.Check();
+  options.silhouette_check.Check("silhouette check");
   if (options.network_mask_sigma_px > 0) {
     HandFitOptions coarse = options.fit;
     coarse.silhouette_sigma_px = options.network_mask_sigma_px;

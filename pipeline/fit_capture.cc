@@ -5,6 +5,7 @@
 #include <map>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/text.h"
 #include "hand/hand_anatomy.h"
 #include "pipeline/label_job.h"
@@ -42,28 +43,22 @@ void ReadFitReports(const std::string& out_dir, const std::vector<std::string>& 
 
 }  // namespace
 
-void FitCaptureOptions::Check() const {
-  if (capture_dir.empty())
-    throw InputError("command line", "--capture", "a capture folder");
-  if (out_dir.empty()) throw InputError("command line", "--out", "an output folder");
-  if (max_frames < 0) {
-    throw InputError("command line", "--max-frames", ">= 0", std::to_string(max_frames));
-  }
+void FitCaptureOptions::Check(const std::string& source) const {
+  if (capture_dir.empty()) throw InputError(source, "--capture", "a capture folder");
+  if (out_dir.empty()) throw InputError(source, "--out", "an output folder");
+  RequireAtLeast(source, "--max-frames", max_frames, 0);
   if (evidence != "auto" && evidence != "detections" && evidence != "keypoints") {
-    throw InputError("command line", "--evidence", "auto, detections or keypoints",
-                     evidence);
+    throw InputError(source, "--evidence", "auto, detections or keypoints", evidence);
   }
   if (object_masks != "files" && object_masks != "none")
-    throw InputError("command line", "--object-masks", "files or none", object_masks);
+    throw InputError(source, "--object-masks", "files or none", object_masks);
   if (masks != "auto" && masks != "detections" && masks != "truth" && masks != "none") {
-    throw InputError("command line", "--masks", "auto, detections, truth or none", masks);
+    throw InputError(source, "--masks", "auto, detections, truth or none", masks);
   }
   if (fit.init.empty()) {
-    throw InputError("command line", "--init", "triangulate, gt, previous or a folder");
+    throw InputError(source, "--init", "triangulate, gt, previous or a folder");
   }
-  if (num_threads < 0) {
-    throw InputError("command line", "--threads", ">= 0", std::to_string(num_threads));
-  }
+  RequireAtLeast(source, "--threads", num_threads, 0);
 }
 
 namespace {
@@ -88,7 +83,7 @@ std::string FlagOfFitField(const std::string& field) {
 }  // namespace
 
 JobConfig FitJob(const FitCaptureOptions& o) {
-  o.Check();
+  o.Check("command line");
   JobConfig job;
   job.source_file = "handlabel fit";
   job.name = "fit";
@@ -109,7 +104,7 @@ JobConfig FitJob(const FitCaptureOptions& o) {
   job.output_dir = o.out_dir;
   job.overlays = o.overlays;
   try {
-    job.Check();
+    job.Check(job.source_file);
   } catch (const InputError& e) {
     const std::string flag = FlagOfFitField(e.field());
     if (flag.empty()) throw;

@@ -46,7 +46,7 @@ struct FitCaptureOptions {
   int num_threads = 1;    // frames in parallel; 0 = all cores (network.threads)
   bool overlays = false;  // the job's overlay pictures of every label (output.overlays)
   // Throws InputError naming the flag.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // The job the options describe (refine always, no network, evidence from files).

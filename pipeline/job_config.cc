@@ -6,6 +6,7 @@
 #include <set>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "pipeline/yaml_section.h"
 
 namespace handlabel {
@@ -61,17 +62,13 @@ void CheckFitSettings(const FitSettings& fit, const std::string& f) {
       {"fit.keypoint_sigma_px", &fit.keypoint_sigma_px},
       {"fit.silhouette_sigma_px", &fit.silhouette_sigma_px}};
   for (const auto& [field, value] : positive) {
-    if (*value && !(**value > 0)) {
-      throw InputError(f, field, "> 0", std::to_string(**value));
-    }
+    if (*value) RequireGreater(f, field, **value, 0);
   }
-  if (fit.mask_margin_px && !(*fit.mask_margin_px >= 0 && *fit.mask_margin_px <= 50)) {
-    throw InputError(f, "fit.mask_margin_px", "0..50 (pixels)",
-                     std::to_string(*fit.mask_margin_px));
+  if (fit.mask_margin_px) {
+    RequireInRange(f, "fit.mask_margin_px", *fit.mask_margin_px, 0, 50, "0..50 (pixels)");
   }
-  if (fit.silhouette_rounds && *fit.silhouette_rounds < 0) {
-    throw InputError(f, "fit.silhouette_rounds", ">= 0",
-                     std::to_string(*fit.silhouette_rounds));
+  if (fit.silhouette_rounds) {
+    RequireAtLeast(f, "fit.silhouette_rounds", *fit.silhouette_rounds, 0);
   }
   if (fit.unknown_occluders && *fit.unknown_occluders != "one_sided" &&
       *fit.unknown_occluders != "two_sided") {
@@ -85,8 +82,7 @@ void CheckFitSettings(const FitSettings& fit, const std::string& f) {
   }
 }
 
-void CheckFileEvidence(const JobConfig& job) {
-  const std::string& f = job.source_file;
+void CheckFileEvidence(const JobConfig& job, const std::string& f) {
   if (job.keypoint_files != "auto" && job.keypoint_files != "detections" &&
       job.keypoint_files != "keypoints") {
     throw InputError(f, "evidence.keypoint_files", "auto | detections | keypoints",
@@ -225,61 +221,54 @@ std::string ToString(RefineMode mode) {
   return "?";
 }
 
-void JobConfig::Check() const {
-  const std::string& f = source_file;
+void JobConfig::Check(const std::string& source) const {
   const std::set<std::string> formats = {"native", "dexycb", "ho3d", "oakink"};
   if (!formats.count(input_format)) {
-    throw InputError(f, "input.format", "native | dexycb | ho3d | oakink",
+    throw InputError(source, "input.format", "native | dexycb | ho3d | oakink",
                      "'" + input_format + "'");
   }
-  if (input_path.empty()) throw InputError(f, "input.path", "the capture folder");
+  if (input_path.empty()) throw InputError(source, "input.path", "the capture folder");
   if (cameras_source != "capture" && cameras_source != "file") {
-    throw InputError(f, "cameras.source", "capture | file", "'" + cameras_source + "'");
+    throw InputError(source, "cameras.source", "capture | file",
+                     "'" + cameras_source + "'");
   }
   if (cameras_source == "file" && cameras_file.empty()) {
-    throw InputError(f, "cameras.file", "a rig file when cameras.source is file");
+    throw InputError(source, "cameras.file", "a rig file when cameras.source is file");
   }
-  if (output_dir.empty()) throw InputError(f, "output.dir", "an output folder");
-  if (batch_size < 1)
-    throw InputError(f, "network.batch_size", ">= 1", std::to_string(batch_size));
-  if (threads < 0)
-    throw InputError(f, "network.threads", ">= 0", std::to_string(threads));
+  if (output_dir.empty()) throw InputError(source, "output.dir", "an output folder");
+  RequireAtLeast(source, "network.batch_size", batch_size, 1);
+  RequireAtLeast(source, "network.threads", threads, 0);
   if (network_weights.empty() && refine_mode != RefineMode::kAlways) {
-    throw InputError(f, "refine.mode",
+    throw InputError(source, "refine.mode",
                      "'always' when network.weights is empty (without a network every "
                      "frame must be fitted)",
                      "'" + ToString(refine_mode) + "'");
   }
   if (network_weights.empty() && keypoints != KeypointSource::kFiles) {
-    throw InputError(f, "evidence.keypoints_2d", "'files' when there is no network");
+    throw InputError(source, "evidence.keypoints_2d", "'files' when there is no network");
   }
-  if (!(quality.max_reprojection_px > 0)) {
-    throw InputError(f, "refine.max_reprojection_px", "> 0");
-  }
-  if (!(quality.max_view_disagreement_mm > 0)) {
-    throw InputError(f, "refine.max_view_disagreement_mm", "> 0");
-  }
-  if (quality.min_confidence < 0 || quality.min_confidence > 1) {
-    throw InputError(f, "refine.min_confidence", "a value in [0, 1]");
-  }
-  if (quality.min_views < 1) throw InputError(f, "refine.min_views", ">= 1");
+  RequireGreater(source, "refine.max_reprojection_px", quality.max_reprojection_px, 0);
+  RequireGreater(source, "refine.max_view_disagreement_mm",
+                 quality.max_view_disagreement_mm, 0);
+  RequireInRange(source, "refine.min_confidence", quality.min_confidence, 0, 1,
+                 "a value in [0, 1]");
+  RequireAtLeast(source, "refine.min_views", quality.min_views, 1);
   if (!(quality.min_hand_span_m > 0 &&
         quality.max_hand_span_m > quality.min_hand_span_m)) {
-    throw InputError(f, "refine.min_hand_span_m / max_hand_span_m",
+    throw InputError(source, "refine.min_hand_span_m / max_hand_span_m",
                      "0 < min_hand_span_m < max_hand_span_m");
   }
   for (const std::string& m : meshes) {
     if (m != "ply" && m != "obj")
-      throw InputError(f, "output.meshes", "ply and/or obj", "'" + m + "'");
+      throw InputError(source, "output.meshes", "ply and/or obj", "'" + m + "'");
   }
   if (overlay_format != "jpg" && overlay_format != "png") {
-    throw InputError(f, "output.overlay_format", "jpg or png",
+    throw InputError(source, "output.overlay_format", "jpg or png",
                      "'" + overlay_format + "'");
   }
-  if (max_frames < 0)
-    throw InputError(f, "input.max_frames", ">= 0", std::to_string(max_frames));
-  CheckFileEvidence(*this);
-  CheckFitSettings(fit, f);
+  RequireAtLeast(source, "input.max_frames", max_frames, 0);
+  CheckFileEvidence(*this, source);
+  CheckFitSettings(fit, source);
 }
 
 JobConfig LoadJobConfig(const std::string& path) {
@@ -348,7 +337,7 @@ JobConfig LoadJobConfig(const std::string& path) {
   job.network_weights = Resolve(job.network_weights, base);
   job.output_dir = Resolve(job.output_dir, base);
   if (!IsFitInitKeyword(job.fit.init)) job.fit.init = Resolve(job.fit.init, base);
-  job.Check();
+  job.Check(path);
   return job;
 }
 

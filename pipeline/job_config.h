@@ -147,7 +147,7 @@ struct JobConfig {
   FitSettings fit;
 
   // Throws InputError naming the file and field.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Reads and validates a job file. Unknown keys are errors (they are usually typos).

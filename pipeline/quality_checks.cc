@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "geometry/triangulation.h"
 
 namespace handlabel {
@@ -200,14 +201,9 @@ QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
   return report;
 }
 
-void SilhouetteCheckThresholds::Check() const {
-  if (!(max_keypoint_rms_rise_px >= 0)) {
-    throw InputError("silhouette check", "max_keypoint_rms_rise_px", ">= 0",
-                     Format(max_keypoint_rms_rise_px));
-  }
-  if (!(min_view_iou >= 0 && min_view_iou <= 1)) {
-    throw InputError("silhouette check", "min_view_iou", "0..1", Format(min_view_iou));
-  }
+void SilhouetteCheckThresholds::Check(const std::string& source) const {
+  RequireAtLeast(source, "max_keypoint_rms_rise_px", max_keypoint_rms_rise_px, 0);
+  RequireInRange(source, "min_view_iou", min_view_iou, 0, 1);
 }
 
 QualityReport CheckSilhouetteFit(const HandFitStageResult& silhouette_fit,

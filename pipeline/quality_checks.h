@@ -65,7 +65,7 @@ struct SilhouetteCheckThresholds {
   // of an accepted fit in those frames).
   double min_view_iou = 0.5;
   // Throws InputError naming the field.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // Flags, in this order:

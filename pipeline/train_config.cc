@@ -52,7 +52,7 @@ void DeriveSampleOptions(const std::string& path, TrainConfig* c) {
 TrainConfig LoadTrainConfig(const std::string& path) {
   TrainConfigFields fields = ReadTrainConfigYaml(path);
   TrainConfig& c = fields.config;
-  c.synth.Check();
+  c.synth.Check("synth options");
   ResolveNetwork(fields.network_overrides_json, path, &c);
   DeriveSampleOptions(path, &c);
   return c;

@@ -4,22 +4,16 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 
 namespace handlabel {
 
-void HandCropOptions::Check() const {
-  const std::string src = "hand crop options";
-  if (crop_size < 8)
-    throw InputError(src, "crop_size", ">= 8", std::to_string(crop_size));
-  if (!(box_scale > 0))
-    throw InputError(src, "box_scale", "> 0", std::to_string(box_scale));
-  if (!(min_side_px > 0)) {
-    throw InputError(src, "min_side_px", "> 0", std::to_string(min_side_px));
-  }
-  if (min_keypoints < 2) {
-    throw InputError(src, "min_keypoints", ">= 2", std::to_string(min_keypoints));
-  }
-  if (!(std > 0)) throw InputError(src, "std", "> 0", std::to_string(std));
+void HandCropOptions::Check(const std::string& source) const {
+  RequireAtLeast(source, "crop_size", crop_size, 8);
+  RequireGreater(source, "box_scale", box_scale, 0);
+  RequireGreater(source, "min_side_px", min_side_px, 0);
+  RequireAtLeast(source, "min_keypoints", min_keypoints, 2);
+  RequireGreater(source, "std", std, 0);
 }
 
 CropWindow CropFromBox(const Eigen::Vector2d& box_min, const Eigen::Vector2d& box_max,
@@ -133,7 +127,7 @@ std::vector<float> WarpCrop(const RgbImageView& image, const Camera& camera,
 
 ViewCrop CropForView(const RgbImageView& image, const Camera& camera,
                      const HandEvidence& evidence, const HandCropOptions& options) {
-  options.Check();
+  options.Check("hand crop options");
   ViewCrop crop;
   std::optional<CropWindow> window;
   if (evidence.keypoints) {

@@ -42,7 +42,8 @@ struct HandCropOptions {
   // The RGB normalisation of the reference: (value / 255 - mean) / std per channel.
   double mean = 0.5;
   double std = 1.0;
-  void Check() const;  // throws InputError naming the field
+  // Throws InputError naming the field.
+  void Check(const std::string& source) const;
 };
 
 // Window around an axis-aligned box (min and max corner, pixels).

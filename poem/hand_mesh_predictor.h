@@ -79,7 +79,8 @@ struct HandMeshPredictorOptions {
   int num_threads = 0;
   int batch_size = 4;        // frames per forward pass
   uint64_t random_seed = 0;  // random weights only
-  void Check() const;        // throws InputError naming the field
+  // Throws InputError naming the field.
+  void Check(const std::string& source) const;
 };
 
 // Loads the model and validates it; throws InputError naming the file or option.

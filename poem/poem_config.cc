@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/text.h"
 
 namespace handlabel {
@@ -16,11 +17,6 @@ std::string RangeString(const std::array<double, 6>& r) {
   return "[" + Join(items) + "]";
 }
 
-void Positive(const std::string& source, const std::string& field, double value) {
-  if (!(value > 0))
-    throw InputError(source, field, "a positive value", FormatNumber(value));
-}
-
 }  // namespace
 
 std::array<int, 4> PoemConfig::stage_blocks() const {
@@ -32,27 +28,23 @@ void PoemConfig::Check(const std::string& source) const {
   if (backbone != "resnet18" && backbone != "resnet34") {
     throw InputError(source, "backbone", "resnet18 or resnet34", backbone);
   }
-  Positive(source, "backbone_width", backbone_width);
-  if (num_views < 1 || num_views > 64) {
-    throw InputError(source, "num_views", "1..64", std::to_string(num_views));
-  }
+  RequireGreater(source, "backbone_width", backbone_width, 0, "a positive value");
+  RequireInRange(source, "num_views", num_views, 1, 64);
   if (crop_size < 32 || crop_size % 32 != 0) {
     throw InputError(source, "crop_size", "a positive multiple of 32",
                      std::to_string(crop_size));
   }
-  Positive(source, "depth_bins", depth_bins);
+  RequireGreater(source, "depth_bins", depth_bins, 0, "a positive value");
   if (embed_dim < 4 || embed_dim % 4 != 0) {
     throw InputError(source, "embed_dim", "a positive multiple of 4",
                      std::to_string(embed_dim));
   }
-  Positive(source, "transformer_dim", transformer_dim);
-  Positive(source, "num_decoder_blocks", num_decoder_blocks);
-  Positive(source, "point_neighbors", point_neighbors);
-  Positive(source, "query_neighbors", query_neighbors);
-  if (query_neighbors > kNumQueries) {
-    throw InputError(source, "query_neighbors", "at most " + std::to_string(kNumQueries),
-                     std::to_string(query_neighbors));
-  }
+  RequireGreater(source, "transformer_dim", transformer_dim, 0, "a positive value");
+  RequireGreater(source, "num_decoder_blocks", num_decoder_blocks, 0, "a positive value");
+  RequireGreater(source, "point_neighbors", point_neighbors, 0, "a positive value");
+  RequireGreater(source, "query_neighbors", query_neighbors, 0, "a positive value");
+  RequireAtMost(source, "query_neighbors", query_neighbors, kNumQueries,
+                "at most " + std::to_string(kNumQueries));
   if (num_sampled_points < point_neighbors) {
     throw InputError(source, "num_sampled_points",
                      "at least point_neighbors (" + std::to_string(point_neighbors) + ")",
@@ -65,7 +57,7 @@ void PoemConfig::Check(const std::string& source) const {
                      "at most the frustum point count " + std::to_string(frustum_points),
                      std::to_string(num_sampled_points));
   }
-  Positive(source, "ball_radius", ball_radius);
+  RequireGreater(source, "ball_radius", ball_radius, 0, "a positive value");
   for (int a = 0; a < 3; ++a) {
     if (!(position_range[a + 3] > position_range[a])) {
       throw InputError(source, "position_range",

@@ -64,7 +64,7 @@ struct PoemConfig {
   std::array<int, 4> stage_blocks() const;
 
   // Throws InputError naming `source` and the first invalid field.
-  void Check(const std::string& source = "POEM config") const;
+  void Check(const std::string& source) const;
 
   // Human-readable "field: this vs other" lines for every field that differs.
   std::vector<std::string> Differences(const PoemConfig& other) const;

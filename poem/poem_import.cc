@@ -90,7 +90,7 @@ PoemConfig InferPoemConfig(const std::map<std::string, torch::Tensor>& s,
 
 PoemModel ImportReleasedPoemCheckpoint(const std::string& path, const PoemConfig& config,
                                        StateDictReport* report) {
-  config.Check();
+  config.Check("POEM config");
   const std::map<std::string, torch::Tensor> state = ReadTorchStateDict(path);
   const PoemConfig found = InferPoemConfig(state, config, path);
   const std::vector<std::string> diff = config.Differences(found);

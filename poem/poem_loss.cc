@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "poem/poem_geometry.h"
 
 namespace handlabel {
@@ -36,7 +37,7 @@ TrainStepResult BackwardAndStep(PoemModel& model, torch::optim::Optimizer& optim
 
 }  // namespace
 
-void PoemLossOptions::Check() const {
+void PoemLossOptions::Check(const std::string& source) const {
   const std::pair<const char*, double> fields[] = {
       {"heatmap_weight", heatmap_weight},
       {"triangulation_weight", triangulation_weight},
@@ -44,17 +45,13 @@ void PoemLossOptions::Check() const {
       {"vertices_weight", vertices_weight},
       {"joints_2d_weight", joints_2d_weight},
       {"mask_weight", mask_weight}};
-  for (const auto& [name, value] : fields) {
-    if (!(value >= 0)) {
-      throw InputError("POEM loss options", name, ">= 0", std::to_string(value));
-    }
-  }
+  for (const auto& [name, value] : fields) RequireAtLeast(source, name, value, 0);
 }
 
 PoemLoss ComputePoemLoss(const PoemOutputs& out, const PoemBatch& batch,
                          const PoemTargets& t, const torch::Tensor& regressor,
                          const PoemLossOptions& o) {
-  o.Check();
+  o.Check("POEM loss options");
   const int64_t J = PoemConfig::kNumJoints;
   const double crop_w = batch.images.size(-1), crop_h = batch.images.size(-2);
   const double diag = std::sqrt(crop_w * crop_w + crop_h * crop_h);

@@ -37,7 +37,8 @@ struct PoemLossOptions {
   double vertices_weight = 1.0;        // per layer: vertex L1
   double joints_2d_weight = 1.0;       // per layer: clamped reprojection of the joints
   double mask_weight = 1.0;  // mask head (ours): binary cross-entropy of the logits
-  void Check() const;        // throws InputError for negative weights
+  // Throws InputError for negative weights.
+  void Check(const std::string& source) const;
 };
 
 struct PoemLoss {

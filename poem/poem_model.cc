@@ -242,7 +242,7 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
 }
 
 PoemModelImpl::PoemModelImpl(const PoemConfig& config) : config_(config) {
-  config_.Check();
+  config_.Check("POEM config");
   const int w = config_.backbone_width;
   img_backbone = register_module("img_backbone", ResNet(config_.stage_blocks(), w));
   uv_delayer = register_module("uv_delayer", MakeUDecoder(w));

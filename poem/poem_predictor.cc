@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "poem/hand_mesh_predictor.h"
 #include "poem/poem_batch.h"
 #include "poem/poem_checkpoint.h"
@@ -158,24 +159,20 @@ PoemModel LoadModel(const HandMeshPredictorOptions& o) {
 
 }  // namespace
 
-void HandMeshPredictorOptions::Check() const {
-  const std::string src = "hand mesh predictor options";
-  if (model != "poem") throw InputError(src, "model", "poem", model);
+void HandMeshPredictorOptions::Check(const std::string& source) const {
+  if (model != "poem") throw InputError(source, "model", "poem", model);
   if (weights.empty() && config.empty()) {
-    throw InputError(src, "config", "a config name when no weights are given", "empty");
+    throw InputError(source, "config", "a config name when no weights are given",
+                     "empty");
   }
-  if (num_threads < 0) {
-    throw InputError(src, "num_threads", ">= 0 (0 = all hardware threads)",
-                     std::to_string(num_threads));
-  }
-  if (batch_size < 1) {
-    throw InputError(src, "batch_size", ">= 1", std::to_string(batch_size));
-  }
+  RequireAtLeast(source, "num_threads", num_threads, 0,
+                 ">= 0 (0 = all hardware threads)");
+  RequireAtLeast(source, "batch_size", batch_size, 1);
 }
 
 std::unique_ptr<HandMeshPredictor> CreateHandMeshPredictor(
     const HandMeshPredictorOptions& options) {
-  options.Check();
+  options.Check("hand mesh predictor options");
   const int threads = options.num_threads > 0
                           ? options.num_threads
                           : std::max(1u, std::thread::hardware_concurrency());

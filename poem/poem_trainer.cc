@@ -18,6 +18,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/json_util.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 #include "hand/metrics.h"
 #include "poem/poem_batch_norm_update.h"
@@ -176,24 +177,16 @@ class BatchProducer {
 }  // namespace
 
 void PoemTrainerOptions::Check(const std::string& source) const {
-  auto positive = [&](const char* field, double v) {
-    if (!(v > 0)) throw InputError(source, field, "> 0", std::to_string(v));
-  };
-  auto non_negative = [&](const char* field, double v) {
-    if (!(v >= 0)) throw InputError(source, field, ">= 0", std::to_string(v));
-  };
-  positive("steps", steps);
-  positive("batch_size", batch_size);
-  positive("learning_rate", learning_rate);
-  non_negative("warmup_steps", warmup_steps);
-  if (!(decay_at >= 0 && decay_at <= 1)) {
-    throw InputError(source, "decay_at", "0..1", std::to_string(decay_at));
-  }
-  positive("decay_factor", decay_factor);
-  non_negative("grad_clip_norm", grad_clip_norm);
-  positive("checkpoint_every", checkpoint_every);
-  positive("keep_checkpoints", keep_checkpoints);
-  non_negative("keep_every", keep_every);
+  RequireGreater(source, "steps", steps, 0);
+  RequireGreater(source, "batch_size", batch_size, 0);
+  RequireGreater(source, "learning_rate", learning_rate, 0);
+  RequireAtLeast(source, "warmup_steps", warmup_steps, 0);
+  RequireInRange(source, "decay_at", decay_at, 0, 1);
+  RequireGreater(source, "decay_factor", decay_factor, 0);
+  RequireAtLeast(source, "grad_clip_norm", grad_clip_norm, 0);
+  RequireGreater(source, "checkpoint_every", checkpoint_every, 0);
+  RequireGreater(source, "keep_checkpoints", keep_checkpoints, 0);
+  RequireAtLeast(source, "keep_every", keep_every, 0);
   if (keep_every > 0 && keep_every % checkpoint_every != 0) {
     // Otherwise some or all of the steps it names never get a checkpoint.
     throw InputError(
@@ -201,19 +194,19 @@ void PoemTrainerOptions::Check(const std::string& source) const {
         "a multiple of checkpoint_every (" + std::to_string(checkpoint_every) + ")",
         std::to_string(keep_every));
   }
-  positive("log_every", log_every);
-  non_negative("validate_every", validate_every);
-  non_negative("validation_samples", validation_samples);
-  positive("threads", threads);
-  non_negative("prefetch_batches", prefetch_batches);
-  non_negative("init_step", init_step);
+  RequireGreater(source, "log_every", log_every, 0);
+  RequireAtLeast(source, "validate_every", validate_every, 0);
+  RequireAtLeast(source, "validation_samples", validation_samples, 0);
+  RequireGreater(source, "threads", threads, 0);
+  RequireAtLeast(source, "prefetch_batches", prefetch_batches, 0);
+  RequireAtLeast(source, "init_step", init_step, 0);
   if (out_dir.empty()) throw InputError(source, "out_dir", "a folder", "empty");
-  non_negative("heatmap_weight", heatmap_weight);
-  non_negative("triangulation_weight", triangulation_weight);
-  non_negative("joints_weight", joints_weight);
-  non_negative("vertices_weight", vertices_weight);
-  non_negative("joints_2d_weight", joints_2d_weight);
-  non_negative("mask_weight", mask_weight);
+  RequireAtLeast(source, "heatmap_weight", heatmap_weight, 0);
+  RequireAtLeast(source, "triangulation_weight", triangulation_weight, 0);
+  RequireAtLeast(source, "joints_weight", joints_weight, 0);
+  RequireAtLeast(source, "vertices_weight", vertices_weight, 0);
+  RequireAtLeast(source, "joints_2d_weight", joints_2d_weight, 0);
+  RequireAtLeast(source, "mask_weight", mask_weight, 0);
 }
 
 double PoemLearningRate(const PoemTrainerOptions& o, int64_t step) {
@@ -452,8 +445,8 @@ PoemTrainer::PoemTrainer(const PoemConfig& config, const HandModel& hand_model,
                          const PoemTrainerOptions& options, PoemTrainerHooks hooks)
     : state_(
           std::make_unique<State>(config, train, validation, options, std::move(hooks))) {
-  options.Check();
-  config.Check();
+  options.Check("trainer options");
+  config.Check("POEM config");
   if (hand_model.num_vertices() != PoemConfig::kNumVertices) {
     throw InputError(
         "trainer", "hand model",

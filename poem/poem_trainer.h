@@ -69,7 +69,7 @@ struct PoemTrainerOptions {
   double vertices_weight = 1.0;
   double joints_2d_weight = 1.0;
   double mask_weight = 1.0;
-  void Check(const std::string& source = "trainer options") const;
+  void Check(const std::string& source) const;
 };
 
 // The learning rate at a step.

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "core/random.h"
 #include "core/text.h"
 
@@ -14,17 +15,6 @@ namespace {
 constexpr uint64_t kAugmentStream = 0xA06E;
 
 using Affine2 = Eigen::Matrix<double, 2, 3>;  // crop pixel = A * (x, y, 1)
-
-// The name the option structs' Check() bodies below use for FormatNumber.
-std::string Str(double v) { return FormatNumber(v); }
-
-void InRange(const std::string& source, const char* field, double v, double lo,
-             double hi) {
-  if (!(v >= lo && v <= hi)) {
-    throw InputError(source, field, FormatNumber(lo) + ".." + FormatNumber(hi),
-                     FormatNumber(v));
-  }
-}
 
 Eigen::Matrix4d ToMatrix4(const Rigid3& t) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
@@ -178,15 +168,15 @@ Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> ToMaster(
 }  // namespace
 
 void TrainingAugmentOptions::Check(const std::string& source) const {
-  InRange(source, "scale_sigma", scale_sigma, 0, 0.4);
-  InRange(source, "rotation_probability", rotation_probability, 0, 1);
-  InRange(source, "rotation_sigma_deg", rotation_sigma_deg, 0, 90);
+  RequireInRange(source, "scale_sigma", scale_sigma, 0, 0.4);
+  RequireInRange(source, "rotation_probability", rotation_probability, 0, 1);
+  RequireInRange(source, "rotation_sigma_deg", rotation_sigma_deg, 0, 90);
   if (!(gain_min > 0 && gain_max >= gain_min)) {
     throw InputError(source, "gain_min/gain_max", "0 < gain_min <= gain_max",
-                     Str(gain_min) + "/" + Str(gain_max));
+                     OptionValueText(gain_min) + "/" + OptionValueText(gain_max));
   }
-  InRange(source, "noise_rect_probability", noise_rect_probability, 0, 1);
-  InRange(source, "noise_rect_max_side", noise_rect_max_side, 0.01, 1);
+  RequireInRange(source, "noise_rect_probability", noise_rect_probability, 0, 1);
+  RequireInRange(source, "noise_rect_max_side", noise_rect_max_side, 0.01, 1);
 }
 
 void TrainingSampleOptions::Check(const std::string& source) const {
@@ -194,14 +184,10 @@ void TrainingSampleOptions::Check(const std::string& source) const {
     throw InputError(source, "crop_size", "a positive multiple of 32",
                      std::to_string(crop_size));
   }
-  if (!(box_scale > 0)) throw InputError(source, "box_scale", "> 0", Str(box_scale));
-  if (!(min_box_px > 0)) throw InputError(source, "min_box_px", "> 0", Str(min_box_px));
-  if (frame_reuse < 1) {
-    throw InputError(source, "frame_reuse", ">= 1", std::to_string(frame_reuse));
-  }
-  if (reuse_group < 1) {
-    throw InputError(source, "reuse_group", ">= 1", std::to_string(reuse_group));
-  }
+  RequireGreater(source, "box_scale", box_scale, 0);
+  RequireGreater(source, "min_box_px", min_box_px, 0);
+  RequireAtLeast(source, "frame_reuse", frame_reuse, 1);
+  RequireAtLeast(source, "reuse_group", reuse_group, 1);
   augment.Check(source + " augmentation");
 }
 
@@ -272,7 +258,7 @@ SynthTrainingSamples::SynthTrainingSamples(const HandModel& model,
                    return s;
                  }()),
       options_(options) {
-  options_.Check();
+  options_.Check("training samples");
 }
 
 std::shared_ptr<const SynthFrame> SynthTrainingSamples::Frame(int64_t frame_index) const {

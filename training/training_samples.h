@@ -46,7 +46,7 @@ struct TrainingAugmentOptions {
   double gain_max = 1.3;
   double noise_rect_probability = 0.2;  // chance of one noise rectangle per view (0..1)
   double noise_rect_max_side = 0.4;     // its largest side, fraction of the crop (0..1]
-  void Check(const std::string& source = "augmentation") const;
+  void Check(const std::string& source) const;
 };
 
 struct TrainingSampleOptions {
@@ -58,7 +58,7 @@ struct TrainingSampleOptions {
   int reuse_group = 1;        // samples per reuse group, e.g. the batch size (>= 1)
   uint64_t augment_seed = 0;  // mixed with the sample index for the augmentation
   TrainingAugmentOptions augment;
-  void Check(const std::string& source = "training samples") const;
+  void Check(const std::string& source) const;
 };
 
 // The synthetic frame that sample `index` is cut from.

@@ -83,7 +83,7 @@ TEST(RigPresets, BadOptionsNameTheField) {
   RigPresetOptions o;
   o.width = 100;  // height missing
   try {
-    o.Check();
+    o.Check("test");
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "size");

@@ -300,17 +300,17 @@ TEST(SynthCapture, BadOptionsNameTheField) {
   SynthCaptureOptions o = SmallOptions();
   o.rig.preset = "kinect";
   try {
-    o.Check();
+    o.Check("test");
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "preset");
   }
   o = SmallOptions();
   o.num_frames = 0;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
   o = SmallOptions();
   o.detections.outlier_rate = 1.5;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
 }
 
 }  // namespace

@@ -103,14 +103,14 @@ TEST(SynthDetectionsTest, ViewsWithoutObjectsAreUnchangedByTheObjectRule) {
 TEST(SynthDetectionsTest, OptionsOutOfRangeAreRejected) {
   DetectionNoiseOptions o;
   o.object_sigma_per_px = -1;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
   o = DetectionNoiseOptions();
   o.object_confidence_px = 0;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
   o = DetectionNoiseOptions();
   o.object_depth_cap_px = -1;
-  EXPECT_THROW(o.Check(), InputError);
-  EXPECT_NO_THROW(DetectionNoiseOptions().Check());
+  EXPECT_THROW(o.Check("test"), InputError);
+  EXPECT_NO_THROW(DetectionNoiseOptions().Check("test"));
 }
 
 }  // namespace

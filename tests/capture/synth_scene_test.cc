@@ -98,7 +98,7 @@ TEST(SynthScene, ObjectProbabilityMixesEmptyAndObjectFrames) {
   EXPECT_GT(with_objects, 40);
   EXPECT_LT(with_objects, 80);
   o.object_probability = 1.5;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
 }
 
 // A scene's values pooled by kind, so that each tolerance meets values of one scale.

@@ -70,11 +70,11 @@ TEST(CompareRun, MethodNamesRoundTrip) {
 
 TEST(CompareRun, OptionsAreChecked) {
   CompareOptions o;
-  EXPECT_THROW(o.Check(), InputError);  // no folder
+  EXPECT_THROW(o.Check("test"), InputError);  // no folder
   o.out_dir = "/tmp/x";
-  EXPECT_NO_THROW(o.Check());
+  EXPECT_NO_THROW(o.Check("test"));
   o.ablation_frames = 0;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
 }
 
 }  // namespace

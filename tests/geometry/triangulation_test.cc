@@ -110,7 +110,7 @@ TEST(Triangulation, TooFewViewsGiveNoPoint) {
   EXPECT_FALSE(TriangulateRobust(rig, obs).valid);
   RobustTriangulationOptions bad;
   bad.inlier_threshold_px = -1;
-  EXPECT_THROW(bad.Check(), InputError);
+  EXPECT_THROW(bad.Check("test"), InputError);
 }
 
 }  // namespace

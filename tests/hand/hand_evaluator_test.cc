@@ -144,11 +144,11 @@ TEST(HandEvaluator, RejectsOptionsThatDoNotFitTheModel) {
   EXPECT_THROW(HandEvaluator(model, options), InputError);
   options = {};
   options.num_betas = -2;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_THROW(options.Check("test"), InputError);
   options = {};
   options.num_pca_comps = -1;
-  EXPECT_THROW(options.Check(), InputError);
-  EXPECT_NO_THROW(HandEvaluatorOptions().Check());
+  EXPECT_THROW(options.Check("test"), InputError);
+  EXPECT_NO_THROW(HandEvaluatorOptions().Check("test"));
 }
 
 // Dual derivatives of keypoints and all vertices w.r.t. all 61 parameters versus

@@ -85,10 +85,10 @@ TEST(HandPoseSampler, DrawsKindsByWeightAndChecksOptions) {
         HandPoseKind::kPoint);
   }
   options.weight_point = 0;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_THROW(options.Check("test"), InputError);
   options.weight_point = 1;
   options.jitter_deg = -1;
-  EXPECT_THROW(options.Check(), InputError);
+  EXPECT_THROW(options.Check("test"), InputError);
 }
 
 }  // namespace

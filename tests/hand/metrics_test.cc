@@ -81,10 +81,10 @@ TEST(MetricsTest, PckHandComputed) {
 TEST(MetricsTest, PckOptionsCheck) {
   PckOptions o;
   o.steps = 1;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
   o = {};
   o.max_threshold = 0.0;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
 }
 
 // Against NumPy/SciPy (tests/data/metrics/make_metrics_fixture.py, POEM's code path).

@@ -163,7 +163,7 @@ TEST(FitCaptureTest, BadOptionsNameTheFlag) {
   o.out_dir = "y";
   o.evidence = "magic";
   try {
-    o.Check();
+    o.Check("test");
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "--evidence");

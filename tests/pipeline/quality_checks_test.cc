@@ -158,7 +158,7 @@ TEST(SilhouetteCheck, AViewWhoseMaskTheFitMissesFailsIou) {
   EXPECT_EQ(r.FailedNames(), "silhouette_iou");
   EXPECT_NEAR(Flag(r, "silhouette_iou").value, 0.3, 1e-12);
   t.min_view_iou = -0.1;
-  EXPECT_THROW(t.Check(), InputError);
+  EXPECT_THROW(t.Check("test"), InputError);
 }
 
 }  // namespace

@@ -210,10 +210,10 @@ TEST(TrainingSamples, SameIndexKeepsItsSample) {
 TEST(TrainingSamples, OptionsRejectBadValues) {
   TrainingSampleOptions o;
   o.crop_size = 100;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
   o = TrainingSampleOptions();
   o.augment.gain_min = 1.5;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("test"), InputError);
 }
 
 }  // namespace
