@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "core/option_checks.h"
 #include "fitting/analytic_hand_pose.h"
 #include "fitting/joint_limit_cost.h"
 #include "fitting/keypoint_reprojection_cost.h"
@@ -93,19 +94,6 @@ std::vector<double> KeypointSquaredErrorsPx(const KeypointView& view,
 // Palm keypoints (SNAP): wrist and the four finger MCPs; rigid in the hand's frame.
 constexpr int kPalmKeypoints[] = {0, 5, 9, 13, 17};
 
-std::string Str(double x) { return std::to_string(x); }
-
-void RequirePositive(double value, const char* field) {
-  if (!(value > 0.0)) throw InputError("HandFitOptions", field, "> 0", Str(value));
-}
-void RequireNonNegative(int value, const char* field) {
-  if (value < 0) throw InputError("HandFitOptions", field, ">= 0", std::to_string(value));
-}
-// A double overload: through the int one -0.5 would truncate to 0 and pass.
-void RequireNonNegative(double value, const char* field) {
-  if (!(value >= 0)) throw InputError("HandFitOptions", field, ">= 0", Str(value));
-}
-
 // Least-squares rotation R and translation t with target ~ R * source + t (Kabsch).
 void RigidAlign(const std::vector<Eigen::Vector3d>& source,
                 const std::vector<Eigen::Vector3d>& target, Eigen::Matrix3d* r,
@@ -130,47 +118,41 @@ void RigidAlign(const std::vector<Eigen::Vector3d>& source,
 
 }  // namespace
 
-void HandFitConfig::Check() const {
+void HandFitConfig::Check(const std::string& source) const {
   if (pose_pca_comps != 0 && pose_pca_comps != 12 && pose_pca_comps != 45) {
-    throw InputError("HandFitConfig", "pose_pca_comps", "0 (axis-angle), 12 or 45",
+    throw InputError(source, "pose_pca_comps", "0 (axis-angle), 12 or 45",
                      std::to_string(pose_pca_comps));
   }
 }
 
-void HandFitOptions::Check() const {
-  RequirePositive(keypoint_sigma_px, "keypoint_sigma_px");
-  RequirePositive(keypoint_loss.scale, "keypoint_loss.scale");
-  RequirePositive(limit_sigma_deg, "limit_sigma_deg");
-  RequirePositive(pose_prior_sigma_rad, "pose_prior_sigma_rad");
-  RequirePositive(shape_prior_sigma, "shape_prior_sigma");
-  RequirePositive(points3d_sigma_m, "points3d_sigma_m");
-  RequirePositive(temporal_pose_sigma_rad, "temporal_pose_sigma_rad");
-  RequirePositive(temporal_transl_sigma_m, "temporal_transl_sigma_m");
-  RequirePositive(silhouette_sigma_px, "silhouette_sigma_px");
-  if (silhouette_vertex_stride < 1) {
-    throw InputError("HandFitOptions", "silhouette_vertex_stride", ">= 1",
-                     std::to_string(silhouette_vertex_stride));
-  }
-  RequireNonNegative(silhouette_outline_samples, "silhouette_outline_samples");
-  RequireNonNegative(silhouette_rounds, "silhouette_rounds");
-  RequirePositive(silhouette_contour_cosine, "silhouette_contour_cosine");
-  RequireNonNegative(occluder_reach_px, "occluder_reach_px");
-  RequireNonNegative(silhouette_window_margin_px, "silhouette_window_margin_px");
-  RequirePositive(unknown_occluder_cap_px, "unknown_occluder_cap_px");
-  RequireNonNegative(mask_margin_max_px, "mask_margin_max_px");
-  RequireNonNegative(rigid_skip_below_px, "rigid_skip_below_px");
-  RequireNonNegative(rigid_iterations, "rigid_iterations");
-  RequireNonNegative(keypoint_iterations, "keypoint_iterations");
-  RequireNonNegative(init_iterations, "init_iterations");
-  RequireNonNegative(silhouette_iterations, "silhouette_iterations");
-  RequirePositive(function_tolerance, "function_tolerance");
-  RequirePositive(parameter_tolerance, "parameter_tolerance");
-  if (num_threads < 1) {
-    throw InputError("HandFitOptions", "num_threads", ">= 1",
-                     std::to_string(num_threads));
-  }
-  RequirePositive(triangulation_inlier_px, "triangulation_inlier_px");
-  RequirePositive(fallback_depth_m, "fallback_depth_m");
+void HandFitOptions::Check(const std::string& source) const {
+  RequireGreater(source, "keypoint_sigma_px", keypoint_sigma_px, 0);
+  RequireGreater(source, "keypoint_loss.scale", keypoint_loss.scale, 0);
+  RequireGreater(source, "limit_sigma_deg", limit_sigma_deg, 0);
+  RequireGreater(source, "pose_prior_sigma_rad", pose_prior_sigma_rad, 0);
+  RequireGreater(source, "shape_prior_sigma", shape_prior_sigma, 0);
+  RequireGreater(source, "points3d_sigma_m", points3d_sigma_m, 0);
+  RequireGreater(source, "temporal_pose_sigma_rad", temporal_pose_sigma_rad, 0);
+  RequireGreater(source, "temporal_transl_sigma_m", temporal_transl_sigma_m, 0);
+  RequireGreater(source, "silhouette_sigma_px", silhouette_sigma_px, 0);
+  RequireAtLeast(source, "silhouette_vertex_stride", silhouette_vertex_stride, 1);
+  RequireAtLeast(source, "silhouette_outline_samples", silhouette_outline_samples, 0);
+  RequireAtLeast(source, "silhouette_rounds", silhouette_rounds, 0);
+  RequireGreater(source, "silhouette_contour_cosine", silhouette_contour_cosine, 0);
+  RequireAtLeast(source, "occluder_reach_px", occluder_reach_px, 0);
+  RequireAtLeast(source, "silhouette_window_margin_px", silhouette_window_margin_px, 0);
+  RequireGreater(source, "unknown_occluder_cap_px", unknown_occluder_cap_px, 0);
+  RequireAtLeast(source, "mask_margin_max_px", mask_margin_max_px, 0);
+  RequireAtLeast(source, "rigid_skip_below_px", rigid_skip_below_px, 0);
+  RequireAtLeast(source, "rigid_iterations", rigid_iterations, 0);
+  RequireAtLeast(source, "keypoint_iterations", keypoint_iterations, 0);
+  RequireAtLeast(source, "init_iterations", init_iterations, 0);
+  RequireAtLeast(source, "silhouette_iterations", silhouette_iterations, 0);
+  RequireGreater(source, "function_tolerance", function_tolerance, 0);
+  RequireGreater(source, "parameter_tolerance", parameter_tolerance, 0);
+  RequireAtLeast(source, "num_threads", num_threads, 1);
+  RequireGreater(source, "triangulation_inlier_px", triangulation_inlier_px, 0);
+  RequireGreater(source, "fallback_depth_m", fallback_depth_m, 0);
 }
 
 namespace {
@@ -199,7 +181,7 @@ CeresHandFitter::CeresHandFitter(const HandModel& model, const HandFitConfig& co
       config_(config),
       options_(options),
       evaluator_(model,
-                 (config.Check(), options.Check(), EvaluatorOptionsFor(model, config))),
+                 (config.Check("HandFitConfig"), options.Check("HandFitOptions"), EvaluatorOptionsFor(model, config))),
       anatomy_(ComputeHandAnatomy(model)),
       limits_(DefaultHandLimits()) {}
 

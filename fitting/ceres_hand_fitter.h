@@ -46,7 +46,7 @@ struct HandFitConfig {
   bool use_shape_prior = true;
   bool use_points3d = true;  // only if HandFitInput::targets3d is set
   bool use_temporal = true;  // only if HandFitInput::previous is set
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 // How to optimise; every weight is expressed as the standard deviation that one unit
@@ -121,7 +121,7 @@ struct HandFitOptions {
   // Distance from the first camera used when fewer than 3 palm keypoints triangulate.
   double fallback_depth_m = 0.6;
   // Throws InputError naming the field.
-  void Check() const;
+  void Check(const std::string& source) const;
 };
 
 struct HandFitInput {

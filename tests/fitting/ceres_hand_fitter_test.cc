@@ -21,20 +21,20 @@ class CeresHandFitterTest : public ::testing::Test {
 TEST_F(CeresHandFitterTest, OptionsCheck) {
   HandFitOptions o;
   o.keypoint_sigma_px = 0.0;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("HandFitOptions"), InputError);
   o = {};
   o.silhouette_vertex_stride = 0;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("HandFitOptions"), InputError);
   // Fractional negatives of double fields (an int check would truncate them to 0).
   o = {};
   o.mask_margin_max_px = -0.5;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("HandFitOptions"), InputError);
   o = {};
   o.rigid_skip_below_px = -0.5;
-  EXPECT_THROW(o.Check(), InputError);
+  EXPECT_THROW(o.Check("HandFitOptions"), InputError);
   HandFitConfig c;
   c.pose_pca_comps = 7;
-  EXPECT_THROW(c.Check(), InputError);
+  EXPECT_THROW(c.Check("HandFitConfig"), InputError);
   EXPECT_THROW(CeresHandFitter(model_, c), InputError);
 }
 
