@@ -94,11 +94,14 @@ void BoardDetectOptions::Check(const std::string& source) const {
   RequireAtLeast(source, "min_corners", min_corners, 4);
 }
 
-BoardObservation DetectBoard(const GrayImage& image, const BoardSpec& board,
+BoardObservation DetectBoard(const ImageU8& image, const BoardSpec& board,
                              const BoardDetectOptions& options) {
   options.Check("BoardDetectOptions");
+  HL_CHECK(image.channels == 1, "board detection takes grey images, not " +
+                                    std::to_string(image.channels) + " channels");
+  // A view of the pixels, not a copy: OpenCV only reads them.
   const cv::Mat gray(image.height, image.width, CV_8UC1,
-                     const_cast<uint8_t*>(image.pixels.data()));
+                     const_cast<uint8_t*>(image.data.data()));
   BoardObservation obs = board.type == BoardType::kCharuco
                              ? DetectCharuco(gray, board)
                              : DetectCheckerboard(gray, board);

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "calib/board_spec.h"
-#include "calib/gray_image.h"
+#include "image/image.h"
 
 namespace handlabel {
 
@@ -27,13 +27,13 @@ struct BoardDetectOptions {
   void Check(const std::string& source) const;
 };
 
-// Empty observation if the board is not found.
+// `image` is grey (1 channel). Empty observation if the board is not found.
 //
 // Checkerboards are symmetric, so their corner order is ambiguous: it is chosen so
 // that corner 0 is the one nearest the image's top-left. This is consistent across
 // cameras only when all cameras see the board upright from the same side; prefer
 // ChArUco boards for multi-camera rigs.
-BoardObservation DetectBoard(const GrayImage& image, const BoardSpec& board,
+BoardObservation DetectBoard(const ImageU8& image, const BoardSpec& board,
                              const BoardDetectOptions& options = {});
 
 }  // namespace handlabel

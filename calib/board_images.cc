@@ -1,10 +1,13 @@
 #include "calib/board_images.h"
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <ostream>
 
 #include "core/errors.h"
+#include "image/image.h"
 
 namespace handlabel {
 namespace {
@@ -14,6 +17,23 @@ bool IsImageFile(const std::filesystem::path& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" ||
          ext == ".tif" || ext == ".tiff";
+}
+
+// Any format OpenCV decodes (BMP and TIFF too, which image/image_file.h does not read),
+// as OpenCV's own grey conversion: detections depend on these exact pixels.
+ImageU8 ReadBoardImage(const std::string& path) {
+  cv::Mat mat;
+  try {
+    mat = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  } catch (const cv::Exception& e) {
+    throw InputError(path, "(image)", "a readable image", e.what());
+  }
+  if (mat.empty()) throw InputError(path, "(image)", "a readable image", "cannot decode");
+  ImageU8 image(mat.cols, mat.rows, 1);
+  for (int y = 0; y < mat.rows; ++y) {
+    std::memcpy(&image.at(0, y), mat.ptr<uint8_t>(y), mat.cols);
+  }
+  return image;
 }
 
 }  // namespace
@@ -52,7 +72,7 @@ std::vector<CameraBoardViews> DetectBoardsInFolders(const std::string& dir,
     views.name = camera_dir.filename().string();
     std::string first_image;
     for (const fs::path& path : images) {
-      const GrayImage image = ReadGrayImage(path.string());
+      const ImageU8 image = ReadBoardImage(path.string());
       if (first_image.empty()) {
         first_image = path.string();
         views.width = image.width;

@@ -109,7 +109,7 @@ BoardRenderer::BoardRenderer(const BoardSpec& board, const Camera& camera,
 
 BoardRenderer::~BoardRenderer() = default;
 
-GrayImage BoardRenderer::Render(const Rigid3& cam_from_board, uint64_t seed) const {
+ImageU8 BoardRenderer::Render(const Rigid3& cam_from_board, uint64_t seed) const {
   const Impl& m = *impl_;
   const int w = m.camera.width(), h = m.camera.height();
   const BoardRenderOptions& o = m.options;
@@ -146,7 +146,7 @@ GrayImage BoardRenderer::Render(const Rigid3& cam_from_board, uint64_t seed) con
     corner_value[k] = shade(m.Lookup(p.x(), p.y()));
   }
 
-  GrayImage image(w, h);
+  ImageU8 image(w, h, 1);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, o.noise_sigma);
   const int s = o.supersampling;

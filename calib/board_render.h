@@ -8,9 +8,9 @@
 #include <memory>
 
 #include "calib/board_spec.h"
-#include "calib/gray_image.h"
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
+#include "image/image.h"
 
 namespace handlabel {
 
@@ -31,8 +31,8 @@ class BoardRenderer {
   BoardRenderer(const BoardSpec& board, const Camera& camera,
                 const BoardRenderOptions& options = {});
   ~BoardRenderer();
-  // `seed` drives the pixel noise.
-  GrayImage Render(const Rigid3& cam_from_board, uint64_t seed) const;
+  // A grey (1-channel) image of the camera's size; `seed` drives the pixel noise.
+  ImageU8 Render(const Rigid3& cam_from_board, uint64_t seed) const;
 
  private:
   struct Impl;

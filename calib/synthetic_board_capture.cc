@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/option_checks.h"
 #include "core/random.h"
+#include "image/image.h"
 
 namespace handlabel {
 namespace {
@@ -174,9 +175,9 @@ int RenderBoardCapture(const SyntheticBoardCapture& capture, const BoardSpec& bo
     fs::create_directories(folder);
     const BoardRenderer renderer(board, rc.camera, options);
     for (const auto& [key, world_from_board] : capture.world_from_board) {
-      const GrayImage image = renderer.Render(rc.cam_from_world * world_from_board,
-                                              seed + 7919 * c + written);
-      WriteGrayImage(image, (folder / (key + ".png")).string());
+      const ImageU8 image = renderer.Render(rc.cam_from_world * world_from_board,
+                                            seed + 7919 * c + written);
+      WritePng((folder / (key + ".png")).string(), image);
       ++written;
     }
   }

@@ -6,10 +6,10 @@
 #include <random>
 
 #include "calib/board_scale.h"
-#include "calib/gray_image.h"
 #include "calib/synthetic_board_capture.h"
 #include "cameras/rig_compare.h"
 #include "cameras/rig_json.h"
+#include "image/image.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 
@@ -38,8 +38,8 @@ double Texture(double u, double v, int plane) {
 }
 
 // A floor (z = 0) and two walls (x = -0.6, y = -0.6), textured.
-GrayImage RenderScene(const RigCamera& c) {
-  GrayImage image(c.camera.width(), c.camera.height());
+ImageU8 RenderScene(const RigCamera& c) {
+  ImageU8 image(c.camera.width(), c.camera.height(), 1);
   const Rigid3 world_from_cam = c.cam_from_world.Inverse();
   const Eigen::Vector3d origin = c.CenterInWorld();
   for (int y = 0; y < image.height; ++y) {
@@ -78,8 +78,7 @@ Rig MakeSceneRig(const std::string& dir) {
                Camera::Pinhole(250, 250, 159.5, 119.5, 320, 240),
                LookAt(eye, Eigen::Vector3d(-0.1, -0.1, 0.1), Eigen::Vector3d::UnitZ())});
     fs::create_directories(dir + "/images/" + truth[i].name);
-    WriteGrayImage(RenderScene(truth[i]),
-                   dir + "/images/" + truth[i].name + "/000000.png");
+    WritePng(dir + "/images/" + truth[i].name + "/000000.png", RenderScene(truth[i]));
   }
   return truth;
 }

@@ -5,10 +5,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "calib/gray_image.h"
 #include "calib/synthetic_board_capture.h"
 #include "cameras/rig_compare.h"
 #include "cameras/rig_json.h"
+#include "image/image.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 
@@ -69,7 +69,7 @@ TEST(CalibCommand, ClearErrorsForBadCaptures) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("--board"), std::string::npos) << r.err;
   // Inconsistent image sizes within a camera.
-  WriteGrayImage(GrayImage(320, 240, 128), dir + "/c/images/cam1/zzz.png");
+  WritePng(dir + "/c/images/cam1/zzz.png", ImageU8(320, 240, 1, 128));
   r = RunHandlabelCommand({"calib", "board", "--images", dir + "/c/images", "--board",
                            "charuco:7x5:0.04:0.03"});
   EXPECT_EQ(r.status, 1);
