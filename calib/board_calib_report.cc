@@ -1,12 +1,12 @@
 #include "calib/board_calib_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
-#include <opencv2/imgproc.hpp>
 #include <sstream>
 
-#include "calib/cv_image_file.h"
-#include "core/errors.h"
+#include "image/draw.h"
+#include "image/image.h"
 
 namespace handlabel {
 
@@ -61,50 +61,71 @@ nlohmann::json BoardCalibJson(const BoardCalibResult& result, const BoardSpec& b
           {"world_from_board", boards}};
 }
 
+namespace {
+
+constexpr int kResidualPanel = 260;  // pixels, each camera's square panel
+
+// Where camera c's zero residual sits: the middle of its panel, a little lower to leave
+// room for the label.
+Eigen::Vector2d ResidualOrigin(int c, int cols) {
+  return Eigen::Vector2d((c % cols) * kResidualPanel + kResidualPanel / 2,
+                         (c / cols) * kResidualPanel + kResidualPanel / 2 + 10);
+}
+
+// Frame, axes through zero and the 1 px circle (`scale` pixels per residual pixel).
+void DrawResidualFrame(ImageU8* canvas, int c, int cols, double scale) {
+  const int x0 = (c % cols) * kResidualPanel, y0 = (c / cols) * kResidualPanel;
+  const int x1 = x0 + kResidualPanel - 1, y1 = y0 + kResidualPanel - 1;
+  const Rgb frame = {200, 200, 200}, axis = {220, 220, 220};
+  DrawLine(canvas, Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0), frame);
+  DrawLine(canvas, Eigen::Vector2d(x0, y1), Eigen::Vector2d(x1, y1), frame);
+  DrawLine(canvas, Eigen::Vector2d(x0, y0), Eigen::Vector2d(x0, y1), frame);
+  DrawLine(canvas, Eigen::Vector2d(x1, y0), Eigen::Vector2d(x1, y1), frame);
+  const Eigen::Vector2d o = ResidualOrigin(c, cols);
+  const double half = kResidualPanel / 2.0;
+  DrawLine(canvas, o - Eigen::Vector2d(half - 10, 0), o + Eigen::Vector2d(half - 10, 0),
+           axis);
+  DrawLine(canvas, o - Eigen::Vector2d(0, half - 30), o + Eigen::Vector2d(0, half - 10),
+           axis);
+  DrawRing(canvas, o, static_cast<int>(std::lround(scale)), {150, 150, 150});
+}
+
+// The camera's name and "rms 0.112 px, 2903 pts, 27 out" below it, above the circle.
+void DrawResidualLabel(ImageU8* canvas, int c, int cols, const CameraCalibStats& s) {
+  const int x = (c % cols) * kResidualPanel + 6, y = (c / cols) * kResidualPanel + 4;
+  DrawText(canvas, x, y, s.name, {0, 0, 0}, 2);
+  std::ostringstream stats;
+  stats << "rms " << std::fixed << std::setprecision(3) << s.rms_px << " px, "
+        << s.observations << " pts, " << s.outliers << " out";
+  DrawText(canvas, x, y + 2 * kFontGlyphHeight + 3, stats.str(), {40, 40, 40});
+}
+
+}  // namespace
+
 void PlotBoardResiduals(const BoardCalibResult& result, const std::string& png_path) {
   const int n = static_cast<int>(result.stats.size());
   const int cols = std::min(n, 4), rows = (n + cols - 1) / cols;
-  const int panel = 260;
-  cv::Mat canvas(rows * panel, cols * panel, CV_8UC3, cv::Scalar(255, 255, 255));
+  // A strip below the panels for the legend, clear of the outliers on the panel edges.
+  constexpr int kLegendHeight = 16;
+  ImageU8 canvas(cols * kResidualPanel, rows * kResidualPanel + kLegendHeight, 3, 255);
   // Common scale: 3 x the largest inlier RMS, at least 1 px, fills half a panel.
   double max_rms = 0;
   for (const CameraCalibStats& s : result.stats) max_rms = std::max(max_rms, s.rms_px);
   const double range = std::max(1.0, 3 * max_rms);
-  const double scale = (panel / 2.0 - 20) / range;
-  for (int c = 0; c < n; ++c) {
-    const cv::Point origin((c % cols) * panel + panel / 2,
-                           (c / cols) * panel + panel / 2 + 10);
-    cv::rectangle(canvas, cv::Rect((c % cols) * panel, (c / cols) * panel, panel, panel),
-                  cv::Scalar(200, 200, 200));
-    cv::line(canvas, origin - cv::Point(panel / 2 - 10, 0),
-             origin + cv::Point(panel / 2 - 10, 0), cv::Scalar(220, 220, 220));
-    cv::line(canvas, origin - cv::Point(0, panel / 2 - 30),
-             origin + cv::Point(0, panel / 2 - 10), cv::Scalar(220, 220, 220));
-    cv::circle(canvas, origin, static_cast<int>(std::lround(scale)),
-               cv::Scalar(150, 150, 150), 1, cv::LINE_AA);
-  }
+  const double scale = (kResidualPanel / 2.0 - 20) / range;
+  for (int c = 0; c < n; ++c) DrawResidualFrame(&canvas, c, cols, scale);
   for (const CornerResidual& r : result.residuals) {
-    const cv::Point origin((r.camera % cols) * panel + panel / 2,
-                           (r.camera / cols) * panel + panel / 2 + 10);
+    // Residuals beyond the range sit on its edge rather than drop out of the picture.
     const Eigen::Vector2d p = r.residual.cwiseMax(-range).cwiseMin(range) * scale;
-    cv::circle(canvas,
-               origin + cv::Point(static_cast<int>(p.x()), static_cast<int>(p.y())), 1,
-               r.inlier ? cv::Scalar(200, 90, 20) : cv::Scalar(30, 30, 220), cv::FILLED);
+    DrawDisc(&canvas, ResidualOrigin(r.camera, cols) + p, 1,
+             r.inlier ? Rgb{20, 90, 200} : Rgb{220, 30, 30});
   }
-  for (int c = 0; c < n; ++c) {
-    const CameraCalibStats& s = result.stats[c];
-    std::ostringstream label;
-    label << s.name << ": rms " << std::fixed << std::setprecision(3) << s.rms_px
-          << " px, " << s.observations << " pts, " << s.outliers << " out";
-    cv::putText(canvas, label.str(),
-                cv::Point((c % cols) * panel + 6, (c / cols) * panel + 16),
-                cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  }
+  for (int c = 0; c < n; ++c) DrawResidualLabel(&canvas, c, cols, result.stats[c]);
   std::ostringstream legend;
-  legend << "grey circle = 1 px; axes span +-" << std::setprecision(2) << range << " px";
-  cv::putText(canvas, legend.str(), cv::Point(6, rows * panel - 6),
-              cv::FONT_HERSHEY_SIMPLEX, 0.35, cv::Scalar(80, 80, 80), 1, cv::LINE_AA);
-  WriteCvImage(canvas, png_path);
+  legend << "grey circle = 1 px, axes span +-" << std::setprecision(2) << range << " px";
+  DrawText(&canvas, 6, rows * kResidualPanel + (kLegendHeight - kFontGlyphHeight) / 2,
+           legend.str(), {80, 80, 80});
+  WritePng(png_path, canvas);
 }
 
 }  // namespace handlabel

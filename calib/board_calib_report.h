@@ -13,7 +13,7 @@ namespace handlabel {
 std::string BoardCalibTable(const BoardCalibResult& result);
 nlohmann::json BoardCalibJson(const BoardCalibResult& result, const BoardSpec& board,
                               const BoardCalibOptions& options);
-// Throws InputError if the PNG cannot be written.
+// Drawn with image/draw.h; throws Error naming the path if the PNG cannot be written.
 void PlotBoardResiduals(const BoardCalibResult& result, const std::string& png_path);
 
 }  // namespace handlabel

@@ -6,12 +6,12 @@
 #include <functional>
 #include <iomanip>
 #include <limits>
-#include <opencv2/imgproc.hpp>
 #include <sstream>
 
-#include "calib/cv_image_file.h"
 #include "core/errors.h"
 #include "core/option_checks.h"
+#include "image/draw.h"
+#include "image/image.h"
 
 namespace handlabel {
 namespace {
@@ -40,13 +40,19 @@ ViewBasis RigBasis(const Rig& rig) {
   return {forward.cross(up), forward, up};
 }
 
-cv::Scalar CameraColor(size_t i, size_t n) {
-  cv::Mat hsv(1, 1, CV_8UC3,
-              cv::Scalar(static_cast<int>(180.0 * i / std::max<size_t>(n, 1)), 200, 200));
-  cv::Mat bgr;
-  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
-  const cv::Vec3b c = bgr.at<cv::Vec3b>(0, 0);
-  return cv::Scalar(c[0], c[1], c[2]);
+// Camera i of n: hues evenly around the colour wheel at saturation and value 200/255
+// (OpenCV's HSV picture of the earlier plots), so neighbours in the list differ.
+Rgb CameraColor(size_t i, size_t n) {
+  const double sextant = 6.0 * i / std::max<size_t>(n, 1);
+  const double value = 200, chroma = value * 200 / 255;
+  const double x = chroma * (1 - std::abs(std::fmod(sextant, 2.0) - 1));
+  const double rgb[6][3] = {{chroma, x, 0}, {x, chroma, 0}, {0, chroma, x},
+                            {0, x, chroma}, {x, 0, chroma}, {chroma, 0, x}};
+  const double* c = rgb[std::min(static_cast<int>(sextant), 5)];
+  const auto level = [&](double v) {
+    return static_cast<uint8_t>(std::lround(v + value - chroma));
+  };
+  return {level(c[0]), level(c[1]), level(c[2])};
 }
 
 struct Frustum {
@@ -72,32 +78,31 @@ Frustum MakeFrustum(const RigCamera& c, double depth) {
   return f;
 }
 
-// Maps 2D plot coordinates (metres) into one panel with a uniform scale.
+// One square panel of its own (so that drawing is clipped to it), mapping 2D plot
+// coordinates (metres) to pixels with one scale for both axes.
 class Panel {
  public:
-  Panel(cv::Mat image, const std::vector<Eigen::Vector2d>& extent_points, int margin)
-      : image_(image), margin_(margin) {
+  Panel(int size, const std::vector<Eigen::Vector2d>& extent_points, int margin)
+      : image_(size, size, 3, 255) {
     Eigen::Vector2d lo(1e30, 1e30), hi(-1e30, -1e30);
     for (const Eigen::Vector2d& p : extent_points) {
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
-    const Eigen::Vector2d size = (hi - lo).cwiseMax(Eigen::Vector2d(0.05, 0.05));
-    const double usable = image.cols - 2 * margin;
-    scale_ = usable / std::max(size.x(), size.y());
+    const Eigen::Vector2d size_m = (hi - lo).cwiseMax(Eigen::Vector2d(0.05, 0.05));
+    scale_ = (size - 2 * margin) / std::max(size_m.x(), size_m.y());
     mid_ = (lo + hi) / 2;
   }
-  cv::Point ToPixel(const Eigen::Vector2d& p) const {
-    const double x = image_.cols / 2.0 + (p.x() - mid_.x()) * scale_;
-    const double y = image_.rows / 2.0 - (p.y() - mid_.y()) * scale_;
-    return cv::Point(static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)));
+  // Rounded to whole pixels, so that lines meeting at a point start on the same pixel.
+  Eigen::Vector2d ToPixel(const Eigen::Vector2d& p) const {
+    return Eigen::Vector2d(std::round(image_.width / 2.0 + (p.x() - mid_.x()) * scale_),
+                           std::round(image_.height / 2.0 - (p.y() - mid_.y()) * scale_));
   }
   double scale() const { return scale_; }
-  cv::Mat& image() { return image_; }
+  ImageU8& image() { return image_; }
 
  private:
-  cv::Mat image_;
-  int margin_;
+  ImageU8 image_;
   double scale_ = 1;
   Eigen::Vector2d mid_;
 };
@@ -123,42 +128,82 @@ std::string FormatLength(double m) {
   return s.str();
 }
 
-void DrawPanel(Panel& panel, const std::vector<Frustum>& frusta, const Rig& rig,
-               const std::vector<Eigen::Vector3d>& points,
-               const std::function<Eigen::Vector2d(const Eigen::Vector3d&)>& to2d,
-               const std::string& label, const std::string& axes) {
-  cv::Mat& img = panel.image();
-  for (const Eigen::Vector3d& p : points) {
-    cv::circle(img, panel.ToPixel(to2d(p)), 2, cv::Scalar(120, 120, 120), cv::FILLED,
-               cv::LINE_AA);
+using PlotProjection = std::function<Eigen::Vector2d(const Eigen::Vector3d&)>;
+
+const Rgb kBlack = {0, 0, 0};
+
+// Rays from the centre to the far corners, the far rectangle thicker and a dot on the
+// centre.
+void DrawFrustum(Panel& panel, const Frustum& f, const PlotProjection& to2d,
+                 const Rgb& color) {
+  ImageU8* img = &panel.image();
+  const Eigen::Vector2d c = panel.ToPixel(to2d(f.centre));
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d a = panel.ToPixel(to2d(f.corners[k]));
+    const Eigen::Vector2d b = panel.ToPixel(to2d(f.corners[(k + 1) % 4]));
+    DrawLine(img, c, a, color);
+    DrawThickLine(img, a, b, 2.5, color);
   }
-  // World origin.
-  cv::drawMarker(img, panel.ToPixel(to2d(Eigen::Vector3d::Zero())), cv::Scalar(0, 0, 0),
-                 cv::MARKER_CROSS, 14, 1, cv::LINE_AA);
-  for (size_t i = 0; i < frusta.size(); ++i) {
-    const cv::Scalar color = CameraColor(i, frusta.size());
-    const Frustum& f = frusta[i];
-    const cv::Point c = panel.ToPixel(to2d(f.centre));
-    for (int k = 0; k < 4; ++k) {
-      const cv::Point a = panel.ToPixel(to2d(f.corners[k]));
-      const cv::Point b = panel.ToPixel(to2d(f.corners[(k + 1) % 4]));
-      cv::line(img, c, a, color, 1, cv::LINE_AA);
-      cv::line(img, a, b, color, 2, cv::LINE_AA);
+  DrawDisc(img, c, 3, color);
+}
+
+// Camera names above and right of their centres, after all frusta and on a white
+// outline (all outlines first), so that no line runs through a letter.
+void DrawCameraNames(Panel& panel, const std::vector<Frustum>& frusta, const Rig& rig,
+                     const PlotProjection& to2d) {
+  constexpr int kScale = 2;
+  for (const bool outline : {true, false}) {
+    for (size_t i = 0; i < frusta.size(); ++i) {
+      const Eigen::Vector2d c = panel.ToPixel(to2d(frusta[i].centre));
+      const int x = static_cast<int>(c.x()) + 6;
+      const int y = static_cast<int>(c.y()) - 6 - kScale * kFontGlyphHeight;
+      for (int d = 0; d < (outline ? 9 : 1); ++d) {
+        const int dx = outline ? d % 3 - 1 : 0, dy = outline ? d / 3 - 1 : 0;
+        DrawText(&panel.image(), x + dx, y + dy, rig[i].name,
+                 outline ? Rgb{255, 255, 255} : Rgb{40, 40, 40}, kScale);
+      }
     }
-    cv::circle(img, c, 3, color, cv::FILLED, cv::LINE_AA);
-    cv::putText(img, rig[i].name, c + cv::Point(5, -5), cv::FONT_HERSHEY_SIMPLEX, 0.4,
-                cv::Scalar(40, 40, 40), 1, cv::LINE_AA);
   }
-  cv::putText(img, label, cv::Point(10, 22), cv::FONT_HERSHEY_SIMPLEX, 0.6,
-              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  cv::putText(img, axes, cv::Point(10, 42), cv::FONT_HERSHEY_SIMPLEX, 0.4,
-              cv::Scalar(80, 80, 80), 1, cv::LINE_AA);
-  const double bar = NiceLength(img.cols / 5.0 / panel.scale());
-  const int bar_px = static_cast<int>(std::lround(bar * panel.scale()));
-  const cv::Point start(10, img.rows - 15);
-  cv::line(img, start, start + cv::Point(bar_px, 0), cv::Scalar(0, 0, 0), 2);
-  cv::putText(img, FormatLength(bar), start + cv::Point(bar_px + 6, 4),
-              cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+}
+
+// The panel's name and axes at the top, a scale bar at the bottom.
+void DrawPanelText(Panel& panel, const std::string& label, const std::string& axes) {
+  ImageU8* img = &panel.image();
+  DrawText(img, 10, 10, label, kBlack, 2);
+  DrawText(img, 10, 32, axes, {80, 80, 80});
+  const double bar = NiceLength(img->width / 5.0 / panel.scale());
+  const double bar_px = std::round(bar * panel.scale());
+  const Eigen::Vector2d start(10, img->height - 15);
+  DrawLine(img, start, start + Eigen::Vector2d(bar_px, 0), kBlack, 2);
+  DrawText(img, static_cast<int>(start.x() + bar_px) + 8,
+           static_cast<int>(start.y()) - kFontGlyphHeight + 1, FormatLength(bar), kBlack,
+           2);
+}
+
+void DrawPanel(Panel& panel, const std::vector<Frustum>& frusta, const Rig& rig,
+               const std::vector<Eigen::Vector3d>& points, const PlotProjection& to2d,
+               const std::string& label, const std::string& axes) {
+  ImageU8* img = &panel.image();
+  for (const Eigen::Vector3d& p : points) {
+    DrawDisc(img, panel.ToPixel(to2d(p)), 1.5, {150, 150, 150});
+  }
+  // World origin: a cross.
+  const Eigen::Vector2d origin = panel.ToPixel(to2d(Eigen::Vector3d::Zero()));
+  DrawLine(img, origin - Eigen::Vector2d(7, 0), origin + Eigen::Vector2d(7, 0), kBlack);
+  DrawLine(img, origin - Eigen::Vector2d(0, 7), origin + Eigen::Vector2d(0, 7), kBlack);
+  for (size_t i = 0; i < frusta.size(); ++i) {
+    DrawFrustum(panel, frusta[i], to2d, CameraColor(i, frusta.size()));
+  }
+  DrawCameraNames(panel, frusta, rig, to2d);
+  DrawPanelText(panel, label, axes);
+}
+
+// Copies `panel` into `canvas` with its top-left pixel at (x0, y0).
+void Paste(const ImageU8& panel, int x0, int y0, ImageU8* canvas) {
+  for (int y = 0; y < panel.height; ++y) {
+    std::copy_n(&panel.at(0, y), size_t(panel.width) * panel.channels,
+                &canvas->at(x0, y0 + y));
+  }
 }
 
 double AutoDepth(const Rig& rig) {
@@ -194,11 +239,9 @@ void PlotRig(const Rig& rig, const std::string& png_path, const RigPlotOptions& 
   };
   const int n = options.panel_size;
   const int title_height = options.title.empty() ? 0 : 30;
-  cv::Mat canvas(n + title_height, 2 * n, CV_8UC3, cv::Scalar(255, 255, 255));
+  ImageU8 canvas(2 * n, n + title_height, 3, 255);
   for (int view = 0; view < 2; ++view) {
-    const auto& to2d = view == 0
-                           ? std::function<Eigen::Vector2d(const Eigen::Vector3d&)>(top)
-                           : std::function<Eigen::Vector2d(const Eigen::Vector3d&)>(side);
+    const PlotProjection to2d = view == 0 ? PlotProjection(top) : PlotProjection(side);
     std::vector<Eigen::Vector2d> extent;
     for (const Frustum& f : frusta) {
       extent.push_back(to2d(f.centre));
@@ -206,19 +249,17 @@ void PlotRig(const Rig& rig, const std::string& png_path, const RigPlotOptions& 
     }
     for (const Eigen::Vector3d& p : options.points) extent.push_back(to2d(p));
     extent.push_back(to2d(Eigen::Vector3d::Zero()));
-    Panel panel(canvas(cv::Rect(view * n, title_height, n, n)), extent, 60);
+    Panel panel(n, extent, 60);
     DrawPanel(panel, frusta, rig, options.points, to2d,
               view == 0 ? "from above" : "from the side",
               view == 0 ? "horizontal: rig right, vertical: rig forward"
                         : "horizontal: rig forward, vertical: rig up");
+    Paste(panel.image(), view * n, title_height, &canvas);
   }
-  cv::line(canvas, cv::Point(n, title_height), cv::Point(n, n + title_height),
-           cv::Scalar(180, 180, 180));
-  if (!options.title.empty()) {
-    cv::putText(canvas, options.title, cv::Point(10, 21), cv::FONT_HERSHEY_SIMPLEX, 0.6,
-                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  }
-  WriteCvImage(canvas, png_path);
+  DrawLine(&canvas, Eigen::Vector2d(n, title_height),
+           Eigen::Vector2d(n, n + title_height - 1), {180, 180, 180});
+  if (!options.title.empty()) DrawText(&canvas, 10, 8, options.title, kBlack, 2);
+  WritePng(png_path, canvas);
 }
 
 std::string RigTable(const Rig& rig) {

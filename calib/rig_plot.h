@@ -22,8 +22,9 @@ struct RigPlotOptions {
 };
 
 // Writes a PNG with two orthographic views of the camera frusta: from above (looking
-// down the rig's mean "up" axis, the mean of the cameras' -y axes) and from the side.
-// Throws InputError if the file cannot be written.
+// down the rig's mean "up" axis, the mean of the cameras' -y axes) and from the side,
+// drawn with image/draw.h. Always PNG, whatever the extension; creates missing parent
+// folders; throws Error naming the path if the file cannot be written.
 void PlotRig(const Rig& rig, const std::string& png_path,
              const RigPlotOptions& options = {});
 
