@@ -90,14 +90,15 @@ void DrawResidualFrame(ImageU8* canvas, int c, int cols, double scale) {
   DrawRing(canvas, o, static_cast<int>(std::lround(scale)), {150, 150, 150});
 }
 
-// The camera's name and "rms 0.112 px, 2903 pts, 27 out" below it, above the circle.
+// The camera's name and "rms 0.112 px, 2903 pts, 27 out" below it, clear of the
+// outliers piled on the top of the +-range square (from y = 30 px).
 void DrawResidualLabel(ImageU8* canvas, int c, int cols, const CameraCalibStats& s) {
-  const int x = (c % cols) * kResidualPanel + 6, y = (c / cols) * kResidualPanel + 4;
+  const int x = (c % cols) * kResidualPanel + 6, y = (c / cols) * kResidualPanel + 3;
   DrawText(canvas, x, y, s.name, {0, 0, 0}, 2);
   std::ostringstream stats;
   stats << "rms " << std::fixed << std::setprecision(3) << s.rms_px << " px, "
         << s.observations << " pts, " << s.outliers << " out";
-  DrawText(canvas, x, y + 2 * kFontGlyphHeight + 3, stats.str(), {40, 40, 40});
+  DrawText(canvas, x, y + 2 * kFontGlyphHeight + 2, stats.str(), {40, 40, 40});
 }
 
 }  // namespace
