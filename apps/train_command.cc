@@ -11,8 +11,8 @@
 #include "core/errors.h"
 #include "pipeline/train_config.h"
 #include "training/training_samples.h"
-#include "poem/loss_plot.h"
-#include "poem/poem_trainer.h"
+#include "network/poem/loss_plot.h"
+#include "network/poem/poem_trainer.h"
 
 namespace handlabel {
 

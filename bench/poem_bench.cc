@@ -29,11 +29,11 @@
 
 #include "geometry/rigid3.h"
 #include "pipeline/build_config.h"
-#include "poem/hand_mesh_predictor.h"
-#include "poem/poem_batch.h"
-#include "poem/poem_checkpoint.h"
-#include "poem/poem_model.h"
-#include "poem/poem_modules.h"
+#include "network/poem/hand_mesh_predictor.h"
+#include "network/poem/poem_batch.h"
+#include "network/poem/poem_checkpoint.h"
+#include "network/poem/poem_model.h"
+#include "network/poem/poem_modules.h"
 
 namespace handlabel {
 namespace {

@@ -8,8 +8,8 @@
 #include "hand/capsule_hand.h"
 #include "openhand/builder.h"
 #include "training/training_samples.h"
-#include "poem/poem_loss.h"
-#include "poem/poem_training_batch.h"
+#include "network/poem/poem_loss.h"
+#include "network/poem/poem_training_batch.h"
 
 namespace handlabel {
 namespace {

@@ -1,5 +1,5 @@
 // CPU time of one call of MediaPipe Hands' TFLite models in our LibTorch interpreter
-// (detector/tflite_model.h), per view: the landmark models on a 224 x 224 crop and the
+// (network/detector/tflite_model.h), per view: the landmark models on a 224 x 224 crop and the
 // palm detectors on a 192 x 192 image, with 1 and 2 intra-op threads.
 //
 //   scripts/fetch-mediapipe-models && ./build/bench/tflite_bench
@@ -12,7 +12,7 @@
 #include <random>
 
 #include "core/data_dir.h"
-#include "detector/tflite_model.h"
+#include "network/detector/tflite_model.h"
 
 namespace handlabel {
 namespace {

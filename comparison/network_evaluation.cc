@@ -8,8 +8,8 @@
 #include "core/stopwatch.h"
 #include "hand/mesh_keypoints.h"
 #include "image/line_plot.h"
-#include "poem/hand_mesh_predictor.h"
-#include "poem/mask_sheet.h"
+#include "network/poem/hand_mesh_predictor.h"
+#include "network/poem/mask_sheet.h"
 
 namespace handlabel {
 namespace {

@@ -31,7 +31,7 @@ struct NetworkEvalOptions {
   double box_scale = 2.0;     // crop side / keypoint box side
   PckOptions pck;             // thresholds of the PCK curve (POEM: 0-20 mm, 20 steps)
   // With a mask head: write the first mask_png_frames frames' crops with predicted and
-  // true masks to this PNG (poem/mask_sheet.h); empty = none.
+  // true masks to this PNG (network/poem/mask_sheet.h); empty = none.
   std::string mask_png;
   int mask_png_frames = 3;
   // How the answer's keypoints are read (as a job's network.keypoints): the MPJPE,

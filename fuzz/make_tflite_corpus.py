@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the named seeds of fuzz/corpus/tflite_reader/: small TFLite models described
-as JSON and compiled to binary by flatc with our schema subset (detector/tflite_schema.fbs).
+as JSON and compiled to binary by flatc with our schema subset (network/detector/tflite_schema.fbs).
 Standard library + flatc only.  Usage: fuzz/make_tflite_corpus.py [OUT_DIR]"""
 import json
 import os

@@ -1,4 +1,4 @@
-// libFuzzer target for the TFLite reader (detector/tflite_reader.h): the flatbuffers
+// libFuzzer target for the TFLite reader (network/detector/tflite_reader.h): the flatbuffers
 // Verifier, then our index, shape and buffer-size checks. After a successful parse,
 // every tensor's constant data and every operator's tensor indices are touched, so a
 // range the checks missed shows up as an AddressSanitizer report. Anything but success
@@ -10,7 +10,7 @@
 #include <string>
 
 #include "core/errors.h"
-#include "detector/tflite_reader.h"
+#include "network/detector/tflite_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string bytes(reinterpret_cast<const char*>(data), size);

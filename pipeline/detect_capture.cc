@@ -10,7 +10,7 @@
 #include "core/errors.h"
 #include "core/json_util.h"
 #include "core/stopwatch.h"
-#include "detector/detector_overlay.h"
+#include "network/detector/detector_overlay.h"
 #include "image/image_file.h"
 
 namespace handlabel {

@@ -1,5 +1,5 @@
 #pragma once
-// `handlabel detect --capture C`: multi-view hand finding (detector/hand_detector.h) on
+// `handlabel detect --capture C`: multi-view hand finding (network/detector/hand_detector.h) on
 // every frame of a native capture, written as the capture's detections
 // (detections/{frame}.json, docs/capture-format.md) with per-keypoint confidence,
 // handedness, presence, and per view the reason when there is no detection. The
@@ -11,8 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "detector/hand_detector.h"
-#include "detector/mediapipe_hands.h"
+#include "network/detector/hand_detector.h"
+#include "network/detector/mediapipe_hands.h"
 
 namespace handlabel {
 
@@ -22,7 +22,7 @@ struct DetectCaptureOptions {
   // Replace detections the capture already has (e.g. a synthetic capture's simulated
   // ones); without it such a capture is refused, so nothing written is lost.
   bool overwrite = false;
-  // When set, also a picture per view of what was found (detector/detector_overlay.h):
+  // When set, also a picture per view of what was found (network/detector/detector_overlay.h):
   // <overlays_dir>/<frame>/<camera>.png.
   std::string overlays_dir;
   // Throws InputError naming `source` when a field is out of range.

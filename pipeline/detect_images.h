@@ -1,5 +1,5 @@
 #pragma once
-// `handlabel detect --images`: MediaPipe Hands (detector/mediapipe_hands.h) on single
+// `handlabel detect --images`: MediaPipe Hands (network/detector/mediapipe_hands.h) on single
 // images, one JSON file per image with everything the pipeline computes (palms, ROIs,
 // landmarks in image, crop and world coordinates, presence, handedness) and the time of
 // each step; the parity check against MediaPipe's own runtime
@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "detector/mediapipe_hands.h"
+#include "network/detector/mediapipe_hands.h"
 
 namespace handlabel {
 

@@ -5,7 +5,7 @@
 #include "capture/frame_images.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
-#include "detector/detector_overlay.h"
+#include "network/detector/detector_overlay.h"
 #include "hand/hand_skeleton.h"
 #include "image/draw.h"
 #include "image/image_file.h"

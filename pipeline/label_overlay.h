@@ -26,7 +26,7 @@ class RasterOverlayWriter : public OverlayWriter {
  public:
   // `detections`: the detector's answers when the job's 2D comes from it
   // (evidence.keypoints_2d: detector); each view then also shows its detection
-  // (detector/detector_overlay.h). Null: the label only.
+  // (network/detector/detector_overlay.h). Null: the label only.
   // `format`: jpg | png (output.overlay_format).
   RasterOverlayWriter(const HandModel& model, std::string format,
                       std::shared_ptr<DetectionStore> detections = nullptr)

@@ -35,7 +35,7 @@ struct MeshPrediction {
 
 // The network stage: the network's answer per frame in the rig's conventions. A value
 // rather than a class to derive from: the one network interface is
-// poem/hand_mesh_predictor.h, pipeline/network_stage.h makes this stage from it,
+// network/poem/hand_mesh_predictor.h, pipeline/network_stage.h makes this stage from it,
 // and tests set their own `predict`.
 struct NetworkStage {
   std::string model_name;       // recorded in provenance and logs

@@ -10,7 +10,7 @@
 #include "core/stopwatch.h"
 #include "formats/sha256.h"
 #include "image/image.h"
-#include "poem/poem_config.h"
+#include "network/poem/poem_config.h"
 
 namespace handlabel {
 namespace {

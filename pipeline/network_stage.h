@@ -1,7 +1,7 @@
 #pragma once
 // The labeling job's network stage (label_stages.h NetworkStage) on the one network
-// interface, poem/hand_mesh_predictor.h: per view it reads the image and crops
-// around the hand (the capture's 2D keypoints locate it; poem/hand_crop.h), runs the
+// interface, network/poem/hand_mesh_predictor.h: per view it reads the image and crops
+// around the hand (the capture's 2D keypoints locate it; network/poem/hand_crop.h), runs the
 // network in batches, and brings the answer back to the job's conventions: 3D points
 // from the master camera's frame to the rig's world frame, 2D keypoints from crop
 // pixels to full-image (distorted) pixels with the heatmap peaks as confidences, and
@@ -15,8 +15,8 @@
 
 #include "pipeline/job_config.h"
 #include "pipeline/label_stages.h"
-#include "poem/hand_crop.h"
-#include "poem/hand_mesh_predictor.h"
+#include "network/poem/hand_crop.h"
+#include "network/poem/hand_mesh_predictor.h"
 
 namespace handlabel {
 

@@ -87,7 +87,7 @@ CropTransform MakeCropTransform(const Camera& camera, const Eigen::Vector2d& lo,
   t.lin = t.s * t.rot * Eigen::Vector2d(t.f / fx, t.f / fy).asDiagonal();
   t.affine.leftCols<2>() = t.lin;
   t.affine.col(2) = Eigen::Vector2d::Constant(0.5 * o.crop_size) -
-                    t.lin * center;  // as poem/hand_crop.h
+                    t.lin * center;  // as network/poem/hand_crop.h
   return t;
 }
 

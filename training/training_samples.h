@@ -33,7 +33,7 @@
 
 #include "capture/synth_capture.h"
 #include "hand/hand_model.h"
-#include "poem/training_sample.h"
+#include "network/poem/training_sample.h"
 
 namespace handlabel {
 

@@ -6,7 +6,7 @@
 
 #include "capture/capture_reader.h"
 #include "core/data_dir.h"
-#include "detector/detector_overlay.h"
+#include "network/detector/detector_overlay.h"
 #include "image/image_file.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_stage_factory.h"

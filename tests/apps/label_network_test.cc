@@ -9,8 +9,8 @@
 
 #include "formats/sha256.h"
 #include "pipeline/label_record.h"
-#include "poem/hand_mesh_predictor.h"
-#include "poem/poem_config.h"
+#include "network/poem/hand_mesh_predictor.h"
+#include "network/poem/poem_config.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"

@@ -14,7 +14,7 @@
 #include "hand/capsule_hand.h"
 #include "hand/hand_model_io.h"
 #include "image/image_file.h"
-#include "poem/poem_config.h"
+#include "network/poem/poem_config.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/test_util.h"
 

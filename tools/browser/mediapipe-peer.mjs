@@ -1,5 +1,5 @@
 // MediaPipe Hands' own runtime (the npm package's JavaScript solution in headless Debian
-// Chromium) as the parity peer of handlabel's detector (detector/mediapipe_hands.h).
+// Chromium) as the parity peer of handlabel's detector (network/detector/mediapipe_hands.h).
 //
 //   node tools/browser/mediapipe-peer.mjs --out DIR [--model full|lite] [--max-hands N]
 //        [--inference gpu|cpu] IMAGE...

@@ -1,0 +1,358 @@
+#include "network/detector/hand_detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/errors.h"
+#include "core/option_checks.h"
+#include "geometry/triangulation.h"
+
+namespace handlabel {
+namespace {
+
+using Points3 = std::array<Eigen::Vector3d, kPalmKeypoints>;
+
+double PalmSizePx(const PalmDetection& p, int w, int h) {
+  return std::max(p.width * w, p.height * h);
+}
+
+Eigen::Vector2d PalmKeypointPx(const PalmDetection& p, int k, int w, int h) {
+  return NormToPixel(p.keypoints[k], w, h);
+}
+
+// The 7 palm keypoints triangulated from the given (view, palm) pairs.
+std::optional<Points3> TriangulatePalm(
+    const Rig& rig, const std::vector<ImageU8>& images,
+    const std::vector<std::vector<PalmDetection>>& palms,
+    const std::vector<std::pair<int, int>>& members) {
+  Points3 out;
+  for (int k = 0; k < kPalmKeypoints; ++k) {
+    std::vector<ViewObservation> obs;
+    for (const auto& [view, index] : members) {
+      const ImageU8& im = images[view];
+      obs.push_back(
+          {view, PalmKeypointPx(palms[view][index], k, im.width, im.height), 1.0});
+    }
+    const auto point = TriangulateWeighted(rig, obs);
+    if (!point) return std::nullopt;
+    out[k] = *point;
+  }
+  return out;
+}
+
+// Mean distance (pixels) between a palm's keypoints and the projected 3D palm, in palm
+// sizes; infinity when a point is behind the camera.
+double PalmDisagreement(const RigCamera& camera, const PalmDetection& palm,
+                        const Points3& p3, int w, int h) {
+  double sum = 0;
+  for (int k = 0; k < kPalmKeypoints; ++k) {
+    Eigen::Vector2d uv;
+    if (!camera.ProjectWorld(p3[k], &uv)) return std::numeric_limits<double>::infinity();
+    sum += (uv - PalmKeypointPx(palm, k, w, h)).norm();
+  }
+  return sum / kPalmKeypoints / std::max(PalmSizePx(palm, w, h), 1.0);
+}
+
+struct PalmHypothesis {
+  std::vector<std::pair<int, int>> members;  // (view, palm index)
+  double score_sum = 0;
+};
+
+// Step 2: the 3D palm most views agree on.
+PalmHypothesis BestPalmHypothesis(const Rig& rig, const std::vector<ImageU8>& images,
+                                  const std::vector<std::vector<PalmDetection>>& palms,
+                                  const MultiViewDetectorOptions& options) {
+  const int n = static_cast<int>(images.size());
+  PalmHypothesis best;
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      for (int i = 0; i < static_cast<int>(palms[a].size()); ++i) {
+        for (int j = 0; j < static_cast<int>(palms[b].size()); ++j) {
+          const auto p3 = TriangulatePalm(rig, images, palms, {{a, i}, {b, j}});
+          if (!p3) continue;
+          PalmHypothesis h;
+          for (int v = 0; v < n; ++v) {
+            int best_index = -1;
+            double best_d = options.palm_agreement;
+            for (int c = 0; c < static_cast<int>(palms[v].size()); ++c) {
+              const double d = PalmDisagreement(rig[v], palms[v][c], *p3, images[v].width,
+                                                images[v].height);
+              if (d < best_d) best_d = d, best_index = c;
+            }
+            if (best_index < 0) continue;
+            h.members.push_back({v, best_index});
+            h.score_sum += palms[v][best_index].score;
+          }
+          const bool more = h.members.size() > best.members.size();
+          const bool tie_better =
+              h.members.size() == best.members.size() && h.score_sum > best.score_sum;
+          if (more || tie_better) best = h;
+        }
+      }
+    }
+  }
+  return best;
+}
+
+// The 3D palm (7 keypoints and the box centre, triangulated from the agreeing views) and
+// the box size per unit of wrist-to-middle-MCP distance, as those views saw it.
+struct Palm3d {
+  Points3 keypoints;
+  Eigen::Vector3d box_centre = Eigen::Vector3d::Zero();
+  double box_per_span = 0;
+};
+
+std::optional<Palm3d> TriangulatePalmWithBox(
+    const Rig& rig, const std::vector<ImageU8>& images,
+    const std::vector<std::vector<PalmDetection>>& palms, const PalmHypothesis& h) {
+  const auto keypoints = TriangulatePalm(rig, images, palms, h.members);
+  if (!keypoints) return std::nullopt;
+  Palm3d out;
+  out.keypoints = *keypoints;
+  std::vector<ViewObservation> centres;
+  for (const auto& [v, index] : h.members) {
+    const PalmDetection& p = palms[v][index];
+    const int w = images[v].width, ht = images[v].height;
+    centres.push_back(
+        {v, NormToPixel({p.xmin + p.width / 2, p.ymin + p.height / 2}, w, ht), 1.0});
+    const double span =
+        (PalmKeypointPx(p, 2, w, ht) - PalmKeypointPx(p, 0, w, ht)).norm();
+    out.box_per_span += PalmSizePx(p, w, ht) / std::max(span, 1.0) / h.members.size();
+  }
+  const auto centre = TriangulateWeighted(rig, centres);
+  if (!centre) return std::nullopt;
+  out.box_centre = *centre;
+  return out;
+}
+
+// The 3D palm seen from camera `camera` as a palm detection (normalised), a square box of
+// the agreeing views' size per span; nothing when it projects behind the camera or
+// its centre falls outside the image.
+std::optional<PalmDetection> ProjectPalm(const RigCamera& camera, const Palm3d& palm,
+                                         int w, int h) {
+  PalmDetection out;
+  out.score = 0;
+  std::array<Eigen::Vector2d, kPalmKeypoints> px;
+  for (int k = 0; k < kPalmKeypoints; ++k) {
+    if (!camera.ProjectWorld(palm.keypoints[k], &px[k])) return std::nullopt;
+    out.keypoints[k] = Eigen::Vector2d((px[k].x() + 0.5) / w, (px[k].y() + 0.5) / h);
+  }
+  Eigen::Vector2d centre;
+  if (!camera.ProjectWorld(palm.box_centre, &centre) || !camera.camera.InImage(centre)) {
+    return std::nullopt;
+  }
+  const double size = palm.box_per_span * (px[2] - px[0]).norm();
+  out.xmin = (centre.x() + 0.5 - size / 2) / w;
+  out.ymin = (centre.y() + 0.5 - size / 2) / h;
+  out.width = size / w;
+  out.height = size / h;
+  return out;
+}
+
+double MedianReprojectionPx(const RigCamera& camera, const Keypoints2d& kp,
+                            const FrameHandResult& frame) {
+  std::vector<double> errors;
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (!frame.keypoint3d_valid[k] || kp.confidence(k) <= 0) continue;
+    Eigen::Vector2d uv;
+    if (!camera.ProjectWorld(frame.keypoints3d.row(k).transpose(), &uv)) continue;
+    errors.push_back((uv - kp.uv_px.row(k).transpose()).norm());
+  }
+  if (errors.empty()) return -1;
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  return errors[errors.size() / 2];
+}
+
+double RoiSizePx(const NormalizedRect& roi, int w, int h) {
+  return std::sqrt(roi.width * w * roi.height * h);
+}
+
+// Step 4: robust per-keypoint triangulation from the detected views.
+void TriangulateKeypoints(const Rig& rig, const std::vector<ImageU8>& images,
+                          const MultiViewDetectorOptions& options,
+                          FrameHandResult* frame) {
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    std::vector<ViewObservation> obs;
+    double roi_px = 0;
+    for (int v = 0; v < static_cast<int>(frame->views.size()); ++v) {
+      const ViewHandResult& r = frame->views[v];
+      if (!r.detected || r.keypoints.confidence(k) <= 0) continue;
+      obs.push_back({v, r.keypoints.uv_px.row(k).transpose(), r.keypoints.confidence(k)});
+      roi_px = std::max(roi_px, RoiSizePx(r.hand.roi, images[v].width, images[v].height));
+    }
+    RobustTriangulationOptions ro;
+    ro.inlier_threshold_px = std::max(2.0, options.keypoint_inlier * roi_px);
+    const RobustTriangulation t = TriangulateRobust(rig, obs, ro);
+    frame->keypoint3d_valid[k] = t.valid;
+    if (t.valid) frame->keypoints3d.row(k) = t.point.transpose();
+  }
+}
+
+// The 3D hand projected into view v; false when too little of it lands in the image.
+bool ProjectHand(const RigCamera& camera, const FrameHandResult& frame,
+                 const MultiViewDetectorOptions& options, KeypointPixels* uv_px) {
+  int inside = 0, valid = 0;
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (!frame.keypoint3d_valid[k]) continue;
+    Eigen::Vector2d uv;
+    if (!camera.ProjectWorld(frame.keypoints3d.row(k).transpose(), &uv)) return false;
+    uv_px->row(k) = uv.transpose();
+    ++valid;
+    if (camera.camera.InImage(uv)) ++inside;
+  }
+  if (valid < kNumHandKeypoints) {
+    // Missing 3D keypoints: the ROI rule needs them all; use the projected wrist for
+    // the missing ones only when the wrist exists.
+    if (!frame.keypoint3d_valid[0]) return false;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (!frame.keypoint3d_valid[k]) uv_px->row(k) = uv_px->row(0);
+    }
+  }
+  return inside >= options.min_keypoints_in_view * kNumHandKeypoints;
+}
+
+// `min_presence`: the detector's own threshold for ROIs from the view's palm, the lower
+// `min_presence_from_3d` for ROIs the other views put there.
+void RunLandmarks(const MediapipeHands& detector, const ImageU8& image,
+                  const NormalizedRect& roi, const std::string& source,
+                  double min_presence, ViewHandResult* r) {
+  r->hand = detector.LandmarksInRoi(image, roi);
+  r->detected = r->hand.presence >= min_presence;
+  if (r->detected) {
+    r->source = source;
+    r->reason.clear();
+    r->keypoints = r->hand.ToKeypoints(image.width, image.height);
+  } else {
+    r->source.clear();
+    r->reason = "low_presence";
+    r->keypoints = Keypoints2d();
+  }
+}
+
+void VoteSide(FrameHandResult* frame) {
+  double weight = 0, right = 0;
+  for (const ViewHandResult& r : frame->views) {
+    if (!r.detected) continue;
+    // left_in_mirror_score is the probability of the person's right hand.
+    right += r.hand.presence * r.hand.left_in_mirror_score;
+    weight += r.hand.presence;
+  }
+  if (weight <= 0) return;
+  const double p_right = right / weight;
+  frame->side = p_right >= 0.5 ? HandSide::kRight : HandSide::kLeft;
+  frame->side_score = p_right >= 0.5 ? p_right : 1 - p_right;
+}
+
+}  // namespace
+
+void MultiViewDetectorOptions::Check(const std::string& source) const {
+  RequireAtLeast(source, "min_palm_views", min_palm_views, 2);
+  RequireGreater(source, "palm_agreement", palm_agreement, 0);
+  RequireGreater(source, "keypoint_inlier", keypoint_inlier, 0);
+  RequireGreater(source, "max_reprojection", max_reprojection, 0);
+  RequireInRange(source, "min_presence_from_3d", min_presence_from_3d, 0, 1,
+                 "a value in [0, 1]");
+  RequireInRange(source, "min_keypoints_in_view", min_keypoints_in_view, 0, 1,
+                 "a value in [0, 1]");
+}
+
+FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& rig,
+                                    const std::vector<ImageU8>& images,
+                                    const MultiViewDetectorOptions& options) {
+  options.Check("MultiViewDetectorOptions");
+  HL_CHECK(images.size() == rig.size(), "one image per rig camera");
+  const int n = static_cast<int>(images.size());
+  FrameHandResult frame;
+  frame.views.resize(n);
+  std::vector<std::vector<PalmDetection>> palms(n);
+  for (int v = 0; v < n; ++v) {
+    palms[v] = detector.DetectPalms(images[v]);
+    frame.views[v].palm_candidates = static_cast<int>(palms[v].size());
+    frame.views[v].palms = palms[v];
+    frame.views[v].reason = "no_hand_in_frame";
+  }
+  const PalmHypothesis best = BestPalmHypothesis(rig, images, palms, options);
+  if (static_cast<int>(best.members.size()) < options.min_palm_views) return frame;
+  frame.palm_views = static_cast<int>(best.members.size());
+
+  // Step 3: landmarks where the palms agreed.
+  for (const auto& [v, index] : best.members) {
+    const NormalizedRect roi =
+        HandRoiFromPalm(palms[v][index], images[v].width, images[v].height);
+    RunLandmarks(detector, images[v], roi, "palm", detector.options().min_presence,
+                 &frame.views[v]);
+  }
+  // Step 4a: views whose palm detection missed, from the projected 3D palm.
+  const auto palm3d = TriangulatePalmWithBox(rig, images, palms, best);
+  for (int v = 0; v < n && palm3d; ++v) {
+    if (frame.views[v].detected || frame.views[v].reason == "low_presence") continue;
+    const auto palm = ProjectPalm(rig[v], *palm3d, images[v].width, images[v].height);
+    if (!palm) {
+      frame.views[v].reason = "hand_outside_view";
+      continue;
+    }
+    RunLandmarks(detector, images[v],
+                 HandRoiFromPalm(*palm, images[v].width, images[v].height), "3d_palm",
+                 options.min_presence_from_3d, &frame.views[v]);
+  }
+  TriangulateKeypoints(rig, images, options, &frame);
+  frame.found = frame.keypoint3d_valid[0];
+  if (!frame.found) {
+    VoteSide(&frame);
+    // Fewer than two views agree on the keypoints: no view's hand can be checked
+    // against the others (step 5), and one view alone leaves its depth unknown (a fit
+    // from it lands metres off). Dropped, with the reason.
+    for (ViewHandResult& r : frame.views) {
+      if (!r.detected) continue;
+      r.detected = false;
+      r.reason = "unconfirmed_by_other_views";
+      r.source.clear();
+      r.keypoints = Keypoints2d();
+    }
+    return frame;
+  }
+
+  // Step 4b: views still without a hand from the projected 3D keypoints (all views in
+  // a second pass).
+  const auto redo_from_3d = [&](int v, const std::string& source) {
+    KeypointPixels uv = KeypointPixels::Zero();
+    if (!ProjectHand(rig[v], frame, options, &uv)) {
+      frame.views[v].detected = false;
+      frame.views[v].reason = "hand_outside_view";
+      return;
+    }
+    RunLandmarks(detector, images[v],
+                 RoiFromKeypoints(uv, images[v].width, images[v].height), source,
+                 options.min_presence_from_3d, &frame.views[v]);
+  };
+  for (int v = 0; v < n; ++v) {
+    if (!frame.views[v].detected && frame.views[v].reason != "hand_outside_view") {
+      redo_from_3d(v, "3d_hand");
+    }
+  }
+  TriangulateKeypoints(rig, images, options, &frame);
+  if (options.second_pass) {
+    for (int v = 0; v < n; ++v) redo_from_3d(v, "second_pass");
+    TriangulateKeypoints(rig, images, options, &frame);
+  }
+
+  // Step 5: drop views that disagree with the triangulated hand.
+  for (int v = 0; v < n; ++v) {
+    ViewHandResult& r = frame.views[v];
+    if (!r.detected) continue;
+    r.median_reprojection_px = MedianReprojectionPx(rig[v], r.keypoints, frame);
+    const double limit = options.max_reprojection *
+                         RoiSizePx(r.hand.roi, images[v].width, images[v].height);
+    if (r.median_reprojection_px > limit) {
+      r.detected = false;
+      r.reason = "inconsistent_with_3d_hand";
+      r.source.clear();
+      r.keypoints = Keypoints2d();
+    }
+  }
+  VoteSide(&frame);
+  return frame;
+}
+
+}  // namespace handlabel

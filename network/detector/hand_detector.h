@@ -1,0 +1,100 @@
+#pragma once
+// Multi-view hand finding with MediaPipe Hands (network/detector/mediapipe_hands.h): one hand per
+// frame, found consistently across a calibrated rig.
+//
+//  1. Palm candidates in every view (palm detection on the whole image).
+//  2. Every pair of candidates from two views is triangulated (the 7 palm keypoints);
+//     the hypothesis that the most other views confirm (a candidate whose keypoints lie
+//     within `palm_agreement` palm sizes of the projection) wins, and is re-triangulated
+//     from all its views. Two views can agree on two different hands; a third one rarely
+//     does, so ties go to more views, then to the higher summed palm score.
+//  3. Landmarks in the confirming views (ROI from their palm); handedness is voted:
+//     presence-weighted mean of the per-view probabilities.
+//  4. Where palm detection missed the hand, the 3D palm (its keypoints and box centre,
+//     triangulated from those views; box size from their box-to-palm-span ratio) is
+//     projected and its ROI cropped for the landmark model. Then the 21 keypoints are
+//     triangulated (robustly, per keypoint) from every view with landmarks, and views
+//     still without a hand get the ROI around the projected keypoints. Optionally
+//     (`second_pass`) every view is redone from the keypoints triangulated from all.
+//  5. A view's detection that disagrees with the triangulated hand (median reprojection
+//     error above `max_reprojection` ROI sizes) is dropped.
+// Each view without a detection records why (ViewHandResult::reason).
+//
+// Pixels are distorted image pixels (the models run on the images as they are);
+// triangulation undistorts through the rig's camera models (geometry/triangulation.h).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "network/detector/mediapipe_hands.h"
+#include "geometry/rig.h"
+#include "hand/hand_model.h"
+#include "hand/keypoints2d.h"
+#include "image/image.h"
+
+namespace handlabel {
+
+struct MultiViewDetectorOptions {
+  // Fewest views whose palms must agree on a 3D palm.
+  int min_palm_views = 2;
+  // A candidate palm confirms a 3D palm when its keypoints' mean distance to the
+  // projection is below this many palm sizes (longer side of its box, pixels).
+  double palm_agreement = 0.25;
+  // Keypoint triangulation: inlier threshold as a share of the view's ROI size.
+  double keypoint_inlier = 0.05;
+  // A view's detection is dropped when its median keypoint reprojection error exceeds
+  // this share of its ROI size.
+  double max_reprojection = 0.1;
+  // A projected hand is looked for in a view only when at least this share of its 21
+  // keypoints projects inside the image.
+  double min_keypoints_in_view = 0.5;
+  // Presence a hand needs in a ROI placed from the other views (3D palm or keypoints):
+  // there the rig already says where the hand is, and held objects hide much of it, so
+  // this is below the single-image threshold (MediapipeHandsOptions::min_presence); the
+  // reprojection check (max_reprojection) still drops crops that disagree.
+  double min_presence_from_3d = 0.2;
+  // Redo every view from the ROI of the keypoints triangulated from all views.
+  bool second_pass = false;
+  // Throws InputError naming `source` when a field is out of range.
+  void Check(const std::string& source) const;
+};
+
+// One view's outcome.
+struct ViewHandResult {
+  bool detected = false;
+  // "palm" (ROI from this view's palm), "3d_palm" (from the projected 3D palm),
+  // "3d_hand" (from the projected 3D keypoints) or "second_pass"; empty without one.
+  std::string source;
+  // Why there is no detection: "no_hand_in_frame" (no palms agreed in enough views),
+  // "hand_outside_view" (the 3D hand projects mostly outside the image or behind the
+  // camera), "low_presence" (the landmark model found no hand in the ROI),
+  // "inconsistent_with_3d_hand" (its keypoints disagree with the triangulated hand),
+  // "unconfirmed_by_other_views" (a hand in this view, but in no other: no 3D hand to
+  // check it against, and one view leaves its depth unknown).
+  std::string reason;
+  int palm_candidates = 0;           // palms the view's palm detection found
+  std::vector<PalmDetection> palms;  // those palms (normalised to the image), best first
+  HandLandmarks hand;                // valid when detected
+  Keypoints2d keypoints;  // distorted pixels, confidence per header rule; 0 = missing
+  double median_reprojection_px = -1;  // against the triangulated keypoints; -1 unknown
+};
+
+struct FrameHandResult {
+  std::vector<ViewHandResult> views;  // rig order
+  bool found = false;                 // a 3D hand was established
+  HandSide side = HandSide::kRight;   // voted (person's side)
+  double side_score = 0;              // voted probability of `side`
+  int palm_views = 0;                 // views whose palms agreed
+  // Triangulated keypoints (world frame) and whether each one is valid.
+  Eigen::Matrix<double, kNumHandKeypoints, 3, Eigen::RowMajor> keypoints3d =
+      Eigen::Matrix<double, kNumHandKeypoints, 3, Eigen::RowMajor>::Zero();
+  std::array<bool, kNumHandKeypoints> keypoint3d_valid{};
+};
+
+// Runs steps 1-5 on one frame: images[c] is the RGB image of rig camera c.
+FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& rig,
+                                    const std::vector<ImageU8>& images,
+                                    const MultiViewDetectorOptions& options = {});
+
+}  // namespace handlabel
