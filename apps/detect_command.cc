@@ -1,6 +1,7 @@
-// `handlabel detect`: MediaPipe Hands' 2D hand keypoints (network/detector/mediapipe_hands.h) for
-// a capture's views, found consistently across the rig (pipeline/detect_capture.h), or
-// for single images (pipeline/detect_images.h). docs/detector.md.
+// `handlabel detect`: MediaPipe Hands' 2D hand keypoints
+// (network/detector/mediapipe_hands.h) for a capture's views, found consistently across
+// the rig (pipeline/detect_capture.h), or for single images (pipeline/detect_images.h).
+// docs/detector.md.
 
 #include <unistd.h>
 

@@ -9,10 +9,10 @@
 #include "apps/cli_util.h"
 #include "apps/commands.h"
 #include "core/errors.h"
-#include "pipeline/train_config.h"
-#include "training/training_samples.h"
 #include "network/poem/loss_plot.h"
 #include "network/poem/poem_trainer.h"
+#include "pipeline/train_config.h"
+#include "training/training_samples.h"
 
 namespace handlabel {
 

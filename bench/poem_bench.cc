@@ -28,12 +28,12 @@
 #include <random>
 
 #include "geometry/rigid3.h"
-#include "pipeline/build_config.h"
 #include "network/poem/hand_mesh_predictor.h"
 #include "network/poem/poem_batch.h"
 #include "network/poem/poem_checkpoint.h"
 #include "network/poem/poem_model.h"
 #include "network/poem/poem_modules.h"
+#include "pipeline/build_config.h"
 
 namespace handlabel {
 namespace {

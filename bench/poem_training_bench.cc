@@ -6,10 +6,10 @@
 #include <torch/torch.h>
 
 #include "hand/capsule_hand.h"
-#include "openhand/builder.h"
-#include "training/training_samples.h"
 #include "network/poem/poem_loss.h"
 #include "network/poem/poem_training_batch.h"
+#include "openhand/builder.h"
+#include "training/training_samples.h"
 
 namespace handlabel {
 namespace {

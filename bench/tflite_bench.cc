@@ -1,6 +1,6 @@
 // CPU time of one call of MediaPipe Hands' TFLite models in our LibTorch interpreter
-// (network/detector/tflite_model.h), per view: the landmark models on a 224 x 224 crop and the
-// palm detectors on a 192 x 192 image, with 1 and 2 intra-op threads.
+// (network/detector/tflite_model.h), per view: the landmark models on a 224 x 224 crop
+// and the palm detectors on a 192 x 192 image, with 1 and 2 intra-op threads.
 //
 //   scripts/fetch-mediapipe-models && ./build/bench/tflite_bench
 // Arguments: intra-op threads. Counter: calls_per_s. The input is seeded uniform noise

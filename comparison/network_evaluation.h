@@ -14,10 +14,10 @@
 #include <string>
 
 #include "capture/synth_capture.h"
+#include "comparison/compare_run.h"
 #include "hand/hand_model.h"
 #include "hand/mesh_keypoints.h"
 #include "hand/metrics.h"
-#include "comparison/compare_run.h"
 #include "training/training_samples.h"
 
 namespace handlabel {

@@ -1,7 +1,7 @@
-// libFuzzer target for the TFLite reader (network/detector/tflite_reader.h): the flatbuffers
-// Verifier, then our index, shape and buffer-size checks. After a successful parse,
-// every tensor's constant data and every operator's tensor indices are touched, so a
-// range the checks missed shows up as an AddressSanitizer report. Anything but success
+// libFuzzer target for the TFLite reader (network/detector/tflite_reader.h): the
+// flatbuffers Verifier, then our index, shape and buffer-size checks. After a successful
+// parse, every tensor's constant data and every operator's tensor indices are touched, so
+// a range the checks missed shows up as an AddressSanitizer report. Anything but success
 // or InputError is a finding. (The LibTorch interpreter is not built with sanitizers;
 // it only sees graphs this reader accepted.)
 

@@ -10,8 +10,8 @@
 #include "core/errors.h"
 #include "core/json_util.h"
 #include "core/stopwatch.h"
-#include "network/detector/detector_overlay.h"
 #include "image/image_file.h"
+#include "network/detector/detector_overlay.h"
 
 namespace handlabel {
 namespace {

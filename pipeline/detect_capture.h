@@ -1,9 +1,10 @@
 #pragma once
-// `handlabel detect --capture C`: multi-view hand finding (network/detector/hand_detector.h) on
-// every frame of a native capture, written as the capture's detections
-// (detections/{frame}.json, docs/capture-format.md) with per-keypoint confidence,
-// handedness, presence, and per view the reason when there is no detection. The
-// manifest (capture.json) then lists the detections kind. docs/detector.md.
+// `handlabel detect --capture C`: multi-view hand finding
+// (network/detector/hand_detector.h) on every frame of a native capture, written as the
+// capture's detections (detections/{frame}.json, docs/capture-format.md) with
+// per-keypoint confidence, handedness, presence, and per view the reason when there is no
+// detection. The manifest (capture.json) then lists the detections kind.
+// docs/detector.md.
 
 #include <functional>
 #include <string>
@@ -22,8 +23,8 @@ struct DetectCaptureOptions {
   // Replace detections the capture already has (e.g. a synthetic capture's simulated
   // ones); without it such a capture is refused, so nothing written is lost.
   bool overwrite = false;
-  // When set, also a picture per view of what was found (network/detector/detector_overlay.h):
-  // <overlays_dir>/<frame>/<camera>.png.
+  // When set, also a picture per view of what was found
+  // (network/detector/detector_overlay.h): <overlays_dir>/<frame>/<camera>.png.
   std::string overlays_dir;
   // Throws InputError naming `source` when a field is out of range.
   void Check(const std::string& source) const;

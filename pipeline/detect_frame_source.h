@@ -1,8 +1,8 @@
 #pragma once
 // A label job's `evidence.keypoints_2d: detector` (docs/labeling-jobs.md): the frames of
 // any capture reader with their 2D keypoints from MediaPipe Hands, run on the frame's
-// images as it is loaded (multi-view hand finding, network/detector/hand_detector.h), exactly as
-// `handlabel detect --capture` would write them (pipeline/detect_capture.h): a
+// images as it is loaded (multi-view hand finding, network/detector/hand_detector.h),
+// exactly as `handlabel detect --capture` would write them (pipeline/detect_capture.h): a
 // keypoint with confidence 0 is unknown (position 0), a view without a detection has
 // none. The detector's full answer per frame stays available to the overlay writer
 // (DetectionStore), which draws it (network/detector/detector_overlay.h).

@@ -1,8 +1,8 @@
 #pragma once
-// `handlabel detect --images`: MediaPipe Hands (network/detector/mediapipe_hands.h) on single
-// images, one JSON file per image with everything the pipeline computes (palms, ROIs,
-// landmarks in image, crop and world coordinates, presence, handedness) and the time of
-// each step; the parity check against MediaPipe's own runtime
+// `handlabel detect --images`: MediaPipe Hands (network/detector/mediapipe_hands.h) on
+// single images, one JSON file per image with everything the pipeline computes (palms,
+// ROIs, landmarks in image, crop and world coordinates, presence, handedness) and the
+// time of each step; the parity check against MediaPipe's own runtime
 // (scripts/mediapipe-parity) and the real-photo benchmark read these files.
 
 #include <functional>

@@ -5,10 +5,10 @@
 #include "capture/frame_images.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
-#include "network/detector/detector_overlay.h"
 #include "hand/hand_skeleton.h"
 #include "image/draw.h"
 #include "image/image_file.h"
+#include "network/detector/detector_overlay.h"
 #include "pipeline/label_outputs.h"
 
 namespace handlabel {

@@ -1,8 +1,8 @@
 #pragma once
 // The labeling job's network stage (label_stages.h NetworkStage) on the one network
 // interface, network/poem/hand_mesh_predictor.h: per view it reads the image and crops
-// around the hand (the capture's 2D keypoints locate it; network/poem/hand_crop.h), runs the
-// network in batches, and brings the answer back to the job's conventions: 3D points
+// around the hand (the capture's 2D keypoints locate it; network/poem/hand_crop.h), runs
+// the network in batches, and brings the answer back to the job's conventions: 3D points
 // from the master camera's frame to the rig's world frame, 2D keypoints from crop
 // pixels to full-image (distorted) pixels with the heatmap peaks as confidences, and
 // the mask head's crop masks (if the network has one) to full-image silhouettes.
@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/job_config.h"
-#include "pipeline/label_stages.h"
 #include "network/poem/hand_crop.h"
 #include "network/poem/hand_mesh_predictor.h"
+#include "pipeline/job_config.h"
+#include "pipeline/label_stages.h"
 
 namespace handlabel {
 

@@ -8,9 +8,9 @@
 
 #include "capture/synth_capture.h"
 #include "hand/hand_model.h"
-#include "training/training_samples.h"
 #include "network/poem/poem_config.h"
 #include "network/poem/poem_trainer.h"
+#include "training/training_samples.h"
 
 namespace handlabel {
 

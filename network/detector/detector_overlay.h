@@ -1,6 +1,6 @@
 #pragma once
-// Pictures of what the hand detector found in a view (network/detector/hand_detector.h): every
-// palm box of the palm detector (yellow), the ROI the landmark model ran on (cyan,
+// Pictures of what the hand detector found in a view (network/detector/hand_detector.h):
+// every palm box of the palm detector (yellow), the ROI the landmark model ran on (cyan,
 // rotated), the 21 keypoints with the skeleton (finger colours; a keypoint's disc
 // shrinks with its confidence, and a keypoint of confidence 0 is not drawn), and a
 // caption: the source and presence of the detection, or in red the reason the view
@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "network/detector/hand_detector.h"
 #include "image/draw.h"
 #include "image/image.h"
+#include "network/detector/hand_detector.h"
 
 namespace handlabel {
 

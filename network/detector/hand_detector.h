@@ -1,6 +1,6 @@
 #pragma once
-// Multi-view hand finding with MediaPipe Hands (network/detector/mediapipe_hands.h): one hand per
-// frame, found consistently across a calibrated rig.
+// Multi-view hand finding with MediaPipe Hands (network/detector/mediapipe_hands.h): one
+// hand per frame, found consistently across a calibrated rig.
 //
 //  1. Palm candidates in every view (palm detection on the whole image).
 //  2. Every pair of candidates from two views is triangulated (the 7 palm keypoints);
@@ -27,11 +27,11 @@
 #include <string>
 #include <vector>
 
-#include "network/detector/mediapipe_hands.h"
 #include "geometry/rig.h"
 #include "hand/hand_model.h"
 #include "hand/keypoints2d.h"
 #include "image/image.h"
+#include "network/detector/mediapipe_hands.h"
 
 namespace handlabel {
 

@@ -21,10 +21,10 @@
 #include <string>
 #include <vector>
 
-#include "network/detector/mediapipe_geometry.h"
 #include "hand/hand_model.h"
 #include "hand/keypoints2d.h"
 #include "image/image.h"
+#include "network/detector/mediapipe_geometry.h"
 
 namespace handlabel {
 

@@ -1,8 +1,9 @@
 // The LibTorch interpreter behind network/detector/tflite_model.h.
 //
-// Loading turns every operator into a step (network/detector/tflite_steps.h), then runs the graph
-// once on zeros and checks each result's shape against the shape the file declares, so
-// semantic mismatches and malformed graphs fail at load, naming the operator.
+// Loading turns every operator into a step (network/detector/tflite_steps.h), then runs
+// the graph once on zeros and checks each result's shape against the shape the file
+// declares, so semantic mismatches and malformed graphs fail at load, naming the
+// operator.
 
 #include <torch/torch.h>
 

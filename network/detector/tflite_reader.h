@@ -1,7 +1,7 @@
 #pragma once
-// Reads a TFLite flatbuffer (network/detector/tflite_schema.fbs, our subset of TFLite's schema)
-// into plain structs: tensors with shapes, types and constant data, and operators with
-// the options our interpreter uses. Torch-free, so the fuzz target (fuzz/) builds it
+// Reads a TFLite flatbuffer (network/detector/tflite_schema.fbs, our subset of TFLite's
+// schema) into plain structs: tensors with shapes, types and constant data, and operators
+// with the options our interpreter uses. Torch-free, so the fuzz target (fuzz/) builds it
 // alone. Every index and size is checked here, so the interpreter can trust the graph:
 // the flatbuffers Verifier first, then tensor, buffer and operator indices, shapes
 // (non-negative, at most kMaxTfliteElements elements) and constant data sizes.

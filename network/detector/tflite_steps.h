@@ -1,7 +1,8 @@
 #pragma once
-// The operator steps of the TFLite interpreter (network/detector/tflite_model.cc): every operator
-// of a graph becomes a closure over LibTorch with its weights already dequantised and
-// permuted into LibTorch's layout. Internal to network/ (it includes LibTorch).
+// The operator steps of the TFLite interpreter (network/detector/tflite_model.cc): every
+// operator of a graph becomes a closure over LibTorch with its weights already
+// dequantised and permuted into LibTorch's layout. Internal to network/ (it includes
+// LibTorch).
 //
 // Layout: TFLite is NHWC; LibTorch's convolutions are NCHW. Rank-4 activations made by
 // convolutions and pools stay NCHW between operators (Value::nchw) and are permuted to

@@ -1,6 +1,6 @@
 #pragma once
-// Training curves of a run folder (network/poem/poem_trainer.h): loss.csv and validation.csv
-// drawn as one PNG with image/line_plot.h.
+// Training curves of a run folder (network/poem/poem_trainer.h): loss.csv and
+// validation.csv drawn as one PNG with image/line_plot.h.
 
 #include <string>
 #include <vector>

@@ -12,12 +12,12 @@
 #include <filesystem>
 #include <fstream>
 
+#include "network/poem/hand_mesh_predictor.h"
+#include "network/poem/poem_config.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_record.h"
 #include "pipeline/label_stage_factory.h"
-#include "network/poem/hand_mesh_predictor.h"
-#include "network/poem/poem_config.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"

@@ -6,8 +6,8 @@
 
 #include "capture/capture_reader.h"
 #include "core/data_dir.h"
-#include "network/detector/detector_overlay.h"
 #include "image/image_file.h"
+#include "network/detector/detector_overlay.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_stage_factory.h"
 #include "tests/apps/run_command.h"

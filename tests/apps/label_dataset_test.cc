@@ -9,10 +9,10 @@
 #include <fstream>
 
 #include "hand/capsule_hand.h"
-#include "pipeline/label_outputs.h"
-#include "pipeline/label_record.h"
 #include "network/poem/hand_mesh_predictor.h"
 #include "network/poem/poem_config.h"
+#include "pipeline/label_outputs.h"
+#include "pipeline/label_record.h"
 #include "tests/apps/run_command.h"
 #include "tests/capture/dexycb_fixture.h"
 #include "tests/test_util.h"

@@ -8,9 +8,9 @@
 #include <fstream>
 
 #include "formats/sha256.h"
-#include "pipeline/label_record.h"
 #include "network/poem/hand_mesh_predictor.h"
 #include "network/poem/poem_config.h"
+#include "pipeline/label_record.h"
 #include "tests/apps/label_test_capture.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"

@@ -14,12 +14,12 @@
 #include <sstream>
 
 #include "core/data_dir.h"
-#include "network/detector/tflite_model.h"
 #include "hand/hand_model.h"
 #include "hand/hand_model_io.h"
 #include "image/image.h"
 #include "image/image_file.h"
 #include "image/mesh_render.h"
+#include "network/detector/tflite_model.h"
 
 namespace handlabel {
 namespace {
@@ -198,7 +198,8 @@ TEST(TfliteMediapipeModels, PalmDetectorFindsTheRenderedPalm) {
 }
 
 // Not a test: writes inputs and our outputs for the peer check against TFLite's own
-// runtime (tests/network/detector/tflite_peer_parity.mjs; docs/model-card-mediapipe-hands.md):
+// runtime (tests/network/detector/tflite_peer_parity.mjs;
+// docs/model-card-mediapipe-hands.md):
 //   HANDLABEL_TFLITE_PARITY_DIR=/tmp/parity [HANDLABEL_TFLITE_PARITY_IMAGES=a.jpg:b.png]
 //     build/tests/detector_tests --gtest_also_run_disabled_tests
 //     --gtest_filter='*WritePeerParityFiles'   (one command line)

@@ -1,6 +1,7 @@
 #pragma once
 // Tiny TFLite models built in memory with flatbuffers' builder API (our schema subset,
-// network/detector/tflite_schema.fbs), and plain-loop NHWC helpers, for the interpreter tests.
+// network/detector/tflite_schema.fbs), and plain-loop NHWC helpers, for the interpreter
+// tests.
 
 #include <flatbuffers/flatbuffers.h>
 

@@ -1,6 +1,6 @@
 // Parity of the C++ POEM forward pass with an independent Python implementation
-// (tests/network/poem/poem_oracle.py, Debian python3-torch) on random weights written with
-// torch.save. The oracle is required: if /usr/bin/python3 cannot import torch, the
+// (tests/network/poem/poem_oracle.py, Debian python3-torch) on random weights written
+// with torch.save. The oracle is required: if /usr/bin/python3 cannot import torch, the
 // test fails (scripts/install-deps installs python3-torch).
 
 #include <gtest/gtest.h>
@@ -134,8 +134,9 @@ TEST(PoemParity, ReleasedStateDictKeysAndShapesMatchOracle) {
   std::ofstream(dir + "/config.json")
       << ReleasedPoemConfig(PoemDataset::kDexYCB).ToJson();
   const std::string cmd = "/usr/bin/python3 " + std::string(HANDLABEL_SOURCE_DIR) +
-                          "/tests/network/poem/poem_oracle.py --shapes-only --config " + dir +
-                          "/config.json --out " + dir + " > " + dir + "/oracle.log 2>&1";
+                          "/tests/network/poem/poem_oracle.py --shapes-only --config " +
+                          dir + "/config.json --out " + dir + " > " + dir +
+                          "/oracle.log 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0)
       << "the Python oracle failed (needs /usr/bin/python3 with torch)";
   std::ifstream f(dir + "/shapes.json");
