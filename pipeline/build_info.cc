@@ -7,9 +7,9 @@
 #include "core/version.h"
 #include "fitting/fitting_versions.h"
 #include "image/image_versions.h"
+#include "network/poem/network_versions.h"
 #include "pipeline/build_config.h"
 #include "pipeline/git_hash.h"
-#include "poem/network_versions.h"
 
 namespace handlabel {
 

@@ -1,4 +1,4 @@
-#include "poem/network_versions.h"
+#include "network/poem/network_versions.h"
 
 #include <ATen/Parallel.h>
 #include <torch/version.h>
