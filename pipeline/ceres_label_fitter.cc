@@ -1,5 +1,7 @@
 #include "pipeline/ceres_label_fitter.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -51,11 +53,15 @@ HandParams ReadInitFile(const std::string& dir, const std::string& frame) {
                    "a per-frame parameter file (<frame>.json, frames/ or labels/)");
 }
 
-Points3dTargets NetworkTargets(const MeshPrediction& net, int num_vertices) {
+// The network's answer as 3D targets: its keypoints with `keypoint_weight` each and,
+// when with_vertices, every kVertexTargetStride-th vertex.
+Points3dTargets NetworkTargets(const MeshPrediction& net, int num_vertices,
+                               double keypoint_weight, bool with_vertices) {
   Points3dTargets targets;
   targets.keypoints = net.keypoints;
-  targets.keypoint_weights = Eigen::VectorXd::Ones(kNumHandKeypoints);
-  if (net.vertices.rows() == num_vertices) {
+  targets.keypoint_weights =
+      Eigen::VectorXd::Constant(kNumHandKeypoints, keypoint_weight);
+  if (with_vertices && net.vertices.rows() == num_vertices) {
     for (int v = 0; v < num_vertices; v += kVertexTargetStride) {
       targets.vertex_ids.push_back(v);
     }
@@ -74,6 +80,37 @@ MaskImage ReadViewMask(const std::string& path, const RigCamera& camera, bool ob
   MaskImage mask = objects ? ReadObjectMaskPng(path) : ReadMaskPng(path);
   CheckViewImageSize(path, mask.cols(), mask.rows(), camera);
   return mask;
+}
+
+// The worst view's RMS distance (px) between the projected `keypoints` and the view's
+// 2D keypoints with confidence > 0; 0 without any.
+double WorstViewRmsPx(const std::vector<KeypointView>& views, const Points3d& keypoints) {
+  double worst = 0;
+  for (const KeypointView& view : views) {
+    double sum = 0;
+    int count = 0;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      Eigen::Vector2d uv;
+      if (!(view.keypoints.confidence[k] > 0) ||
+          !view.camera.ProjectWorld(keypoints.row(k).transpose(), &uv)) {
+        continue;
+      }
+      sum += (uv - view.keypoints.uv_px.row(k).transpose()).squaredNorm();
+      ++count;
+    }
+    if (count > 0) worst = std::max(worst, std::sqrt(sum / count));
+  }
+  return worst;
+}
+
+// What a fit's answer costs against the evidence alone: every term but the pull
+// towards the network's answer, so that fits with and without that pull compare.
+double EvidenceCost(const HandFitResult& fit) {
+  double total = 0;
+  for (const auto& [term, cost] : fit.term_costs) {
+    if (term != "points3d") total += cost;
+  }
+  return total;
 }
 
 }  // namespace
@@ -150,7 +187,7 @@ HandParams CeresLabelFitter::Start(const LabelFitRequest& request,
   const FrameInput& frame = *request.frame;
   if (request.init) {
     *start = "network";
-    input->targets3d = NetworkTargets(*request.init, num_vertices_);
+    input->targets3d = NetworkTargets(*request.init, num_vertices_, 1.0, true);
     return fitter.InitFromKeypoints3d(request.init->keypoints,
                                       input->targets3d->keypoint_weights);
   }
@@ -176,6 +213,30 @@ HandParams CeresLabelFitter::Start(const LabelFitRequest& request,
   return fitter.InitFromViews(input->views);
 }
 
+HandFitResult CeresLabelFitter::RefineAgainstFiles(const LabelFitRequest& request,
+                                                   const CeresHandFitter& fitter,
+                                                   const HandFitInput& input,
+                                                   std::string* start) const {
+  const MeshPrediction& net = *request.init;
+  // A target at sigma s with weight w pulls as one at sigma s / sqrt(w).
+  const double sigma_ratio = fitter.options().points3d_sigma_m / options_.network_sigma_m;
+  HandFitInput from_network = input;
+  from_network.targets3d =
+      NetworkTargets(net, num_vertices_, sigma_ratio * sigma_ratio, false);
+  *start = "network";
+  HandFitResult fit = fitter.Fit(
+      from_network, fitter.InitFromKeypoints3d(net.keypoints,
+                                               Eigen::VectorXd::Ones(kNumHandKeypoints)));
+  if (WorstViewRmsPx(input.views, net.keypoints) <= options_.restart_px) return fit;
+  HandFitResult from_views = fitter.Fit(input, fitter.InitFromViews(input.views));
+  if (EvidenceCost(from_views) < EvidenceCost(fit)) {
+    *start = "triangulated_views (network start too far)";
+    return from_views;
+  }
+  *start = "network (triangulated restart fitted worse)";
+  return fit;
+}
+
 std::optional<QualityReport> CeresLabelFitter::CheckSilhouettes(
     HandFitResult* fit) const {
   if (!fit->keypoints_only) return std::nullopt;
@@ -199,8 +260,13 @@ LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
   HandFitInput input = Evidence(request, &silhouettes);
   const CeresHandFitter& fitter =
       !request.masks.empty() && network_mask_fitter_ ? *network_mask_fitter_ : fitter_;
-  const HandParams init = Start(request, fitter, &input, &start);
-  HandFitResult fit = fitter.Fit(input, init);
+  HandFitResult fit;
+  if (request.init && request.file_views > 0) {
+    fit = RefineAgainstFiles(request, fitter, input, &start);
+  } else {
+    const HandParams init = Start(request, fitter, &input, &start);
+    fit = fitter.Fit(input, init);
+  }
   const std::optional<QualityReport> check = CheckSilhouettes(&fit);
 
   LabelFit out;

@@ -49,6 +49,17 @@ struct CeresLabelFitterOptions {
   // Start of a fit from 2D evidence alone: triangulate | gt | previous | a folder of
   // per-frame parameter files (job field fit.init, pipeline/job_config.h).
   std::string init = "triangulate";
+  // Refining a network answer against file (detector) 2D: its 21 keypoints pull with
+  // this sigma (metres; job field refine.network_sigma_mm) and its vertices not at all.
+  // The network's error is centimetres where it has not been adapted to the rig; at
+  // fit.points3d_sigma_m (2 mm) its pull outvotes the detector's views and the refined
+  // answer stays where the network put it. Without file 2D the network's own answer
+  // and 2D are all there is, and it keeps the tight pull.
+  double network_sigma_m = 0.02;
+  // ... and when the network's start reprojects further than this from the file views
+  // (worst view RMS, px; refine.restart_px), the fit also runs from the triangulated
+  // views and keeps whichever ends with the lower keypoint cost. 0: always both.
+  double restart_px = 40;
 };
 
 class CeresLabelFitter : public LabelFitter {
@@ -66,6 +77,12 @@ class CeresLabelFitter : public LabelFitter {
   // names it for the report.
   HandParams Start(const LabelFitRequest& request, const CeresHandFitter& fitter,
                    HandFitInput* input, std::string* start) const;
+  // Refinement against file 2D: from the network's answer, loosely pulled, and from
+  // the triangulated views too when that answer is far from the file views; the fit
+  // with the lower keypoint cost wins. `start` names the winner's start.
+  HandFitResult RefineAgainstFiles(const LabelFitRequest& request,
+                                   const CeresHandFitter& fitter,
+                                   const HandFitInput& input, std::string* start) const;
 
   // With silhouette rounds run: the check of the silhouette fit; when it fails and
   // check_silhouettes is set, `fit` becomes its keypoints-only result.

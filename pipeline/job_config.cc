@@ -140,6 +140,8 @@ void ReadRefineSection(Section& top, const std::string& path, JobConfig* job) {
   refine.Read("min_views", &job->quality.min_views);
   refine.Read("min_hand_span_m", &job->quality.min_hand_span_m);
   refine.Read("max_hand_span_m", &job->quality.max_hand_span_m);
+  refine.Read("network_sigma_mm", &job->refine_network_sigma_mm);
+  refine.Read("restart_px", &job->refine_restart_px);
   refine.RejectUnknownKeys();
 }
 
@@ -253,6 +255,8 @@ void JobConfig::Check(const std::string& source) const {
   RequireInRange(source, "refine.min_confidence", quality.min_confidence, 0, 1,
                  "a value in [0, 1]");
   RequireAtLeast(source, "refine.min_views", quality.min_views, 1);
+  RequireGreater(source, "refine.network_sigma_mm", refine_network_sigma_mm, 0);
+  RequireAtLeast(source, "refine.restart_px", refine_restart_px, 0);
   if (!(quality.min_hand_span_m > 0 &&
         quality.max_hand_span_m > quality.min_hand_span_m)) {
     throw InputError(source, "refine.min_hand_span_m / max_hand_span_m",

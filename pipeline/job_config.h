@@ -102,6 +102,12 @@ struct JobConfig {
   // refinement and fallback
   RefineMode refine_mode = RefineMode::kFallback;
   QualityThresholds quality;
+  // Refining a network answer where the frame has file (detector) 2D: the pull of the
+  // answer's keypoints (refine.network_sigma_mm, mm per residual unit) and the start's
+  // worst-view reprojection error beyond which the fit also runs from the triangulated
+  // views (refine.restart_px, px; 0 = always); pipeline/ceres_label_fitter.h.
+  double refine_network_sigma_mm = 20;
+  double refine_restart_px = 40;
   KeypointSource keypoints = KeypointSource::kNetwork;
   MaskSource masks = MaskSource::kFiles;
   // Which files of a native capture are the file evidence: keypoint_files "auto"

@@ -163,6 +163,12 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   if (!weights_sha256.empty() && job.network_keypoints != AnswerKeypoints::kJoints) {
     extra["network_keypoints"] = ToString(job.network_keypoints);
   }
+  // Refinement against file 2D changed (issue 43): the network's answer is a loose start
+  // with a restart from the views, so jobs that refine it against files hash anew.
+  if (!weights_sha256.empty() && job.keypoints != KeypointSource::kNetwork &&
+      job.refine_mode != RefineMode::kOff) {
+    extra["refine_against_files"] = {job.refine_network_sigma_mm, job.refine_restart_px};
+  }
   if (!extra.empty()) j["added"] = extra;
   return Sha256Hex(j.dump());
 }

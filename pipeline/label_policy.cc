@@ -1,5 +1,7 @@
 #include "pipeline/label_policy.h"
 
+#include <algorithm>
+
 #include "core/errors.h"
 #include "core/random.h"
 #include "pipeline/frame_metrics.h"
@@ -35,7 +37,8 @@ Points3d NativeJointsFromKeypoints(const Points3d& keypoints) {
 
 std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
                                                     const FrameInput& frame,
-                                                    const MeshPrediction* prediction) {
+                                                    const MeshPrediction* prediction,
+                                                    int* file_views) {
   const size_t views = frame.rig.size();
   std::vector<std::optional<Keypoints2d>> evidence(views);
   const bool use_files = job.keypoints != KeypointSource::kNetwork;
@@ -44,10 +47,16 @@ std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
     HL_CHECK(frame.keypoints_2d.size() == views, "one keypoint entry per view");
     evidence = frame.keypoints_2d;
   }
+  std::vector<bool> from_files(views);
+  for (size_t v = 0; v < views; ++v) from_files[v] = evidence[v].has_value();
+  const bool any_files =
+      std::find(from_files.begin(), from_files.end(), true) != from_files.end();
   if (use_network && prediction) {
     HL_CHECK(prediction->keypoints_2d.size() == views, "one 2D prediction per view");
     for (size_t v = 0; v < views; ++v) {
-      if (!evidence[v]) evidence[v] = prediction->keypoints_2d[v];
+      if (evidence[v]) continue;
+      evidence[v] = prediction->keypoints_2d[v];
+      if (any_files) evidence[v]->confidence *= kNetworkFillInConfidence;
     }
   }
   for (const std::string& name : job.ignore_views) {
@@ -57,6 +66,11 @@ std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
                        "camera names of the capture", "'" + name + "'");
     }
     evidence[v].reset();
+    from_files[v] = false;
+  }
+  if (file_views) {
+    *file_views =
+        static_cast<int>(std::count(from_files.begin(), from_files.end(), true));
   }
   for (const auto& view : evidence) {
     if (view) return evidence;
@@ -113,7 +127,7 @@ class FrameLabeler {
     LabelFitRequest request;
     request.frame = &frame_;
     request.init = init;
-    request.keypoints_2d = FitEvidence(job_, frame_, prediction_);
+    request.keypoints_2d = FitEvidence(job_, frame_, prediction_, &request.file_views);
     if (job_.masks == MaskSource::kNetwork && prediction_)
       request.masks = prediction_->masks;
     request.previous = previous_;

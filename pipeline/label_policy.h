@@ -30,13 +30,21 @@ struct FrameOutcome {
   std::map<std::string, double> metrics;  // "<group>/<metric>" (label_summary.h)
 };
 
+// Where the network's own 2D fills a view that has no file 2D while other views do,
+// its confidences count this much: they are heatmap peaks, sure of themselves even when
+// the answer is centimetres off, and must not outvote a detector's views.
+constexpr double kNetworkFillInConfidence = 0.25;
+
 // The 2D evidence for the fitter per job field evidence.keypoints_2d: the network's
 // keypoints, the capture's keypoint files, or both (files where a view has one, else
-// the network's); none for the cameras of evidence.ignore_views. Throws Error when the
-// chosen source has nothing for this frame, InputError for an unknown camera name.
+// the network's, at kNetworkFillInConfidence when some view has files); none for the
+// cameras of evidence.ignore_views. `file_views` (optional) gets how many views hold
+// file 2D. Throws Error when the chosen source has nothing for this frame, InputError
+// for an unknown camera name.
 std::vector<std::optional<Keypoints2d>> FitEvidence(const JobConfig& job,
                                                     const FrameInput& frame,
-                                                    const MeshPrediction* prediction);
+                                                    const MeshPrediction* prediction,
+                                                    int* file_views = nullptr);
 
 // Labels one frame. `prediction` is nullptr when the job has no network; `previous` is
 // the previous frame's label parameters when the job fits from them (fit.init:

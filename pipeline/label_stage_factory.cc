@@ -24,6 +24,8 @@ CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
   o.use_object_masks = job.object_masks;
   o.network_mask_sigma_px = job.network_mask_sigma_px;
   o.init = s.init;
+  o.network_sigma_m = job.refine_network_sigma_mm / 1000;
+  o.restart_px = job.refine_restart_px;
   o.fit.num_threads = 1;  // frames run in parallel
   if (s.keypoint_loss) {
     o.fit.keypoint_loss.type =

@@ -61,6 +61,10 @@ struct LabelFitRequest {
   const MeshPrediction* init = nullptr;
   // 2D evidence, one entry per rig camera (job field evidence.keypoints_2d).
   std::vector<std::optional<Keypoints2d>> keypoints_2d;
+  // How many of those views hold 2D from files or the detector rather than the
+  // network's own 2D. With any, refinement treats the network's answer as a start to
+  // check against them, not as evidence of its own (ceres_label_fitter.h).
+  int file_views = 0;
   // Silhouettes to fit to instead of the capture's mask files, one per rig camera
   // (evidence.masks: network); empty = the fitter's own choice.
   std::vector<MaskImage> masks;
