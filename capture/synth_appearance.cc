@@ -11,6 +11,7 @@
 #include "core/errors.h"
 #include "core/option_checks.h"
 #include "core/random.h"
+#include "image/gaussian_blur.h"
 
 namespace handlabel {
 namespace {
@@ -379,32 +380,8 @@ void ApplyCameraBlurAndNoise(double blur_sigma, double noise_sigma, std::mt19937
                              ImageU8* rgb) {
   const int w = rgb->width, h = rgb->height;
   if (blur_sigma > 0) {
-    const int r = std::max(1, static_cast<int>(std::ceil(2.5 * blur_sigma)));
-    std::vector<float> kernel(2 * r + 1);
-    float total = 0;
-    for (int d = -r; d <= r; ++d) {
-      kernel[d + r] =
-          std::exp(static_cast<float>(-0.5 * d * d / (blur_sigma * blur_sigma)));
-      total += kernel[d + r];
-    }
-    for (float& k : kernel) k /= total;
-    std::vector<float> a(rgb->data.begin(), rgb->data.end()), b(a.size());
-    for (int dir = 0; dir < 2; ++dir) {
-      for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-          for (int c = 0; c < 3; ++c) {
-            float sum = 0;
-            for (int d = -r; d <= r; ++d) {
-              const int xx = dir == 0 ? std::clamp(x + d, 0, w - 1) : x;
-              const int yy = dir == 1 ? std::clamp(y + d, 0, h - 1) : y;
-              sum += kernel[d + r] * a[(static_cast<size_t>(yy) * w + xx) * 3 + c];
-            }
-            b[(static_cast<size_t>(y) * w + x) * 3 + c] = sum;
-          }
-        }
-      }
-      a.swap(b);
-    }
+    std::vector<float> a(rgb->data.begin(), rgb->data.end());
+    GaussianBlurInPlace(blur_sigma, FloatImageLayout::Interleaved(w, h, 3), a.data());
     for (size_t i = 0; i < a.size(); ++i)
       rgb->data[i] = static_cast<uint8_t>(std::clamp(std::lround(a[i]), 0L, 255L));
   }
