@@ -101,23 +101,18 @@ void ResampleCrop(const SynthView& src, const CropTransform& t,
   const Eigen::Vector2d inv_t = -inv * t.affine.col(2);
   view->image.assign(3 * S * S, 0.0f);
   if (o.masks) view->mask.assign(S * S, 0.0f);
-  std::mt19937_64 noise_rng(aug.noise_seed);
-  std::uniform_real_distribution<float> noise(0.0f, 255.0f);
   for (int y = 0; y < S; ++y) {
     for (int x = 0; x < S; ++x) {
       const Eigen::Vector2d p = inv * Eigen::Vector2d(x, y) + inv_t;
-      const bool in_rect = aug.noise_rect && x >= aug.rect_x0 && x < aug.rect_x1 &&
-                           y >= aug.rect_y0 && y < aug.rect_y1;
       for (int ch = 0; ch < 3; ++ch) {
-        float v = static_cast<float>(Bilinear(src.rgb, p.x(), p.y(), ch) * aug.gain[ch]);
-        v = std::min(255.0f, v);
-        if (in_rect) v = noise(noise_rng);
-        view->image[(ch * S + y) * S + x] = v / 255.0f - 0.5f;
+        view->image[(ch * S + y) * S + x] = Bilinear(src.rgb, p.x(), p.y(), ch);
       }
       if (o.masks)
         view->mask[y * S + x] = Bilinear(src.hand_mask, p.x(), p.y(), 0) / 255.0f;
     }
   }
+  ApplyGainAndNoiseRect(aug, S, &view->image);
+  NormaliseCropLevels(&view->image);
 }
 
 // One view of the sample; returns the (turned) camera's cam_from_world. Throws
@@ -167,18 +162,6 @@ Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> ToMaster(
 
 }  // namespace
 
-void TrainingAugmentOptions::Check(const std::string& source) const {
-  RequireInRange(source, "scale_sigma", scale_sigma, 0, 0.4);
-  RequireInRange(source, "rotation_probability", rotation_probability, 0, 1);
-  RequireInRange(source, "rotation_sigma_deg", rotation_sigma_deg, 0, 90);
-  if (!(gain_min > 0 && gain_max >= gain_min)) {
-    throw InputError(source, "gain_min/gain_max", "0 < gain_min <= gain_max",
-                     OptionValueText(gain_min) + "/" + OptionValueText(gain_max));
-  }
-  RequireInRange(source, "noise_rect_probability", noise_rect_probability, 0, 1);
-  RequireInRange(source, "noise_rect_max_side", noise_rect_max_side, 0.01, 1);
-}
-
 void TrainingSampleOptions::Check(const std::string& source) const {
   if (crop_size < 32 || crop_size % 32 != 0) {
     throw InputError(source, "crop_size", "a positive multiple of 32",
@@ -194,30 +177,6 @@ void TrainingSampleOptions::Check(const std::string& source) const {
 int64_t TrainingFrameOf(int64_t index, const TrainingSampleOptions& o) {
   const int64_t group = o.reuse_group, block = group * o.frame_reuse;
   return (index / block) * group + index % group;
-}
-
-ViewAugmentation DrawViewAugmentation(const TrainingAugmentOptions& o, int crop_size,
-                                      std::mt19937_64& rng) {
-  ViewAugmentation a;
-  if (!o.enabled) return a;
-  std::normal_distribution<double> normal(0.0, 1.0);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  a.scale = 1.0 + o.scale_sigma * std::clamp(normal(rng), -2.0, 2.0);
-  const bool rotate = unit(rng) < o.rotation_probability;
-  const double angle = o.rotation_sigma_deg * M_PI / 180.0 * normal(rng);
-  if (rotate) a.rotation_rad = angle;
-  for (double& g : a.gain) g = o.gain_min + (o.gain_max - o.gain_min) * unit(rng);
-  a.noise_rect = unit(rng) < o.noise_rect_probability;
-  const double max_side = o.noise_rect_max_side * crop_size;
-  const int w = std::max(1, static_cast<int>(std::lround(max_side * unit(rng))));
-  const int h = std::max(1, static_cast<int>(std::lround(max_side * unit(rng))));
-  a.rect_x0 = static_cast<int>(unit(rng) * (crop_size - w + 1));
-  a.rect_y0 = static_cast<int>(unit(rng) * (crop_size - h + 1));
-  a.rect_x1 = a.rect_x0 + w;
-  a.rect_y1 = a.rect_y0 + h;
-  a.noise_seed = rng();
-  if (!a.noise_rect) a.rect_x0 = a.rect_y0 = a.rect_x1 = a.rect_y1 = 0;
-  return a;
 }
 
 TrainingSample MakeTrainingSample(const SynthFrame& frame, const Rig& rig,

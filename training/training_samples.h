@@ -26,7 +26,6 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
-#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,20 +33,9 @@
 #include "capture/synth_capture.h"
 #include "hand/hand_model.h"
 #include "network/poem/training_sample.h"
+#include "training/view_augmentation.h"
 
 namespace handlabel {
-
-struct TrainingAugmentOptions {
-  bool enabled = true;                // false: plain crops (validation, evaluation)
-  double scale_sigma = 0.06;          // relative crop size jitter (>= 0)
-  double rotation_probability = 0.5;  // chance of an in-plane rotation (0..1)
-  double rotation_sigma_deg = 5.0;    // its standard deviation, degrees (>= 0)
-  double gain_min = 0.7;              // per-channel colour gain range (0 < min <= max)
-  double gain_max = 1.3;
-  double noise_rect_probability = 0.2;  // chance of one noise rectangle per view (0..1)
-  double noise_rect_max_side = 0.4;     // its largest side, fraction of the crop (0..1]
-  void Check(const std::string& source) const;
-};
 
 struct TrainingSampleOptions {
   int crop_size = 128;        // output crop side in pixels (multiple of 32)
@@ -63,18 +51,6 @@ struct TrainingSampleOptions {
 
 // The synthetic frame that sample `index` is cut from.
 int64_t TrainingFrameOf(int64_t index, const TrainingSampleOptions& options);
-
-// The random choices of one view's augmentation (identity when disabled).
-struct ViewAugmentation {
-  double scale = 1.0;
-  double rotation_rad = 0.0;
-  std::array<double, 3> gain = {1.0, 1.0, 1.0};
-  bool noise_rect = false;
-  int rect_x0 = 0, rect_y0 = 0, rect_x1 = 0, rect_y1 = 0;  // half-open, crop pixels
-  uint64_t noise_seed = 0;
-};
-ViewAugmentation DrawViewAugmentation(const TrainingAugmentOptions& options,
-                                      int crop_size, std::mt19937_64& rng);
 
 // Cuts one sample out of a frame. `rig` is the generator's rig (pinhole cameras).
 // Throws InputError if a camera has lens distortion.
