@@ -1,0 +1,117 @@
+#pragma once
+// POEM training samples cut from a real capture whose frames carry labels (for example
+// the labels of a detector + fit job on that same capture): the network learns the
+// user's cameras, lighting and hands from the slow method's answers (issue 43).
+//
+// Sample i is cut from labelled frame Order(i): the frames in a fresh random order in
+// every epoch of `frames.size()` samples. For each view:
+//   window  with probability detection_crop_probability, what inference crops: the
+//           window around the frame's detected 2D keypoints (CropFromKeypoints, the
+//           network stage's rule); otherwise, or when the view's detections do not
+//           locate the hand, the window around the label's keypoints projected into
+//           the view (CropFromPrior), its side x augment scale, its centre shifted by
+//           N(0, shift_sigma) x side per axis (clipped at 2 sigma).
+//   crop    CropIntrinsics + WarpCrop (network/poem/hand_crop.h), exactly as inference:
+//           any camera model, distortion removed by the warp.
+//   pixels  when augmenting: Gaussian blur of sigma U(0, blur_max_px), pixel noise of
+//           sigma U(0, noise_max) levels, then per-channel gain and the noise rectangle
+//           (view_augmentation.h).
+//   targets the label's keypoints through the view's camera and the crop intrinsics;
+//           master_from_cam as the network stage builds it; keypoints and vertices in
+//           the master frame (camera 0).
+// No in-plane rotation, and every view has weight 1 (views that the detections miss get
+// the label window instead of inference's whole image with weight 0).
+// Everything random derives from (seed, i), so Sample(i) is the same on every call and
+// every thread. Labels arrive as plain arrays: reading label files is pipeline/'s job.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "capture/frame_source.h"
+#include "core/point_arrays.h"
+#include "network/poem/hand_crop.h"
+#include "network/poem/training_sample.h"
+#include "training/view_augmentation.h"
+
+namespace handlabel {
+
+// One labelled frame of a capture, in the rig's world frame (metres).
+struct LabeledFrame {
+  std::string id;         // the frame source's frame id
+  Points3d keypoints_3d;  // 21 x 3, SNAP order
+  Points3d vertices;      // V x 3, the network's mesh (778 for MANO topology)
+};
+
+struct CaptureSampleOptions {
+  int crop_size = 128;  // crop side in pixels, the network's (a multiple of 32)
+  // Chance that a view is cropped around its detected 2D keypoints as inference crops
+  // it (0..1); otherwise around the label's projected keypoints, with jitter.
+  double detection_crop_probability = 0.5;
+  // Label-window crops: centre shift per axis, N(0, shift_sigma) x window side,
+  // clipped at 2 sigma (0..0.5).
+  double shift_sigma = 0.05;
+  double blur_max_px = 1.2;  // blur sigma ~ U(0, blur_max_px) crop pixels (0..5)
+  double noise_max = 6;      // pixel noise sigma ~ U(0, noise_max) levels of 255 (0..50)
+  // Scale jitter of label windows, gain and noise rectangle (view_augmentation.h);
+  // enabled false: plain crops, no blur and no noise (validation). Crops from captures
+  // are not turned: rotation_probability must be 0.
+  TrainingAugmentOptions augment = [] {
+    TrainingAugmentOptions a;
+    a.rotation_probability = 0;
+    return a;
+  }();
+  uint64_t seed = 0;  // frame order and augmentation
+  void Check(const std::string& source) const;
+};
+
+// The random choices for one view of one sample.
+struct CaptureViewDraws {
+  ViewAugmentation augmentation;  // scale (label windows), gain, noise rectangle
+  bool from_detection = false;    // crop around the detected keypoints if they locate
+  Eigen::Vector2d shift = Eigen::Vector2d::Zero();  // label window, fraction of side
+  double blur_sigma_px = 0;
+  double noise_sigma = 0;
+  uint64_t noise_seed = 0;
+};
+CaptureViewDraws DrawCaptureView(const CaptureSampleOptions& options,
+                                 std::mt19937_64& rng);
+
+// The source window of view v: around the frame's detected keypoints when `draws` asks
+// for them and they locate the hand, else around the projected label keypoints
+// (jittered), else (the hand behind the camera or outside the image) the whole image.
+CropWindow CaptureViewWindow(const FrameInput& frame, size_t v,
+                             const Points3d& keypoints_world,
+                             const CaptureViewDraws& draws, const HandCropOptions& crop);
+
+class CaptureTrainingSamples : public TrainingSampleSource {
+ public:
+  // Keeps a reference to `source`, which must outlive this object. Throws InputError
+  // naming the field for bad options, no frames, or a label that is not 21 finite
+  // keypoints and finite vertices.
+  CaptureTrainingSamples(const FrameSource& source, std::vector<LabeledFrame> frames,
+                         const CaptureSampleOptions& options);
+  int num_views() const override { return num_views_; }
+  int crop_size() const override { return options_.crop_size; }
+  // Reads and crops the frame's images; throws InputError naming the frame for a
+  // missing image or a rig of another size.
+  TrainingSample Sample(int64_t index) const override;
+
+  // Position in the frame list of the frame that sample `index` is cut from.
+  size_t FrameOfSample(int64_t index) const;
+  const std::vector<LabeledFrame>& frames() const { return frames_; }
+
+ private:
+  void MakeView(const FrameInput& frame, size_t v, const LabeledFrame& label,
+                const CaptureViewDraws& draws, TrainingView* view) const;
+
+  const FrameSource& source_;
+  std::vector<LabeledFrame> frames_;
+  CaptureSampleOptions options_;
+  HandCropOptions crop_;  // inference's crop rules at options_.crop_size
+  int num_views_ = 0;
+};
+
+}  // namespace handlabel
