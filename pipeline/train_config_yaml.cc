@@ -105,6 +105,7 @@ void ReadTrain(Section train, const std::string& path, PoemTrainerOptions* t) {
   train.Read("log_every", &t->log_every);
   train.Read("validate_every", &t->validate_every);
   train.Read("validation_samples", &t->validation_samples);
+  train.Read("validate_at_start", &t->validate_at_start);
   train.Read("seed", &t->seed);
   train.Read("threads", &t->threads);
   train.Read("prefetch_batches", &t->prefetch_batches);

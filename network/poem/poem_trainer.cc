@@ -488,8 +488,13 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
   torch::set_num_threads(o.threads);
   fs::create_directories(o.out_dir);
   PoemTrainSummary summary;
+  const bool new_run = !fs::exists(s.Path("latest.json"));
   int64_t step = s.StartStep(resume);
   summary.start_step = step;
+  if (new_run && o.validate_at_start && s.validation && o.validation_samples > 0) {
+    summary.last_validation = s.ValidateAndLog(step);
+    if (s.hooks.logs_written) s.hooks.logs_written();
+  }
   const int64_t end =
       stop_at_step >= 0 ? std::min<int64_t>(stop_at_step, o.steps) : o.steps;
   StepClock clock;

@@ -48,10 +48,14 @@ struct PoemTrainerOptions {
   int64_t log_every = 10;         // steps between progress lines / CSV rows (>= 1)
   int64_t validate_every = 1000;  // steps between validations; 0 = never
   int validation_samples = 64;    // held-out samples per validation
-  uint64_t seed = 1;              // model initialisation and per-step torch seeds
-  int threads = 1;                // LibTorch intra-op threads (>= 1)
-  int prefetch_batches = 2;       // batches made ahead on a producer thread; 0 = inline
-  std::string out_dir;            // run folder (created)
+  // Also validate before the first step of a new run (not of a resumed one), so that
+  // validation.csv holds the starting weights' numbers (e.g. of init_weights before
+  // fine-tuning).
+  bool validate_at_start = false;
+  uint64_t seed = 1;         // model initialisation and per-step torch seeds
+  int threads = 1;           // LibTorch intra-op threads (>= 1)
+  int prefetch_batches = 2;  // batches made ahead on a producer thread; 0 = inline
+  std::string out_dir;       // run folder (created)
   // Start a new run (no checkpoint in out_dir yet) from these weights instead of random
   // ones, counting steps from init_step; the optimizer state starts afresh. Used to
   // continue from the small weights-only checkpoint committed to the repository.
