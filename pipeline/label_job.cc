@@ -174,8 +174,8 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
 }
 
 std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames,
-                                      const std::string& spec,
-                                      const std::string& source) {
+                                      const std::string& spec, const std::string& source,
+                                      const std::string& field) {
   if (spec == "all" || spec.empty()) return all_frames;
   const size_t colon = spec.find(':');
   if (colon != std::string::npos) {
@@ -184,12 +184,11 @@ std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames
       if (colon > 0) begin = std::stoul(spec.substr(0, colon));
       if (colon + 1 < spec.size()) end = std::stoul(spec.substr(colon + 1));
     } catch (const std::exception&) {
-      throw InputError(source, "input.frames", "'all', 'a:b' or 'id,id,...'",
-                       "'" + spec + "'");
+      throw InputError(source, field, "'all', 'a:b' or 'id,id,...'", "'" + spec + "'");
     }
     if (begin > end || end > all_frames.size()) {
       throw InputError(
-          source, "input.frames",
+          source, field,
           "a range within the capture's " + std::to_string(all_frames.size()) + " frames",
           "'" + spec + "'");
     }
@@ -206,11 +205,10 @@ std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames
     id.erase(id.find_last_not_of(' ') + 1);
     if (!id.empty()) {
       if (!known.count(id)) {
-        throw InputError(source, "input.frames", "frame ids of the capture",
-                         "'" + id + "'");
+        throw InputError(source, field, "frame ids of the capture", "'" + id + "'");
       }
       if (!chosen.insert(id).second) {
-        throw InputError(source, "input.frames", "each frame id once",
+        throw InputError(source, field, "each frame id once",
                          "'" + id + "' listed twice");
       }
     }

@@ -67,9 +67,11 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256);
 
 // The job's frames from every frame of the capture, per job field input.frames:
 // "all", "a:b" (half-open range of positions in the sorted list) or "id,id,...".
-// Throws InputError naming `source` and input.frames for an unknown id or a bad range.
+// Throws InputError naming `source` and `field` (the job's input.frames, or a flag) for
+// an unknown id or a bad range.
 std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames,
-                                      const std::string& spec, const std::string& source);
+                                      const std::string& spec, const std::string& source,
+                                      const std::string& field = "input.frames");
 
 // The job's frames: SelectFrames over the source's frames per input.frames, then the
 // first input.max_frames of them.

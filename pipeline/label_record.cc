@@ -105,12 +105,14 @@ LabelRecord LabelFromJson(const json& j, const std::string& source) {
     if (!mano.is_null()) {
       label.params = HandParamsFromJson(mano, source, "mano.", JsonNull::kAsNan);
     }
-    label.mesh.keypoints = JsonPointList(j.at("keypoints_3d"), source, "keypoints_3d",
-                                         kNumHandKeypoints, JsonNull::kAsNan);
-    label.mesh.joints = JsonPointList(j.at("joints_native"), source, "joints_native",
-                                      kNumHandJoints, JsonNull::kAsNan);
-    label.mesh.vertices =
-        JsonPointList(j.at("vertices"), source, "vertices", -1, JsonNull::kAsNan);
+    // The point lists are what label consumers use: a missing one is named.
+    label.mesh.keypoints =
+        JsonPointList(JsonMember(j, "keypoints_3d", source), source, "keypoints_3d",
+                      kNumHandKeypoints, JsonNull::kAsNan);
+    label.mesh.joints = JsonPointList(JsonMember(j, "joints_native", source), source,
+                                      "joints_native", kNumHandJoints, JsonNull::kAsNan);
+    label.mesh.vertices = JsonPointList(JsonMember(j, "vertices", source), source,
+                                        "vertices", -1, JsonNull::kAsNan);
     for (const json& c : j.at("quality").at("checks")) {
       label.quality.flags.push_back(
           {c.at("name").get<std::string>(), c.at("passed").get<bool>(),
