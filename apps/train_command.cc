@@ -1,8 +1,9 @@
-// `handlabel train`: trains POEM on synthetic captures made on the fly
-// (docs/training.md).
+// `handlabel train`: trains POEM on synthetic captures made on the fly, or on a
+// capture's own labelled frames (docs/training.md).
 
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -11,7 +12,10 @@
 #include "core/errors.h"
 #include "network/poem/loss_plot.h"
 #include "network/poem/poem_trainer.h"
+#include "pipeline/capture_training_data.h"
 #include "pipeline/train_config.h"
+#include "training/capture_training_samples.h"
+#include "training/mixed_training_samples.h"
 #include "training/training_samples.h"
 
 namespace handlabel {
@@ -27,7 +31,39 @@ struct TrainFlags {
   double learning_rate = 0;
   std::vector<std::string> average;
   int bn_samples = 0;
+  CaptureTrainingInputs capture;  // --capture, --labels, --train-frames, --val-frames
+  double real_share = 1;          // --real-share
 };
+
+// Training on a capture's own labels (docs/training.md).
+void AddCaptureOptions(CLI::App* app, TrainFlags* f) {
+  CaptureTrainingInputs& c = f->capture;
+  auto* capture = app->add_option(
+      "--capture", c.capture_dir,
+      "train on this native capture's labelled frames instead of synthetic ones "
+      "(crops from its detections/ as inference crops them)");
+  auto* labels =
+      app->add_option("--labels", c.labels_dir,
+                      "with --capture: the folder of its <frame>.json labels (a label "
+                      "or fit job's labels/), the training targets");
+  capture->needs(labels);
+  labels->needs(capture);
+  app->add_option("--train-frames", c.train_frames,
+                  "with --capture: frames to train on, 'a:b' (positions in the sorted "
+                  "frames, b excluded), 'id,id,...' or 'all' (default: every frame not "
+                  "in --val-frames)")
+      ->needs(capture);
+  app->add_option("--val-frames", c.val_frames,
+                  "with --capture: held-out frames to validate on (at the start and "
+                  "every train.validate_every steps) instead of synthetic ones; same "
+                  "forms as --train-frames")
+      ->needs(capture);
+  app->add_option("--real-share", f->real_share,
+                  "with --capture: share of training samples from the capture; the rest "
+                  "are the config's synthetic samples (default 1: all real)")
+      ->needs(capture)
+      ->check(CLI::Range(0.0, 1.0));
+}
 
 void AddTrainOptions(CLI::App* app, TrainFlags* f) {
   app->add_option("--config", f->config_path, "training config (YAML)")->required();
@@ -68,6 +104,7 @@ void AddTrainOptions(CLI::App* app, TrainFlags* f) {
                   "them")
       ->needs("--average")
       ->check(CLI::NonNegativeNumber);
+  AddCaptureOptions(app, f);
 }
 
 // The config file with the command line's overrides, checked.
@@ -120,18 +157,79 @@ void ExportLatest(const TrainConfig& config, const TrainFlags& f) {
             << LatestPoemCheckpointStep(config.trainer.out_dir) << ", float16)\n";
 }
 
+// The samples a run trains and validates on, and the sources behind them.
+struct TrainingSources {
+  std::unique_ptr<SynthTrainingSamples> synth_train, synth_validation;
+  CaptureTrainingData capture;
+  std::unique_ptr<CaptureTrainingSamples> real_train, real_validation;
+  std::unique_ptr<MixedTrainingSamples> mixed;
+  const TrainingSampleSource* train = nullptr;
+  const TrainingSampleSource* validation = nullptr;
+};
+
+// The capture's labelled frames (mixed with synthetic ones below --real-share 1) and,
+// with --val-frames, its held-out frames for validation, measured at the start too.
+void AddCaptureSources(const TrainConfig& config, const HandModel& hand,
+                       const TrainFlags& f, TrainingSources* s,
+                       PoemTrainerOptions* trainer) {
+  if (!(f.real_share > 0)) {
+    throw InputError("command line", "--real-share", "> 0 (0 trains on no real frame)",
+                     std::to_string(f.real_share));
+  }
+  s->capture = LoadCaptureTrainingData(f.capture, hand.num_vertices());
+  s->real_train = std::make_unique<CaptureTrainingSamples>(
+      *s->capture.source, s->capture.train, CaptureSampleOptionsFor(config, false));
+  s->train = s->real_train.get();
+  if (f.real_share < 1) {
+    s->synth_train =
+        std::make_unique<SynthTrainingSamples>(hand, config.synth, config.samples);
+    s->mixed = std::make_unique<MixedTrainingSamples>(*s->real_train, *s->synth_train,
+                                                      f.real_share, config.synth.seed);
+    s->train = s->mixed.get();
+  }
+  if (!s->capture.validation.empty()) {
+    s->real_validation = std::make_unique<CaptureTrainingSamples>(
+        *s->capture.source, s->capture.validation, CaptureSampleOptionsFor(config, true));
+    s->validation = s->real_validation.get();
+    // One sample per held-out frame (the first epoch visits each once).
+    trainer->validation_samples = static_cast<int>(s->capture.validation.size());
+    trainer->validate_at_start = true;
+  }
+  std::cerr << "handlabel train: " << s->capture.train.size() << " training and "
+            << s->capture.validation.size() << " validation frames of "
+            << s->capture.source->Describe() << ", real share " << f.real_share << "\n";
+}
+
+TrainingSources MakeTrainingSources(const TrainConfig& config, const HandModel& hand,
+                                    const TrainFlags& f, PoemTrainerOptions* trainer) {
+  TrainingSources s;
+  if (!f.capture.capture_dir.empty()) {
+    AddCaptureSources(config, hand, f, &s, trainer);
+  } else {
+    s.synth_train =
+        std::make_unique<SynthTrainingSamples>(hand, config.synth, config.samples);
+    s.train = s.synth_train.get();
+  }
+  if (!s.validation) {
+    s.synth_validation = std::make_unique<SynthTrainingSamples>(
+        hand, ValidationSynthOptions(config), ValidationSampleOptions(config));
+    s.validation = s.synth_validation.get();
+  }
+  return s;
+}
+
 void Train(const TrainConfig& config, const TrainFlags& f) {
   std::string hand_source;
   const HandModel hand = LoadTrainingHandModel(config, &hand_source);
   std::cerr << "handlabel train: hand model " << hand_source << "\n";
-  const SynthTrainingSamples train(hand, config.synth, config.samples);
-  const SynthTrainingSamples validation(hand, ValidationSynthOptions(config),
-                                        ValidationSampleOptions(config));
+  PoemTrainerOptions trainer_options = config.trainer;
+  const TrainingSources sources = MakeTrainingSources(config, hand, f, &trainer_options);
   const std::string run = config.trainer.out_dir;
   PoemTrainerHooks hooks;
   hooks.progress = [](const std::string& line) { std::cout << line << std::endl; };
   hooks.logs_written = [run] { DrawTrainingCurves(run); };
-  PoemTrainer trainer(config.network, hand, train, &validation, config.trainer, hooks);
+  PoemTrainer trainer(config.network, hand, *sources.train, sources.validation,
+                      trainer_options, hooks);
   const PoemTrainSummary s = trainer.Run(f.resume, f.stop_at);
   std::cout << "trained steps " << s.start_step << " -> " << s.end_step << " in "
             << s.seconds << " s; last loss " << s.last_loss << "; weights "
@@ -143,8 +241,9 @@ void Train(const TrainConfig& config, const TrainFlags& f) {
 int RunTrain(int argc, char** argv) {
   CLI::App app(
       "Train the POEM network on synthetic multi-view captures generated on the fly, "
-      "with checkpoints, resume, loss curves (CSV + PNG) and validation on held-out "
-      "synthetic frames (docs/training.md).\n"
+      "or on a capture's own labelled frames (--capture, --labels), with checkpoints, "
+      "resume, loss curves (CSV + PNG) and validation on held-out frames "
+      "(docs/training.md).\n"
       "Example: handlabel train --config jobs/train_poem_small.yaml --out runs/small",
       "train");
   TrainFlags flags;

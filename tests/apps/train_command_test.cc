@@ -10,7 +10,9 @@
 #include <map>
 #include <sstream>
 
+#include "capture/native_frame_source.h"
 #include "image/image.h"
+#include "pipeline/label_record.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 
@@ -185,6 +187,68 @@ TEST(TrainCommand, MaskPictureNeedsAMaskHead) {
   EXPECT_EQ(r.status, 1);
   EXPECT_THAT(r.err, HasSubstr("--mask-png"));
   EXPECT_FALSE(std::filesystem::exists(dir + "/m.png"));
+}
+
+// A 4-frame synthetic capture made by `handlabel synth` (the open hand, so the labels
+// have the network's 778 vertices) and a labels/ folder of its ground truth.
+std::string CaptureWithTruthLabels(const std::string& dir) {
+  const std::string capture = dir + "/capture";
+  const auto synth =
+      RunHandlabelCommand({"synth", "--preset", "dexycb", "--frames", "4", "--seed", "2",
+                           "--size", "160x120", "--threads", "1", "--out", capture});
+  EXPECT_EQ(synth.status, 0) << synth.err;
+  const NativeFrameSource source(capture);
+  for (const std::string& id : source.FrameIds()) {
+    const FrameGroundTruth truth = *source.Load(id).ground_truth;
+    LabelRecord label;
+    label.frame = id;
+    label.path = LabelPath::kFallbackFit;
+    label.mesh.keypoints = truth.keypoints;
+    label.mesh.vertices = truth.vertices;
+    label.mesh.joints = Points3d::Zero(kNumHandJoints, 3);
+    WriteLabelFiles(dir + "/fit", label, Faces(), {});
+  }
+  return capture;
+}
+
+// Training on a capture's labels, mixed half and half with synthetic samples, validated
+// on a held-out frame of the capture before the first step and at the end.
+TEST(TrainCommand, TrainsOnACapturesLabelsAndValidatesBeforeTheFirstStep) {
+  const std::string dir = testing::ScratchDir();
+  const std::string capture = CaptureWithTruthLabels(dir);
+  const std::string config = TrainConfigFile(dir, "real", "", false);
+  const auto run = RunHandlabelCommand(
+      {"train", "--config", config, "--capture", capture, "--labels", dir + "/fit/labels",
+       "--train-frames", "0:3", "--val-frames", "3:4", "--real-share", "0.5"});
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_THAT(run.err, HasSubstr("3 training and 1 validation frames"));
+  EXPECT_THAT(run.out, HasSubstr("validation at step 0: MPJPE"));
+  EXPECT_THAT(run.out, HasSubstr("validation at step 2: MPJPE"));
+  std::ifstream csv(dir + "/real/validation.csv");
+  std::string header, first, last;
+  std::getline(csv, header);
+  std::getline(csv, first);
+  std::getline(csv, last);
+  EXPECT_EQ(first.substr(0, 2), "0,");
+  EXPECT_EQ(last.substr(0, 2), "2,");
+  EXPECT_EQ(last.substr(last.rfind(',') + 1), "1");  // one sample per held-out frame
+
+  // Resumed: the start is not validated again.
+  const auto resumed = RunHandlabelCommand(
+      {"train", "--config", config, "--resume", "--steps", "3", "--capture", capture,
+       "--labels", dir + "/fit/labels", "--val-frames", "3:4"});
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_THAT(resumed.out, ::testing::Not(HasSubstr("validation at step 2")));
+
+  const auto outside = RunHandlabelCommand(
+      {"train", "--config", TrainConfigFile(dir, "bad", "", false), "--capture", capture,
+       "--labels", dir + "/fit/labels", "--train-frames", "0:9"});
+  EXPECT_EQ(outside.status, 1);
+  EXPECT_THAT(outside.err, HasSubstr("--train-frames"));
+  const auto no_labels =
+      RunHandlabelCommand({"train", "--config", config, "--capture", capture});
+  EXPECT_EQ(no_labels.status, 2);
+  EXPECT_THAT(no_labels.err, HasSubstr("--labels"));
 }
 
 TEST(TrainCommand, MaskHeadTrainingNeedsAHead) {
