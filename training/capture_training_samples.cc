@@ -46,6 +46,19 @@ void AugmentCropPixels(const CaptureViewDraws& d, int S, std::vector<float>* pix
   NormaliseCropLevels(pixels);
 }
 
+// Where the detections locate the hand in fewer than two views (inference could not
+// triangulate such a frame and fits it instead), the views they miss take the label's
+// windows at weight 1.
+void UseLabelWindows(const FrameInput& frame, const Points3d& keypoints_world,
+                     std::vector<CaptureViewDraws>* draws,
+                     std::vector<CaptureViewCrop>* crops, const HandCropOptions& crop) {
+  for (size_t v = 0; v < crops->size(); ++v) {
+    if ((*crops)[v].weight > 0) continue;
+    (*draws)[v].from_detection = false;
+    (*crops)[v] = CaptureViewWindow(frame, v, keypoints_world, (*draws)[v], crop);
+  }
+}
+
 Eigen::Matrix4d ToMatrix4(const Rigid3& t) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
   m.topRows<3>() = t.ToMatrix();
@@ -87,22 +100,26 @@ CaptureViewDraws DrawCaptureView(const CaptureSampleOptions& o, std::mt19937_64&
   return d;
 }
 
-CropWindow CaptureViewWindow(const FrameInput& frame, size_t v,
-                             const Points3d& keypoints_world,
-                             const CaptureViewDraws& draws, const HandCropOptions& crop) {
+CaptureViewCrop CaptureViewWindow(const FrameInput& frame, size_t v,
+                                  const Points3d& keypoints_world,
+                                  const CaptureViewDraws& draws,
+                                  const HandCropOptions& crop) {
   const RigCamera& cam = frame.rig[v];
   if (draws.from_detection && v < frame.keypoints_2d.size() && frame.keypoints_2d[v]) {
-    if (auto window = CropFromKeypoints(*frame.keypoints_2d[v], crop)) return *window;
+    if (auto window = CropFromKeypoints(*frame.keypoints_2d[v], crop)) {
+      return {*window, 1.0f};
+    }
+    return {WholeImageCrop(cam.camera), 0.0f};  // CropForView's fallback
   }
   std::vector<Eigen::Vector3d> in_cam;
   for (Eigen::Index k = 0; k < keypoints_world.rows(); ++k) {
     in_cam.push_back(cam.cam_from_world * keypoints_world.row(k).transpose());
   }
   std::optional<CropWindow> window = CropFromPrior(cam.camera, in_cam, crop);
-  if (!window) return WholeImageCrop(cam.camera);
+  if (!window) return {WholeImageCrop(cam.camera), 1.0f};
   window->side *= draws.augmentation.scale;
   window->center += draws.shift * window->side;
-  return *window;
+  return {*window, 1.0f};
 }
 
 CaptureTrainingSamples::CaptureTrainingSamples(const FrameSource& source,
@@ -129,6 +146,7 @@ size_t CaptureTrainingSamples::FrameOfSample(int64_t index) const {
 void CaptureTrainingSamples::MakeView(const FrameInput& frame, size_t v,
                                       const LabeledFrame& label,
                                       const CaptureViewDraws& draws,
+                                      const CaptureViewCrop& crop,
                                       TrainingView* view) const {
   const RigCamera& cam = frame.rig[v];
   const ImageU8 image = FrameViewImageRgb(frame, v);
@@ -136,10 +154,10 @@ void CaptureTrainingSamples::MakeView(const FrameInput& frame, size_t v,
     throw InputError(frame.id, "images", "an image for every view the network sees",
                      "none for camera " + cam.name);
   }
-  const CropWindow window = CaptureViewWindow(frame, v, label.keypoints_3d, draws, crop_);
-  view->intrinsics = CropIntrinsics(cam.camera, window, crop_.crop_size);
-  view->image =
-      WarpCrop({image.width, image.height, image.data.data()}, cam.camera, window, crop_);
+  view->intrinsics = CropIntrinsics(cam.camera, crop.window, crop_.crop_size);
+  view->image = WarpCrop({image.width, image.height, image.data.data()}, cam.camera,
+                         crop.window, crop_);
+  view->view_weight = crop.weight;
   if (options_.augment.enabled) AugmentCropPixels(draws, crop_.crop_size, &view->image);
   // As the network stage hands the view to the network (pipeline/network_stage.cc).
   const Rigid3 cam_from_master =
@@ -168,9 +186,17 @@ TrainingSample CaptureTrainingSamples::Sample(int64_t index) const {
   sample.index = index;
   sample.frame = static_cast<int64_t>(which);
   sample.views.resize(num_views_);
+  std::vector<CaptureViewDraws> draws(num_views_);
+  std::vector<CaptureViewCrop> crops(num_views_);
+  int weighted = 0;
   for (int v = 0; v < num_views_; ++v) {
-    const CaptureViewDraws draws = DrawCaptureView(options_, rng);
-    MakeView(frame, v, label, draws, &sample.views[v]);
+    draws[v] = DrawCaptureView(options_, rng);
+    crops[v] = CaptureViewWindow(frame, v, label.keypoints_3d, draws[v], crop_);
+    weighted += crops[v].weight > 0;
+  }
+  if (weighted < 2) UseLabelWindows(frame, label.keypoints_3d, &draws, &crops, crop_);
+  for (int v = 0; v < num_views_; ++v) {
+    MakeView(frame, v, label, draws[v], crops[v], &sample.views[v]);
   }
   const Rigid3& master_from_world = frame.rig[0].cam_from_world;
   sample.joints_3d = TransformPoints(master_from_world, label.keypoints_3d);

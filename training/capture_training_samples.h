@@ -7,10 +7,12 @@
 // every epoch of `frames.size()` samples. For each view:
 //   window  with probability detection_crop_probability, what inference crops: the
 //           window around the frame's detected 2D keypoints (CropFromKeypoints, the
-//           network stage's rule); otherwise, or when the view's detections do not
-//           locate the hand, the window around the label's keypoints projected into
-//           the view (CropFromPrior), its side x augment scale, its centre shifted by
-//           N(0, shift_sigma) x side per axis (clipped at 2 sigma).
+//           network stage's rule), or the whole image at view weight 0 where they do
+//           not locate the hand; otherwise the window around the label's keypoints
+//           projected into the view (CropFromPrior), its side x augment scale, its
+//           centre shifted by N(0, shift_sigma) x side per axis (clipped at 2 sigma).
+//           A sample keeps at least two views of weight 1 (the triangulation needs
+//           them): if the detections leave fewer, the others take label windows.
 //   crop    CropIntrinsics + WarpCrop (network/poem/hand_crop.h), exactly as inference:
 //           any camera model, distortion removed by the warp.
 //   pixels  when augmenting: Gaussian blur of sigma U(0, blur_max_px), pixel noise of
@@ -19,8 +21,7 @@
 //   targets the label's keypoints through the view's camera and the crop intrinsics;
 //           master_from_cam as the network stage builds it; keypoints and vertices in
 //           the master frame (camera 0).
-// No in-plane rotation, and every view has weight 1 (views that the detections miss get
-// the label window instead of inference's whole image with weight 0).
+// No in-plane rotation and no view dropout yet.
 // Everything random derives from (seed, i), so Sample(i) is the same on every call and
 // every thread. Labels arrive as plain arrays: reading label files is pipeline/'s job.
 
@@ -47,8 +48,9 @@ struct LabeledFrame {
 
 struct CaptureSampleOptions {
   int crop_size = 128;  // crop side in pixels, the network's (a multiple of 32)
-  // Chance that a view is cropped around its detected 2D keypoints as inference crops
-  // it (0..1); otherwise around the label's projected keypoints, with jitter.
+  // Chance that a view is cropped as inference crops it, around its detected 2D
+  // keypoints or, where they miss the hand, whole at weight 0 (0..1); otherwise around
+  // the label's projected keypoints, with jitter.
   double detection_crop_probability = 0.5;
   // Label-window crops: centre shift per axis, N(0, shift_sigma) x window side,
   // clipped at 2 sigma (0..0.5).
@@ -79,12 +81,20 @@ struct CaptureViewDraws {
 CaptureViewDraws DrawCaptureView(const CaptureSampleOptions& options,
                                  std::mt19937_64& rng);
 
-// The source window of view v: around the frame's detected keypoints when `draws` asks
-// for them and they locate the hand, else around the projected label keypoints
-// (jittered), else (the hand behind the camera or outside the image) the whole image.
-CropWindow CaptureViewWindow(const FrameInput& frame, size_t v,
-                             const Points3d& keypoints_world,
-                             const CaptureViewDraws& draws, const HandCropOptions& crop);
+// The source window of view v and the view's triangulation weight. With
+// draws.from_detection and a detection entry for the view: the window around the
+// detected keypoints when they locate the hand, else, as inference, the whole image at
+// weight 0. Otherwise (or without detections for the view) the window around the
+// projected label keypoints, jittered, at weight 1; the whole image at weight 1 when
+// the label is behind the camera or outside the image.
+struct CaptureViewCrop {
+  CropWindow window;
+  float weight = 1.0f;
+};
+CaptureViewCrop CaptureViewWindow(const FrameInput& frame, size_t v,
+                                  const Points3d& keypoints_world,
+                                  const CaptureViewDraws& draws,
+                                  const HandCropOptions& crop);
 
 class CaptureTrainingSamples : public TrainingSampleSource {
  public:
@@ -105,7 +115,8 @@ class CaptureTrainingSamples : public TrainingSampleSource {
 
  private:
   void MakeView(const FrameInput& frame, size_t v, const LabeledFrame& label,
-                const CaptureViewDraws& draws, TrainingView* view) const;
+                const CaptureViewDraws& draws, const CaptureViewCrop& crop,
+                TrainingView* view) const;
 
   const FrameSource& source_;
   std::vector<LabeledFrame> frames_;

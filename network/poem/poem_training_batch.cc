@@ -42,6 +42,8 @@ PoemTrainingBatch ToPoemTrainingBatch(const std::vector<TrainingSample>& samples
   torch::Tensor T = torch::empty({B, N, 4, 4}, f32);
   torch::Tensor j2d = torch::empty({B, N, 21, 2}, f32);
   torch::Tensor w2d = torch::empty({B, N, 21}, f32);
+  torch::Tensor view_weights = torch::empty({B, N}, f32);
+  bool all_views_weighted = true;
   torch::Tensor j3d = torch::empty({B, 21, 3}, f32);
   torch::Tensor v3d = torch::empty({B, V, 3}, f32);
   float* img = images.data_ptr<float>();
@@ -49,6 +51,7 @@ PoemTrainingBatch ToPoemTrainingBatch(const std::vector<TrainingSample>& samples
   auto t = T.accessor<float, 4>();
   auto uv = j2d.accessor<float, 4>();
   auto w = w2d.accessor<float, 3>();
+  auto vw = view_weights.accessor<float, 2>();
   auto j = j3d.accessor<float, 3>();
   auto v = v3d.accessor<float, 3>();
   for (int64_t b = 0; b < B; ++b) {
@@ -67,8 +70,10 @@ PoemTrainingBatch ToPoemTrainingBatch(const std::vector<TrainingSample>& samples
       for (int q = 0; q < 21; ++q) {
         uv[b][n][q][0] = view.joints_2d(q, 0);
         uv[b][n][q][1] = view.joints_2d(q, 1);
-        w[b][n][q] = view.joints_2d_weight[q];
+        w[b][n][q] = view.joints_2d_weight[q] * view.view_weight;
       }
+      vw[b][n] = view.view_weight;
+      all_views_weighted &= view.view_weight == 1.0f;
     }
     for (int q = 0; q < 21; ++q)
       for (int c = 0; c < 3; ++c) j[b][q][c] = s.joints_3d(q, c);
@@ -79,6 +84,9 @@ PoemTrainingBatch ToPoemTrainingBatch(const std::vector<TrainingSample>& samples
   out.batch.images = images;
   out.batch.intrinsics = K;
   out.batch.master_from_cam = T;
+  // Left undefined when every view counts fully: the model's unweighted path, as
+  // before view weights existed.
+  if (!all_views_weighted) out.batch.view_weights = view_weights;
   out.targets.joints_3d = j3d;
   out.targets.vertices_3d = v3d;
   out.targets.joints_2d = j2d;

@@ -29,6 +29,10 @@ struct TrainingView {
       Eigen::Matrix<double, 21, 2, Eigen::RowMajor>::Zero();
   // Weight of each 2D keypoint in the losses (0 = behind the camera).
   std::array<float, 21> joints_2d_weight{};
+  // Triangulation weight of the view (HandMeshViewInput::weight): 0 for a view whose
+  // evidence did not locate the hand, which inference crops as the whole image and
+  // leaves out of the triangulation; its 2D keypoints then count for nothing either.
+  float view_weight = 1.0f;
 };
 
 struct TrainingSample {

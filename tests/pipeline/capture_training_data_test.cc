@@ -75,33 +75,55 @@ TEST_F(CaptureTrainingDataTest, SplitsFramesAndReadsTheLabelsAsTargets) {
   EXPECT_THAT(data.validation[0].vertices, testing::MatrixNear(truth.vertices, 1e-6));
 }
 
-// Without augmentation and with detections asked for, a view that the detections
-// locate is exactly what the label job's network stage hands to the network: the same
-// pixels, intrinsics and camera-to-master transform.
-TEST_F(CaptureTrainingDataTest, DetectionCropsAreTheNetworkStagesCrops) {
+// The capture with the detector's keypoints of view 3 dropped (a view it missed).
+class MissedView3 : public FrameSource {
+ public:
+  explicit MissedView3(const FrameSource& inner) : inner_(inner) {}
+  std::vector<std::string> FrameIds() const override { return inner_.FrameIds(); }
+  FrameInput Load(const std::string& id) const override {
+    FrameInput frame = inner_.Load(id);
+    if (frame.keypoints_2d[3]) frame.keypoints_2d[3]->confidence.setZero();
+    return frame;
+  }
+  std::string Describe() const override { return "view 3 missed"; }
+
+ private:
+  const FrameSource& inner_;
+};
+
+// The validation samples are what the label job's network stage hands to the network:
+// the same pixels, intrinsics, camera-to-master transforms and view weights, in views
+// the detections locate (cropped around them) and views they miss (the whole image at
+// weight 0) alike.
+TEST_F(CaptureTrainingDataTest, ValidationSamplesAreTheNetworkStagesInput) {
   const CaptureTrainingData data = LoadCaptureTrainingData(inputs_, num_vertices());
   TrainConfig config;
   config.network = TinyPoemConfig(8);
   const CaptureSampleOptions options = CaptureSampleOptionsFor(config, true);
   EXPECT_EQ(options.crop_size, config.network.crop_size);
-  const CaptureTrainingSamples samples(*data.source, {data.train[1]}, options);
-  const TrainingSample sample = samples.Sample(0);
-  const FrameInput frame = data.source->Load(data.train[1].id);
-  HandCropOptions crop;
-  crop.crop_size = config.network.crop_size;
-  std::vector<ViewCrop> crops;
-  const HandMeshInput input = CropFrameForNetwork(frame, 8, crop, &crops);
-  int compared = 0;
-  for (size_t v = 0; v < crops.size(); ++v) {
-    if (crops[v].source != "keypoints") continue;  // whole image at inference
-    ++compared;
-    EXPECT_EQ(sample.views[v].image, input.views[v].pixels) << "view " << v;
-    EXPECT_EQ(sample.views[v].intrinsics, input.views[v].intrinsics) << "view " << v;
-    Eigen::Matrix4d master_from_cam = Eigen::Matrix4d::Identity();
-    master_from_cam.topRows<3>() = input.views[v].cam_from_master.Inverse().ToMatrix();
-    EXPECT_EQ(sample.views[v].master_from_cam, master_from_cam) << "view " << v;
+  const MissedView3 source(*data.source);
+  for (const LabeledFrame& label : data.train) {
+    const CaptureTrainingSamples samples(source, {label}, options);
+    const TrainingSample sample = samples.Sample(0);
+    const FrameInput frame = source.Load(label.id);
+    HandCropOptions crop;
+    crop.crop_size = config.network.crop_size;
+    std::vector<ViewCrop> crops;
+    const HandMeshInput input = CropFrameForNetwork(frame, 8, crop, &crops);
+    int located = 0;
+    for (size_t v = 0; v < crops.size(); ++v) {
+      located += crops[v].source == "keypoints";
+      EXPECT_EQ(sample.views[v].image, input.views[v].pixels) << "view " << v;
+      EXPECT_EQ(sample.views[v].intrinsics, input.views[v].intrinsics) << "view " << v;
+      EXPECT_EQ(sample.views[v].view_weight, input.views[v].weight) << "view " << v;
+      Eigen::Matrix4d master_from_cam = Eigen::Matrix4d::Identity();
+      master_from_cam.topRows<3>() = input.views[v].cam_from_master.Inverse().ToMatrix();
+      EXPECT_EQ(sample.views[v].master_from_cam, master_from_cam) << "view " << v;
+    }
+    EXPECT_GE(located, 4) << label.id;
+    EXPECT_EQ(crops[3].source, "whole image");
+    EXPECT_EQ(sample.views[3].view_weight, 0.0f);
   }
-  EXPECT_GE(compared, 4);
 }
 
 TEST_F(CaptureTrainingDataTest, BadRangesNameTheFlag) {

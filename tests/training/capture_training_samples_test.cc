@@ -176,12 +176,15 @@ TEST_F(CaptureSamplesTest, JitteredLabelWindowsHoldTheHand) {
   }
 }
 
-// With detections asked for everywhere, a view whose detections locate the hand is
-// cropped around them (the window of CropFromKeypoints), else around the label.
+// With detections asked for, a view whose detections locate the hand is cropped around
+// them (the window of CropFromKeypoints), else, as inference, it is the whole image at
+// weight 0; label windows always count.
 TEST_F(CaptureSamplesTest, WindowsComeFromDetectionsWhenTheyLocateTheHand) {
   const std::vector<LabeledFrame> labels = TruthLabels();
-  const FrameInput frame = source_->Load(labels[0].id);
+  FrameInput frame = source_->Load(labels[0].id);
   ASSERT_EQ(frame.keypoints_2d.size(), 8u);
+  ASSERT_TRUE(frame.keypoints_2d[5].has_value());
+  frame.keypoints_2d[5]->confidence.setZero();  // a view the detector missed
   HandCropOptions crop;
   crop.crop_size = 64;
   CaptureViewDraws from_detection;
@@ -189,18 +192,61 @@ TEST_F(CaptureSamplesTest, WindowsComeFromDetectionsWhenTheyLocateTheHand) {
   const CaptureViewDraws from_label;
   int located = 0;
   for (size_t v = 0; v < 8; ++v) {
-    const CropWindow chosen =
+    const CaptureViewCrop chosen =
         CaptureViewWindow(frame, v, labels[0].keypoints_3d, from_detection, crop);
-    const CropWindow label =
+    const CaptureViewCrop label =
         CaptureViewWindow(frame, v, labels[0].keypoints_3d, from_label, crop);
-    std::optional<CropWindow> detected;
-    if (frame.keypoints_2d[v]) detected = CropFromKeypoints(*frame.keypoints_2d[v], crop);
-    const CropWindow& expected = detected ? *detected : label;
+    EXPECT_EQ(label.weight, 1.0f);
+    ASSERT_TRUE(frame.keypoints_2d[v].has_value());
+    const std::optional<CropWindow> detected =
+        CropFromKeypoints(*frame.keypoints_2d[v], crop);
+    const CropWindow expected =
+        detected ? *detected : WholeImageCrop(frame.rig[v].camera);
     located += detected.has_value();
-    EXPECT_EQ(chosen.center, expected.center) << "view " << v;
-    EXPECT_EQ(chosen.side, expected.side) << "view " << v;
+    EXPECT_EQ(chosen.window.center, expected.center) << "view " << v;
+    EXPECT_EQ(chosen.window.side, expected.side) << "view " << v;
+    EXPECT_EQ(chosen.weight, detected ? 1.0f : 0.0f) << "view " << v;
   }
   EXPECT_GE(located, 4);  // the simulated detector finds the hand in most views
+  EXPECT_LE(located, 7);  // not in view 5
+}
+
+// The capture with the detector's keypoints dropped in every view but view 0.
+class OneDetectedView : public FrameSource {
+ public:
+  explicit OneDetectedView(const FrameSource& inner) : inner_(inner) {}
+  std::vector<std::string> FrameIds() const override { return inner_.FrameIds(); }
+  FrameInput Load(const std::string& id) const override {
+    FrameInput frame = inner_.Load(id);
+    for (size_t v = 1; v < frame.keypoints_2d.size(); ++v) {
+      if (frame.keypoints_2d[v]) frame.keypoints_2d[v]->confidence.setZero();
+    }
+    return frame;
+  }
+  std::string Describe() const override { return "one detected view"; }
+
+ private:
+  const FrameSource& inner_;
+};
+
+// A frame whose detections locate the hand in fewer than two views cannot be
+// triangulated (inference fits it instead): its views take the label windows and all
+// count; with two or more, the views the detector missed weigh 0.
+TEST_F(CaptureSamplesTest, FramesWithoutTwoDetectedViewsFallBackToLabelWindows) {
+  CaptureSampleOptions o = StrongOptions();
+  o.detection_crop_probability = 1;
+  o.augment.enabled = false;
+  const OneDetectedView one_view(*source_);
+  const CaptureTrainingSamples samples(one_view, TruthLabels(), o);
+  const FrameInput frame = one_view.Load(TruthLabels()[0].id);
+  ASSERT_TRUE(CropFromKeypoints(*frame.keypoints_2d[0], HandCropOptions()).has_value());
+  for (int64_t index = 0; index < 3; ++index) {
+    for (const TrainingView& v : samples.Sample(index).views) {
+      EXPECT_EQ(v.view_weight, 1.0f);
+      EXPECT_GE(v.joints_2d.minCoeff(), 0.0);  // a label window holds the hand
+      EXPECT_LE(v.joints_2d.maxCoeff(), 64.0);
+    }
+  }
 }
 
 TEST_F(CaptureSamplesTest, BadOptionsAndLabelsNameTheField) {
