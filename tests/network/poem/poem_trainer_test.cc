@@ -380,6 +380,40 @@ TEST(PoemTrainer, KeepsEveryNthCheckpointsWeightsAndAveragesThem) {
 // After the update, eval mode (running statistics) answers like training mode (the
 // batch's own statistics) on the batch the statistics were measured on; before it, the
 // initial statistics give other answers. Parameters do not move.
+// A view of weight 0 (its hand not located, as inference's whole-image views) leaves the
+// triangulation and the 2D loss: the triangulated joints do not move whatever its
+// pixels show, while they do for a view of weight 1. All weights 1 keep the reference's
+// unweighted batch.
+TEST(PoemTrainingBatch, ViewWeightsReachTheTriangulationAndThe2dLoss) {
+  const PoemConfig c = TinyPoemConfig(3);
+  const FakeSamples source(c, 5, false);
+  std::vector<TrainingSample> samples = {source.Sample(0), source.Sample(1)};
+  EXPECT_FALSE(ToPoemTrainingBatch(samples).batch.view_weights.defined());
+  PoemModel model = MakeRandomPoemModel(c, 2);
+  model->eval();
+  auto triangulated = [&](const std::vector<TrainingSample>& batch) {
+    torch::NoGradGuard no_grad;
+    return model->forward(ToPoemTrainingBatch(batch).batch).triangulated_joints.clone();
+  };
+  std::vector<TrainingSample> repainted = samples;
+  for (float& x : repainted[1].views[2].image) x = -x;
+  const double moved_weighted =
+      (triangulated(samples) - triangulated(repainted)).abs().max().item<double>();
+  EXPECT_GT(moved_weighted, 1e-4);
+
+  samples[1].views[2].view_weight = 0;
+  repainted[1].views[2].view_weight = 0;
+  const PoemTrainingBatch batch = ToPoemTrainingBatch(samples);
+  ASSERT_TRUE(batch.batch.view_weights.defined());
+  EXPECT_EQ(batch.batch.view_weights[1][2].item<float>(), 0.0f);
+  EXPECT_EQ(batch.batch.view_weights[1][1].item<float>(), 1.0f);
+  EXPECT_EQ(batch.targets.joints_2d_weights[1][2].abs().sum().item<float>(), 0.0f);
+  EXPECT_EQ(batch.targets.joints_2d_weights[0][2].sum().item<float>(), 21.0f);
+  const double moved_unweighted =
+      (triangulated(samples) - triangulated(repainted)).abs().max().item<double>();
+  EXPECT_LT(moved_unweighted, 1e-6 * moved_weighted + 1e-9);
+}
+
 TEST(PoemBatchNormUpdate, EvalModeMatchesTrainingModeOnTheMeasuredBatch) {
   const PoemConfig c = TinyPoemConfig(2);
   const FakeSamples source(c, 31, false);
