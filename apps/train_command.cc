@@ -2,6 +2,7 @@
 // capture's own labelled frames (docs/training.md).
 
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -9,6 +10,7 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "network/poem/loss_plot.h"
 #include "network/poem/poem_trainer.h"
@@ -57,6 +59,14 @@ void AddCaptureOptions(CLI::App* app, TrainFlags* f) {
                   "with --capture: held-out frames to validate on (at the start and "
                   "every train.validate_every steps) instead of synthetic ones; same "
                   "forms as --train-frames")
+      ->needs(capture);
+  app->add_option("--label-min-views", c.selection.min_views,
+                  "with --capture: a fit label trains only if at least this many views "
+                  "fit its 2D within --label-max-rms-px (default 3)")
+      ->needs(capture);
+  app->add_option("--label-max-rms-px", c.selection.max_view_rms_px,
+                  "with --capture: ... within this RMS pixel distance (fit.view_rms_px; "
+                  "default 10); network labels train only if they passed every check")
       ->needs(capture);
   app->add_option("--real-share", f->real_share,
                   "with --capture: share of training samples from the capture; the rest "
@@ -195,9 +205,16 @@ void AddCaptureSources(const TrainConfig& config, const HandModel& hand,
     trainer->validation_samples = static_cast<int>(s->capture.validation.size());
     trainer->validate_at_start = true;
   }
-  std::cerr << "handlabel train: " << s->capture.train.size() << " training and "
+  std::cerr << "handlabel train: " << s->capture.train.size() << " training ("
+            << s->capture.selection.size() - s->capture.train.size()
+            << " labels left out, capture_labels.json) and "
             << s->capture.validation.size() << " validation frames of "
             << s->capture.source->Describe() << ", real share " << f.real_share << "\n";
+  // What the run learned from, beside its checkpoints.
+  std::filesystem::create_directories(config.trainer.out_dir);
+  WriteFileAtomically(
+      (std::filesystem::path(config.trainer.out_dir) / "capture_labels.json").string(),
+      LabelSelectionJson(f.capture.selection, s->capture.selection).dump(1) + "\n");
 }
 
 TrainingSources MakeTrainingSources(const TrainConfig& config, const HandModel& hand,

@@ -5,6 +5,8 @@
 
 #include "capture/native_frame_source.h"
 #include "core/errors.h"
+#include "core/option_checks.h"
+#include "core/text.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_record.h"
 
@@ -38,27 +40,22 @@ void SplitFrames(const std::vector<std::string>& all, const CaptureTrainingInput
   }
 }
 
-std::vector<LabeledFrame> ReadLabels(const std::vector<std::string>& frames,
-                                     const std::string& labels_dir, int num_vertices) {
-  std::vector<LabeledFrame> labels;
-  for (const std::string& id : frames) {
-    const std::string stem = FrameFileStem(id, labels_dir);
-    const std::string path =
-        (std::filesystem::path(labels_dir) / (stem + ".json")).string();
-    labels.push_back(ReadLabeledFrame(path, id, num_vertices));
-  }
-  return labels;
+std::string LabelPathOf(const std::string& labels_dir, const std::string& frame) {
+  const std::string stem = FrameFileStem(frame, labels_dir);
+  return (std::filesystem::path(labels_dir) / (stem + ".json")).string();
 }
 
-}  // namespace
-
-LabeledFrame ReadLabeledFrame(const std::string& path, const std::string& frame,
-                              int num_vertices) {
+LabelRecord ReadFrameLabel(const std::string& path, const std::string& frame) {
   if (!std::filesystem::exists(path)) {
     throw InputError(path, "label file", "a label for frame '" + frame + "' (--labels)",
                      "no such file");
   }
-  const LabelRecord label = ReadLabelFile(path);
+  return ReadLabelFile(path);
+}
+
+// The label's keypoints and vertices as a target, checked (ReadLabeledFrame's errors).
+LabeledFrame ToLabeledFrame(const LabelRecord& label, const std::string& path,
+                            const std::string& frame, int num_vertices) {
   if (label.frame != frame) {
     throw InputError(path, "frame", "'" + frame + "'", "'" + label.frame + "'");
   }
@@ -75,13 +72,99 @@ LabeledFrame ReadLabeledFrame(const std::string& path, const std::string& frame,
   return {frame, label.mesh.keypoints, label.mesh.vertices};
 }
 
+std::vector<LabeledFrame> ReadLabels(const std::vector<std::string>& frames,
+                                     const std::string& labels_dir, int num_vertices) {
+  std::vector<LabeledFrame> labels;
+  for (const std::string& id : frames) {
+    const std::string path = LabelPathOf(labels_dir, id);
+    labels.push_back(ToLabeledFrame(ReadFrameLabel(path, id), path, id, num_vertices));
+  }
+  return labels;
+}
+
+// The training frames' labels that the rule keeps; `selection` gets every frame.
+std::vector<LabeledFrame> SelectLabels(const std::vector<std::string>& frames,
+                                       const std::string& labels_dir, int num_vertices,
+                                       const LabelSelectionRule& rule,
+                                       std::vector<LabelSelection>* selection) {
+  std::vector<LabeledFrame> kept;
+  for (const std::string& id : frames) {
+    const std::string path = LabelPathOf(labels_dir, id);
+    const LabelRecord label = ReadFrameLabel(path, id);
+    LabeledFrame target = ToLabeledFrame(label, path, id, num_vertices);
+    selection->push_back(SelectTrainingLabel(label, rule));
+    if (selection->back().kept) kept.push_back(std::move(target));
+  }
+  if (kept.empty()) {
+    throw InputError(kCommandLine, "--label-min-views / --label-max-rms-px",
+                     "a rule that keeps at least one training label",
+                     "none of " + std::to_string(frames.size()) + " kept");
+  }
+  return kept;
+}
+
+}  // namespace
+
+void LabelSelectionRule::Check(const std::string& source) const {
+  RequireAtLeast(source, "--label-min-views", min_views, 2);
+  RequireGreater(source, "--label-max-rms-px", max_view_rms_px, 0);
+}
+
+LabelSelection SelectTrainingLabel(const LabelRecord& label,
+                                   const LabelSelectionRule& rule) {
+  LabelSelection s{label.frame, false, ""};
+  if (label.path == LabelPath::kNetwork) {
+    s.kept = label.quality.Passed();
+    s.why = s.kept ? "network answer, every check passed"
+                   : "network answer, failed: " + label.quality.FailedNames();
+    return s;
+  }
+  int good = 0, measured = 0;
+  if (label.fit.is_object() && label.fit.contains("view_rms_px")) {
+    for (const auto& rms : label.fit["view_rms_px"]) {
+      if (!rms.is_number()) continue;
+      ++measured;
+      good += rms.get<double>() <= rule.max_view_rms_px;
+    }
+  }
+  s.kept = good >= rule.min_views;
+  s.why = std::to_string(good) + " of " + std::to_string(measured) + " views within " +
+          FormatNumber(rule.max_view_rms_px) + " px";
+  return s;
+}
+
+nlohmann::json LabelSelectionJson(const LabelSelectionRule& rule,
+                                  const std::vector<LabelSelection>& selection) {
+  nlohmann::json frames = nlohmann::json::array();
+  int kept = 0;
+  for (const LabelSelection& s : selection) {
+    kept += s.kept;
+    frames.push_back({{"frame", s.frame}, {"kept", s.kept}, {"why", s.why}});
+  }
+  return {{"rule",
+           "a network answer that passed every check, or a fit with at least min_views "
+           "views whose fit.view_rms_px <= max_view_rms_px"},
+          {"min_views", rule.min_views},
+          {"max_view_rms_px", rule.max_view_rms_px},
+          {"kept", kept},
+          {"training_frames", selection.size()},
+          {"frames", frames}};
+}
+
+LabeledFrame ReadLabeledFrame(const std::string& path, const std::string& frame,
+                              int num_vertices) {
+  return ToLabeledFrame(ReadFrameLabel(path, frame), path, frame, num_vertices);
+}
+
 CaptureTrainingData LoadCaptureTrainingData(const CaptureTrainingInputs& in,
                                             int num_vertices) {
   CaptureTrainingData data;
   data.source = std::make_unique<NativeFrameSource>(in.capture_dir);
   std::vector<std::string> train, validation;
   SplitFrames(data.source->FrameIds(), in, &train, &validation);
-  data.train = ReadLabels(train, in.labels_dir, num_vertices);
+  in.selection.Check(kCommandLine);
+  data.train =
+      SelectLabels(train, in.labels_dir, num_vertices, in.selection, &data.selection);
   data.validation = ReadLabels(validation, in.labels_dir, num_vertices);
   return data;
 }

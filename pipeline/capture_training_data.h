@@ -8,11 +8,35 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "capture/frame_source.h"
+#include "pipeline/label_record.h"
 #include "pipeline/train_config.h"
 #include "training/capture_training_samples.h"
 
 namespace handlabel {
+
+// Which labels of the training frames may teach the network (the held-out frames are
+// judged whatever their labels score). A label trains when it is a network answer that
+// passed every quality check, or a fit whose report (`fit.view_rms_px`, the RMS pixel
+// distance of the fitted keypoints to the 2D it was fitted to, per view) shows at least
+// `min_views` views within `max_view_rms_px`: a fit that agrees with the evidence in
+// enough views to pin the hand down in 3D. Labels from a fit with fewer such views
+// are where the detector was unsure, and teaching the network those would teach it
+// the fit's guesses.
+struct LabelSelectionRule {
+  int min_views = 3;            // --label-min-views, >= 2 (one view does not pin depth)
+  double max_view_rms_px = 10;  // --label-max-rms-px, > 0
+  void Check(const std::string& source) const;
+};
+
+// One training frame's label and whether the rule kept it (`why`: the rule's reading).
+struct LabelSelection {
+  std::string frame;
+  bool kept = false;
+  std::string why;
+};
 
 struct CaptureTrainingInputs {
   std::string capture_dir;  // a native capture; its detections/ give the 2D keypoints
@@ -23,16 +47,28 @@ struct CaptureTrainingInputs {
   // none. No frame may do both.
   std::string train_frames;
   std::string val_frames;
+  LabelSelectionRule selection;
 };
 
 struct CaptureTrainingData {
   std::unique_ptr<FrameSource> source;  // the capture
-  std::vector<LabeledFrame> train;
+  std::vector<LabeledFrame> train;      // the training frames whose labels were kept
   std::vector<LabeledFrame> validation;
+  std::vector<LabelSelection> selection;  // every training frame, kept or not
 };
 
+// Whether `label` may train under `rule`, and why.
+LabelSelection SelectTrainingLabel(const LabelRecord& label,
+                                   const LabelSelectionRule& rule);
+
+// The selection as JSON: the rule, the counts and every frame's reading, written into
+// the training run's folder (capture_labels.json) so a run says what it learned from.
+nlohmann::json LabelSelectionJson(const LabelSelectionRule& rule,
+                                  const std::vector<LabelSelection>& selection);
+
 // Throws InputError naming the flag (--train-frames, --val-frames) for a bad range or a
-// frame in both, and the label file and field for a missing or unusable label.
+// frame in both, or when the rule keeps no training label, and the label file and
+// field for a missing or unusable label.
 CaptureTrainingData LoadCaptureTrainingData(const CaptureTrainingInputs& inputs,
                                             int num_vertices);
 

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "capture/native_frame_source.h"
+#include "core/json_util.h"
 #include "image/image.h"
 #include "pipeline/label_record.h"
 #include "tests/apps/run_command.h"
@@ -206,6 +207,8 @@ std::string CaptureWithTruthLabels(const std::string& dir) {
     label.mesh.keypoints = truth.keypoints;
     label.mesh.vertices = truth.vertices;
     label.mesh.joints = Points3d::Zero(kNumHandJoints, 3);
+    // A fit agreeing with its 2D in every view: the label selection keeps it.
+    label.fit = {{"view_rms_px", std::vector<double>(source.Load(id).rig.size(), 1.0)}};
     WriteLabelFiles(dir + "/fit", label, Faces(), {});
   }
   return capture;
@@ -221,7 +224,11 @@ TEST(TrainCommand, TrainsOnACapturesLabelsAndValidatesBeforeTheFirstStep) {
       {"train", "--config", config, "--capture", capture, "--labels", dir + "/fit/labels",
        "--train-frames", "0:3", "--val-frames", "3:4", "--real-share", "0.5"});
   ASSERT_EQ(run.status, 0) << run.err;
-  EXPECT_THAT(run.err, HasSubstr("3 training and 1 validation frames"));
+  EXPECT_THAT(run.err, HasSubstr("3 training (0 labels left out, capture_labels.json) "
+                                 "and 1 validation frames"));
+  const nlohmann::json selection = ReadJsonFileStrict(dir + "/real/capture_labels.json");
+  EXPECT_EQ(selection["kept"], 3);
+  EXPECT_EQ(selection["min_views"], 3);
   EXPECT_THAT(run.out, HasSubstr("validation at step 0: MPJPE"));
   EXPECT_THAT(run.out, HasSubstr("validation at step 2: MPJPE"));
   std::ifstream csv(dir + "/real/validation.csv");

@@ -45,6 +45,8 @@ class CaptureTrainingDataTest : public ::testing::Test {
       label.mesh.keypoints = truth.keypoints;
       label.mesh.vertices = truth.vertices;
       label.mesh.joints = Points3d::Zero(kNumHandJoints, 3);
+      // A fit that agrees with its 2D in every view (the label selection reads it).
+      label.fit = {{"view_rms_px", std::vector<double>(8, 1.0)}};
       WriteLabelFiles(scratch + "/fit", label, hand_.faces, {});
     }
     inputs_.labels_dir = scratch + "/fit/labels";
@@ -169,6 +171,70 @@ TEST_F(CaptureTrainingDataTest, MissingOrIncompleteLabelsNameTheFileAndField) {
       [&] { LoadCaptureTrainingData(inputs_, num_vertices() + 1); });
   EXPECT_THAT(error, HasSubstr("vertices"));
   EXPECT_THAT(error, HasSubstr(std::to_string(num_vertices() + 1)));
+}
+
+// A fit label whose report gives these per-view RMS values (null: no 2D in that view).
+LabelRecord FitLabel(const nlohmann::json& view_rms_px) {
+  LabelRecord label;
+  label.frame = "f";
+  label.path = LabelPath::kFallbackFit;
+  label.fit = {{"view_rms_px", view_rms_px}};
+  return label;
+}
+
+TEST(LabelSelection, AFitTrainsWhenEnoughViewsAgreeWithItsTwoD) {
+  const LabelSelectionRule rule;  // 3 views within 10 px
+  EXPECT_TRUE(SelectTrainingLabel(FitLabel({1, 10, 9.5, 40, nullptr}), rule).kept);
+  const LabelSelection two = SelectTrainingLabel(FitLabel({1, 10.5, 9.5, 40}), rule);
+  EXPECT_FALSE(two.kept);
+  EXPECT_EQ(two.why, "2 of 4 views within 10 px");
+  // No report (a label written without a fit): nothing shows it agrees with the 2D.
+  LabelRecord bare = FitLabel(nullptr);
+  bare.fit = nullptr;
+  EXPECT_FALSE(SelectTrainingLabel(bare, rule).kept);
+}
+
+TEST(LabelSelection, ANetworkAnswerTrainsOnlyIfItPassedEveryCheck) {
+  LabelRecord label;
+  label.frame = "f";
+  label.path = LabelPath::kNetwork;
+  label.quality.flags = {{"reprojection", true, 3, 12, ""}};
+  EXPECT_TRUE(SelectTrainingLabel(label, {}).kept);
+  label.quality.flags.push_back({"view_agreement", false, 9, 6, ""});
+  const LabelSelection s = SelectTrainingLabel(label, {});
+  EXPECT_FALSE(s.kept);
+  EXPECT_THAT(s.why, HasSubstr("view_agreement"));
+}
+
+TEST_F(CaptureTrainingDataTest, LabelsTheRuleLeavesOutDoNotTrainAndAreRecorded) {
+  nlohmann::json label;
+  std::ifstream(LabelPathOf(1)) >> label;
+  label["fit"]["view_rms_px"] = {1, 1, 30, 30, 30, 30, 30, 30};
+  std::ofstream(LabelPathOf(1)) << label.dump();
+  inputs_.val_frames = "2:3";
+  const CaptureTrainingData data = LoadCaptureTrainingData(inputs_, num_vertices());
+  ASSERT_EQ(data.train.size(), 1u);
+  EXPECT_EQ(data.train[0].id, frames_[0]);
+  ASSERT_EQ(data.selection.size(), 2u);
+  EXPECT_FALSE(data.selection[1].kept);
+  const nlohmann::json record = LabelSelectionJson(inputs_.selection, data.selection);
+  EXPECT_EQ(record["kept"], 1);
+  EXPECT_EQ(record["training_frames"], 2);
+  EXPECT_EQ(record["frames"][1]["frame"], frames_[1]);
+  // Held-out frames are judged whatever their labels score.
+  inputs_.train_frames = "0:1";
+  inputs_.val_frames = "1:2";
+  EXPECT_EQ(LoadCaptureTrainingData(inputs_, num_vertices()).validation.size(), 1u);
+  // A rule that keeps nothing is refused, naming its flags.
+  inputs_.selection.max_view_rms_px = 0.5;
+  const std::string error =
+      testing::InputErrorOf([&] { LoadCaptureTrainingData(inputs_, num_vertices()); });
+  EXPECT_THAT(error, HasSubstr("--label-max-rms-px"));
+  inputs_.selection.max_view_rms_px = 10;
+  inputs_.selection.min_views = 1;
+  EXPECT_THAT(
+      testing::InputErrorOf([&] { LoadCaptureTrainingData(inputs_, num_vertices()); }),
+      HasSubstr("--label-min-views"));
 }
 
 }  // namespace
