@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "core/text.h"
 #include "core/version.h"
+#include "hand/hand_model.h"
 
 namespace handlabel {
 namespace {
@@ -30,9 +31,7 @@ void CheckCameraNames(const Rig& rig, const std::string& source) {
 }  // namespace
 
 void CaptureInitOptions::Check(const std::string& source) const {
-  if (hand_side != "right" && hand_side != "left") {
-    throw InputError(source, "hand_side", "right or left", hand_side);
-  }
+  ParseHandSide(hand_side, source, "hand_side");
 }
 
 RigSpec ResolveRigSpec(const std::string& text, const std::string& flag) {

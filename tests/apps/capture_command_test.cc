@@ -104,6 +104,13 @@ TEST(CaptureCommand, ImageFoldersImportAndOptionsReachTheLibrary) {
   const std::string source = dir + "/source";
   testing::WriteTestCapture(source, 4, 3);
   const std::string capture = dir + "/capture";
+  // A side that is neither is refused by the one hand-side parser, naming the field.
+  const testing::CommandResult bad =
+      RunHandlabelCommand({"capture", "init", "--rig", "json:" + source + "/rig.json",
+                           "--out", capture, "--hand-side", "both"});
+  EXPECT_NE(bad.status, 0);
+  EXPECT_THAT(bad.err,
+              HasSubstr("'hand_side': expected \"right\" or \"left\", got both"));
   ASSERT_EQ(
       RunHandlabelCommand({"capture", "init", "--rig", "json:" + source + "/rig.json",
                            "--out", capture, "--hand-side", "left"})
