@@ -2,7 +2,9 @@
 // Training POEM on a capture's own labels (docs/training.md, "Training on your own
 // capture's labels"): which of the capture's frames train and which validate, and their
 // labels, read from a label job's labels/ folder here in pipeline/ and handed to
-// training/ (capture_training_samples.h) as plain arrays.
+// training/ (capture_training_samples.h) as plain arrays. It is in pipeline/ because it
+// reads a training config (TrainConfig -> CaptureSampleOptions) and the label job's own
+// output format (pipeline/label_record.h), which training/ may not include.
 
 #include <memory>
 #include <string>
