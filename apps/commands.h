@@ -33,6 +33,7 @@ int RunCapture(int argc, char** argv);
 int RunSynth(int argc, char** argv);
 int RunFit(int argc, char** argv);
 int RunTrain(int argc, char** argv);
+int RunAdapt(int argc, char** argv);
 int RunEvalNetwork(int argc, char** argv);
 int RunDetect(int argc, char** argv);
 int RunCompare(int argc, char** argv);

@@ -248,19 +248,20 @@ PoemModel LoadPoemCheckpoint(const std::string& path) {
 }
 
 void LoadPoemCheckpointInto(PoemModel& model, const std::string& path,
-                            bool mask_head_may_differ) {
+                            bool as_init_weights) {
   Archive a = ReadArchive(path);
-  if (mask_head_may_differ && model->config().mask_head && !a.config.mask_head) {
+  if (as_init_weights && model->config().mask_head && !a.config.mask_head) {
     a.config.mask_head = true;
     for (const auto& [key, value] : PoemStateDict(model)) {
       if (key.rfind("mask_head.", 0) == 0) a.tensors[key] = value.detach().clone();
     }
-  } else if (mask_head_may_differ && !model->config().mask_head && a.config.mask_head) {
+  } else if (as_init_weights && !model->config().mask_head && a.config.mask_head) {
     a.config.mask_head = false;
     for (auto it = a.tensors.begin(); it != a.tensors.end();) {
       it = it->first.rfind("mask_head.", 0) == 0 ? a.tensors.erase(it) : std::next(it);
     }
   }
+  if (as_init_weights) a.config.num_views = model->config().num_views;
   const std::vector<std::string> diff = model->config().Differences(a.config);
   if (!diff.empty()) {
     std::string got;

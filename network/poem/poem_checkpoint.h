@@ -39,13 +39,16 @@ PoemConfig ReadPoemCheckpointConfig(const std::string& path);
 // Builds the model from the embedded config and loads the weights.
 PoemModel LoadPoemCheckpoint(const std::string& path);
 // Loads into an existing model; throws InputError listing every config difference if
-// the checkpoint was written for another configuration. With mask_head_may_differ,
-// the mask head is the one exception: a checkpoint without one loads into a model with
-// one (whose head keeps its current weights: training a head onto trained weights),
-// and a checkpoint's head is dropped when the model has none (continuing the main
-// training from weights that carry a head).
+// the checkpoint was written for another configuration. With as_init_weights (weights
+// a training run starts from) two differences are allowed:
+// - the mask head: a checkpoint without one loads into a model with one (whose head
+//   keeps its current weights: training a head onto trained weights), and a
+//   checkpoint's head is dropped when the model has none (continuing the main training
+//   from weights that carry a head);
+// - the view count: no parameter's shape depends on it (views share the backbone and
+//   are summed), so 8-view weights start a 5-view rig's run (`handlabel adapt`).
 void LoadPoemCheckpointInto(PoemModel& model, const std::string& path,
-                            bool mask_head_may_differ = false);
+                            bool as_init_weights = false);
 
 // The element-wise mean of the weights and batch-norm statistics of checkpoints written
 // for one config (num_batches_tracked: the last file's). The checkpoints of a

@@ -330,7 +330,7 @@ struct PoemTrainer::State {
     if (has_run) {
       step = LoadLatest();
     } else if (!options.init_weights.empty()) {
-      LoadPoemCheckpointInto(model, options.init_weights, /*mask_head_may_differ=*/true);
+      LoadPoemCheckpointInto(model, options.init_weights, /*as_init_weights=*/true);
       step = options.init_step;
     }
     TruncateCsv(Path("loss.csv"), step);
@@ -538,6 +538,10 @@ std::string LatestPoemCheckpointModel(const std::string& out_dir) {
   const fs::path p = fs::path(out_dir) / "latest.json";
   if (!fs::exists(p)) return "";
   return (fs::path(out_dir) / ReadLatestJson(p.string()).model).string();
+}
+
+PoemConfig PoemCheckpointConfig(const std::string& path) {
+  return ReadPoemCheckpointConfig(path);
 }
 
 void ConvertPoemCheckpointToHalf(const std::string& in_path,

@@ -129,6 +129,10 @@ int64_t LatestPoemCheckpointStep(const std::string& out_dir);
 // Model file of the latest checkpoint ("" if none).
 std::string LatestPoemCheckpointModel(const std::string& out_dir);
 
+// The POEM config embedded in an own POEM checkpoint (torch-free for apps/ and
+// pipeline/). Throws InputError naming the file when it is not one.
+PoemConfig PoemCheckpointConfig(const std::string& path);
+
 // Rewrites an own POEM checkpoint with float16 storage (about half the size; it loads
 // with LoadPoemCheckpoint like any other, converted back to float32).
 void ConvertPoemCheckpointToHalf(const std::string& in_path, const std::string& out_path);

@@ -151,7 +151,7 @@ TEST(PoemMaskHead, WeightsWithoutAHeadLoadOnlyWhenAsked) {
   PoemModel masked = MakeRandomPoemModel(TinyWithMasks(2), 22);
   const torch::Tensor head_before = masked->mask_head->parameters()[0].clone();
   EXPECT_THROW(LoadPoemCheckpointInto(masked, dir + "/plain.pt"), InputError);
-  LoadPoemCheckpointInto(masked, dir + "/plain.pt", /*mask_head_may_differ=*/true);
+  LoadPoemCheckpointInto(masked, dir + "/plain.pt", /*as_init_weights=*/true);
   const auto a = PoemStateDict(plain);
   for (const auto& [key, value] : PoemStateDict(masked)) {
     if (key.rfind("mask_head.", 0) == 0) continue;
@@ -168,7 +168,7 @@ TEST(PoemMaskHead, WeightsWithoutAHeadLoadOnlyWhenAsked) {
   // The other way round the head is dropped, and only when asked.
   PoemModel plain_again = MakeRandomPoemModel(TinyPoemConfig(2), 23);
   EXPECT_THROW(LoadPoemCheckpointInto(plain_again, dir + "/masked.pt"), InputError);
-  LoadPoemCheckpointInto(plain_again, dir + "/masked.pt", /*mask_head_may_differ=*/true);
+  LoadPoemCheckpointInto(plain_again, dir + "/masked.pt", /*as_init_weights=*/true);
   EXPECT_TRUE(torch::equal(PoemStateDict(plain_again).at("feat_in.conv.weight"),
                            PoemStateDict(back).at("feat_in.conv.weight")));
 }

@@ -137,6 +137,26 @@ TEST(PoemCheckpoint, RefusesOtherConfigNamingTheDifference) {
   }
 }
 
+// Weights a run starts from may be of another view count (no parameter depends on
+// it): every tensor arrives unchanged, while another difference is still refused.
+TEST(PoemCheckpoint, InitWeightsOfAnotherViewCountLoadUnchanged) {
+  PoemModel model = MakeRandomPoemModel(TinyPoemConfig(2), 11);
+  const std::string path = testing::ScratchDir() + "/tiny_2views.pt";
+  SavePoemCheckpoint(model, path);
+  PoemModel three(TinyPoemConfig(3));
+  LoadPoemCheckpointInto(three, path, /*as_init_weights=*/true);
+  const auto saved = PoemStateDict(model);
+  for (const auto& [key, value] : PoemStateDict(three)) {
+    ASSERT_TRUE(saved.count(key)) << key;
+    EXPECT_TRUE(torch::equal(value, saved.at(key))) << key;
+  }
+  EXPECT_EQ(three->config().num_views, 3);
+  PoemConfig wider = TinyPoemConfig(3);
+  wider.crop_size *= 2;
+  PoemModel other(wider);
+  EXPECT_THROW(LoadPoemCheckpointInto(other, path, /*as_init_weights=*/true), InputError);
+}
+
 TEST(PoemCheckpoint, StateDictMismatchListsKeysAndShapes) {
   PoemModel model = MakeRandomPoemModel(TinyPoemConfig(2), 11);
   auto sd = PoemStateDict(model);

@@ -1,0 +1,68 @@
+#pragma once
+// `handlabel adapt`: teaches the network the user's own rig from the labels of the
+// slow, careful method (a pseudo-label loop; docs/adapt.md). Stages, each kept on disk
+// and marked done in <out>/stages/<name>.done, so that running the same command again
+// continues where a killed run stopped:
+//   detect    MediaPipe Hands on every frame, when the capture has no detections yet
+//             (written into the capture, as `handlabel detect --capture` does)
+//   fit       a fit-only job from the detections: <out>/fit/labels/
+//   train     fine-tunes the starting weights on the frames whose fit label agrees
+//             with its detections (LabelSelectionRule), validating on a block of
+//             held-out frames that never trains; the number of steps is planned once
+//             from the measured time per step and the budget: <out>/train/ (plan.json)
+//   export    the mean of the checkpoints of the last 30 % of the steps (low learning
+//             rate), batch-norm statistics measured again on the capture's training
+//             frames, float16: <out>/network.pt
+//   heldout   network-only jobs with the starting and the adapted weights on the
+//             held-out frames, compared with their fit labels: <out>/heldout/
+//   label     the capture labelled by network + quality checks + fallback fit:
+//             <out>/labels/, <out>/summary.json (the label job layout)
+// <out>/model_card.json and .md say what the network learned from, how long, and the
+// held-out numbers; <out>/progress.json the seconds each stage took.
+
+#include <ostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/capture_training_data.h"
+
+namespace handlabel {
+
+struct AdaptOptions {
+  std::string capture_dir;  // a native capture (capture import, synth)
+  std::string out_dir;
+  // Wall-clock minutes for all stages together; the training gets what the others
+  // leave (> 0).
+  double budget_minutes = 60;
+  int threads = 2;  // LibTorch threads and frames in parallel (>= 1)
+  // Weights to start from; empty = the shipped models/poem_small_dexycb.pt.
+  std::string weights;
+  // Frames that never train and measure the result (a job's input.frames form);
+  // empty = the last 16 frames when the capture has >= 40 (4 more before them are left
+  // out, so that neighbours of held-out frames do not train), else none.
+  std::string heldout;
+  LabelSelectionRule selection;
+  double learning_rate = 1e-4;
+  uint64_t seed = 1;  // training order, augmentation and torch seeds
+  // Also write overlay pictures of the held-out and final labels.
+  bool overlays = true;
+  void Check(const std::string& source) const;
+};
+
+// The options that decide the result, as recorded in <out>/adapt.json (a later run
+// into the same folder must agree with them).
+nlohmann::json AdaptOptionsJson(const AdaptOptions& options);
+
+struct AdaptSummary {
+  std::string network_path;     // <out>/network.pt
+  std::string labels_dir;       // <out>/labels
+  nlohmann::json card;          // the model card's content
+};
+
+// Runs (or continues) the stages. Throws InputError naming the file and field when
+// the folder holds another run (adapt.json), the selection rule keeps no training
+// label, or a stage's input is unusable.
+AdaptSummary RunAdaptation(const AdaptOptions& options, std::ostream* log);
+
+}  // namespace handlabel
