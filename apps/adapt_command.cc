@@ -43,6 +43,10 @@ int RunAdapt(int argc, char** argv) {
   app.add_option("--label-max-rms-px", o.selection.max_view_rms_px,
                  "... within this RMS pixel distance (default 10)");
   app.add_option("--learning-rate", o.learning_rate, "peak learning rate (default 1e-4)");
+  app.add_option("--accept-mm", o.accept_mm,
+                 "the label stage's check thresholds are chosen on the held-out "
+                 "answers: one farther than this from its fit label is bad (default "
+                 "10)");
   app.add_option("--seed", o.seed, "training order, augmentation and torch seeds");
   bool no_overlays = false;
   app.add_flag("--no-overlays", no_overlays,

@@ -20,6 +20,7 @@
 #include "hand/metrics.h"
 #include "network/poem/loss_plot.h"
 #include "network/poem/poem_trainer.h"
+#include "pipeline/adapt_thresholds.h"
 #include "pipeline/build_info.h"
 #include "pipeline/detect_capture.h"
 #include "pipeline/fit_capture.h"
@@ -65,7 +66,7 @@ std::string CpuModelName() {
 }
 
 // The run's state: its options, folders, frames and the seconds each stage took.
-struct Run {
+struct AdaptRun {
   AdaptOptions o;
   std::ostream* log = nullptr;
   fs::path out;
@@ -86,7 +87,7 @@ struct Run {
 
 // The split: the held-out frames, and the training frames (the rest, less the gap
 // before a default held-out block).
-void SplitFrames(Run* run) {
+void SplitFrames(AdaptRun* run) {
   const int n = static_cast<int>(run->frames.size());
   std::set<std::string> unused;
   if (!run->o.heldout.empty()) {
@@ -107,7 +108,7 @@ void SplitFrames(Run* run) {
 }
 
 // adapt.json: a folder holds one run; a later command must ask for the same one.
-void ClaimFolder(const Run& run) {
+void ClaimFolder(const AdaptRun& run) {
   const std::string path = run.Path("adapt.json");
   const nlohmann::json wanted = AdaptOptionsJson(run.o);
   if (fs::exists(path)) {
@@ -115,26 +116,31 @@ void ClaimFolder(const Run& run) {
     for (const auto& [key, value] : wanted.items()) {
       if (!had.contains(key) || had[key] != value) {
         throw InputError(path, key,
-                         value.dump() + " (this folder holds another run: use another "
-                                        "--out, or the same options to continue it)",
-                         had.contains(key) ? had[key].dump() : "nothing");
+                         (had.contains(key) ? had[key].dump() : "nothing") +
+                             ", the run's in this folder (another run needs another "
+                             "--out)",
+                         value.dump());
       }
     }
     run.Say("continuing the run in " + run.out.string());
     return;
   }
+  if (fs::exists(run.out) && !fs::is_empty(run.out)) {
+    throw InputError(run.out.string(), "--out", "a new or empty folder (or an adapt run's)",
+                     "a folder with other files and no adapt.json");
+  }
   fs::create_directories(run.out / "stages");
   WriteFileAtomically(path, wanted.dump(1) + "\n");
 }
 
-void LoadProgress(Run* run) {
+void LoadProgress(AdaptRun* run) {
   const std::string path = run->Path("progress.json");
   if (fs::exists(path)) run->progress = ReadJsonFileStrict(path)["seconds"];
 }
 
 // Runs a stage unless an earlier run finished it; records its seconds.
 template <typename StageFn>
-void RunStage(Run* run, const std::string& name, StageFn&& stage) {
+void RunStage(AdaptRun* run, const std::string& name, StageFn&& stage) {
   const std::string marker = run->Path("stages/" + name + ".done");
   if (fs::exists(marker)) {
     run->Say(name + ": done in an earlier run");
@@ -154,9 +160,10 @@ void RunStage(Run* run, const std::string& name, StageFn&& stage) {
   run->Say(name + ": done in " + FormatNumber(std::round(seconds)) + " s");
 }
 
-void DetectStage(const Run& run) {
+void DetectStage(const AdaptRun& run) {
   if (CaptureReader(run.o.capture_dir).Has(kFileDetections)) {
     run.Say("the capture has detections: they are the 2D evidence");
+    WriteFileAtomically(run.Path("detect.json"), "{\"ran\": false}\n");
     return;
   }
   DetectCaptureOptions detect;
@@ -169,10 +176,21 @@ void DetectStage(const Run& run) {
       });
   run.Say("detect: a hand in " + std::to_string(s.views_detected) + " of " +
           std::to_string(s.views) + " views");
+  WriteFileAtomically(run.Path("detect.json"),
+                      nlohmann::json{{"ran", true},
+                                     {"views", s.views},
+                                     {"views_detected", s.views_detected},
+                                     {"frames_with_hand", s.frames_with_hand}}
+                              .dump(1) +
+                          "\n");
+}
+
+nlohmann::json ReadIfExists(const std::string& path) {
+  return fs::exists(path) ? ReadJsonFileStrict(path) : nlohmann::json();
 }
 
 // A job over the capture's detections without masks (their 2D is the evidence).
-JobConfig CaptureJob(const Run& run, const std::string& name, const std::string& out) {
+JobConfig CaptureJob(const AdaptRun& run, const std::string& name, const std::string& out) {
   JobConfig job;
   job.source_file = "handlabel adapt";
   job.name = name;
@@ -187,7 +205,7 @@ JobConfig CaptureJob(const Run& run, const std::string& name, const std::string&
   return job;
 }
 
-LabelSummary RunJob(const Run& run, const JobConfig& job) {
+LabelSummary RunJob(const AdaptRun& run, const JobConfig& job) {
   job.Check(job.source_file);
   const BuiltLabelStages stages = BuildLabelStages(job);
   LabelRunOptions options;
@@ -196,14 +214,14 @@ LabelSummary RunJob(const Run& run, const JobConfig& job) {
   return RunLabelJob(job, stages.Set(), options);
 }
 
-void FitStage(const Run& run) {
+void FitStage(const AdaptRun& run) {
   JobConfig job = CaptureJob(run, "adapt-fit", run.Path("fit"));
   job.refine_mode = RefineMode::kAlways;
   job.overlays = false;
   RunJob(run, job);
 }
 
-CaptureTrainingInputs TrainingInputs(const Run& run) {
+CaptureTrainingInputs TrainingInputs(const AdaptRun& run) {
   CaptureTrainingInputs in;
   in.capture_dir = run.o.capture_dir;
   in.labels_dir = run.Path("fit/labels");
@@ -213,9 +231,8 @@ CaptureTrainingInputs TrainingInputs(const Run& run) {
   return in;
 }
 
-
 // The run's training: the starting weights' network on the capture's views.
-TrainConfig AdaptTrainConfig(const Run& run) {
+TrainConfig AdaptTrainConfig(const AdaptRun& run) {
   TrainConfig c;
   c.source_file = "handlabel adapt";
   c.network_name = "the starting weights' (" + run.o.weights + ")";
@@ -243,7 +260,7 @@ struct AdaptSamples {
   std::unique_ptr<CaptureTrainingSamples> train, heldout, batch_norm;
 };
 
-AdaptSamples LoadSamples(const Run& run, const TrainConfig& c, const HandModel& hand) {
+AdaptSamples LoadSamples(const AdaptRun& run, const TrainConfig& c, const HandModel& hand) {
   AdaptSamples s;
   s.data = LoadCaptureTrainingData(TrainingInputs(run), hand.num_vertices());
   s.train = std::make_unique<CaptureTrainingSamples>(*s.data.source, s.data.train,
@@ -258,11 +275,14 @@ AdaptSamples LoadSamples(const Run& run, const TrainConfig& c, const HandModel& 
   return s;
 }
 
-PoemTrainSummary TrainUntil(const Run& run, const TrainConfig& c, const HandModel& hand,
+PoemTrainSummary TrainUntil(const AdaptRun& run, const TrainConfig& c, const HandModel& hand,
                             const AdaptSamples& s, int64_t stop_at) {
   PoemTrainerOptions t = c.trainer;
-  t.validation_samples = static_cast<int>(s.data.validation.size());
-  if (!s.heldout) t.validate_every = 0;
+  t.validation_samples = std::max<int>(1, static_cast<int>(s.data.validation.size()));
+  if (!s.heldout) {
+    t.validate_every = 0;
+    t.validate_at_start = false;
+  }
   PoemTrainerHooks hooks;
   hooks.progress = [&run](const std::string& line) { run.Say("train: " + line); };
   const std::string dir = t.out_dir;
@@ -289,7 +309,7 @@ double MeasuredSecondsPerStep(const std::string& train_dir) {
 // How many steps the budget pays for: what is left of it after the stages so far and a
 // reserve for the ones after training (export, held-out jobs, the label job, which
 // fits where the network fails: about as long as the fit stage).
-nlohmann::json PlanTraining(const Run& run, double seconds_per_step) {
+nlohmann::json PlanTraining(const AdaptRun& run, double seconds_per_step) {
   const double reserve = 1.2 * run.progress.value("fit", 0.0) + 150;
   const double budget = run.o.budget_minutes * 60;
   const double left = budget - run.ElapsedSeconds() - reserve;
@@ -316,7 +336,7 @@ void ApplyPlan(const nlohmann::json& plan, TrainConfig* c) {
   c->trainer.validate_every = plan["validate_every"].get<int64_t>();
 }
 
-void TrainStage(Run* run) {
+void TrainStage(AdaptRun* run) {
   TrainConfig c = AdaptTrainConfig(*run);
   std::string hand_source;
   const HandModel hand = LoadTrainingHandModel(c, &hand_source);
@@ -363,7 +383,7 @@ std::vector<std::string> AveragedCheckpoints(const std::string& train_dir, int64
   return paths;
 }
 
-void ExportStage(const Run& run) {
+void ExportStage(const AdaptRun& run) {
   const TrainConfig c = AdaptTrainConfig(run);
   std::string hand_source;
   const HandModel hand = LoadTrainingHandModel(c, &hand_source);
@@ -386,37 +406,85 @@ void ExportStage(const Run& run) {
                           "\n");
 }
 
-// Mean keypoint and vertex distances (mm) of a job's labels to the fit labels.
-nlohmann::json DistanceToFitLabels(const Run& run, const std::string& job_dir) {
-  double joints = 0, vertices = 0;
-  int n = 0, passed = 0;
+// A job's held-out answers judged against their fit labels.
+std::vector<JudgedAnswer> JudgeAnswers(const AdaptRun& run, const std::string& job_dir,
+                                       double* mpvpe_mm) {
+  std::vector<JudgedAnswer> answers;
+  double vertices = 0;
   for (const std::string& id : run.heldout) {
     const LabelRecord answer = ReadLabelFile(LabelFilePath(job_dir, id));
     const LabelRecord fit = ReadLabelFile(LabelFilePath(run.Path("fit"), id));
-    joints += MeanPointError(answer.mesh.keypoints, fit.mesh.keypoints);
-    vertices += MeanPointError(answer.mesh.vertices, fit.mesh.vertices);
-    passed += answer.quality.Passed();
-    ++n;
+    answers.push_back(
+        {1000 * MeanPointError(answer.mesh.keypoints, fit.mesh.keypoints), answer.quality});
+    vertices += 1000 * MeanPointError(answer.mesh.vertices, fit.mesh.vertices);
   }
-  return {{"frames", n},
-          {"mpjpe_mm_vs_fit_labels", 1000 * joints / std::max(n, 1)},
-          {"mpvpe_mm_vs_fit_labels", 1000 * vertices / std::max(n, 1)},
+  *mpvpe_mm = vertices / std::max<size_t>(answers.size(), 1);
+  return answers;
+}
+
+nlohmann::json AnswersJson(const std::vector<JudgedAnswer>& answers, double mpvpe_mm) {
+  double joints = 0;
+  int passed = 0;
+  for (const JudgedAnswer& a : answers) {
+    joints += a.error_mm;
+    bool all = true;
+    for (const QualityFlag& f : a.quality.flags) all = all && f.passed;
+    passed += all;
+  }
+  return {{"frames", answers.size()},
+          {"mpjpe_mm_vs_fit_labels", joints / std::max<size_t>(answers.size(), 1)},
+          {"mpvpe_mm_vs_fit_labels", mpvpe_mm},
           {"passed_every_check", passed}};
 }
 
+// Whether each answer passes under other thresholds (the flags' values judged again).
+int PassingUnder(const std::vector<JudgedAnswer>& answers, const QualityThresholds& t) {
+  int passing = 0;
+  for (const JudgedAnswer& a : answers) {
+    bool all = true;
+    for (const QualityFlag& f : a.quality.flags) {
+      if (f.name == "reprojection") all = all && f.value <= t.max_reprojection_px;
+      else if (f.name == "view_agreement") all = all && f.value <= t.max_view_disagreement_mm;
+      else if (f.name == "detector_agreement") all = all && f.value <= t.max_detector_rms_px;
+      else all = all && f.passed;
+    }
+    passing += all;
+  }
+  return passing;
+}
+
+// The adapted network's thresholds, chosen on its held-out answers
+// (adapt_thresholds.h), for the label stage (heldout.json's thresholds).
+void ChooseAdaptedThresholds(const AdaptRun& run, const std::vector<JudgedAnswer>& answers,
+                             const QualityThresholds& current, nlohmann::json* result) {
+  std::vector<ThresholdChoice> choices;
+  const QualityThresholds chosen =
+      ChooseThresholds(answers, current, run.o.accept_mm, &choices);
+  nlohmann::json study = ThresholdChoicesJson(choices, run.o.accept_mm);
+  study["passing_current"] = PassingUnder(answers, current);
+  study["passing_chosen"] = PassingUnder(answers, chosen);
+  study["refine"] = {{"max_reprojection_px", chosen.max_reprojection_px},
+                     {"max_view_disagreement_mm", chosen.max_view_disagreement_mm},
+                     {"max_detector_rms_px", chosen.max_detector_rms_px}};
+  (*result)["thresholds"] = study;
+}
+
 // The network alone (no refine) before and after, on the held-out frames.
-void HeldoutStage(const Run& run) {
+void HeldoutStage(const AdaptRun& run) {
   nlohmann::json result = nlohmann::json::object();
   const std::pair<std::string, std::string> runs[] = {{"before", run.o.weights},
                                                       {"after", run.Path("network.pt")}};
-  for (const auto& [name, weights] : runs) {
+  for (auto [name, weights] : runs) {
     const int views = PoemCheckpointConfig(weights).num_views;
     if (views != run.num_cameras) {
-      result[name] = {{"weights", weights},
-                      {"skipped", "the weights are for " + std::to_string(views) +
-                                      " views, the capture has " +
-                                      std::to_string(run.num_cameras)}};
-      continue;
+      // The starting weights as they start the training: at the capture's view count.
+      const std::string converted = run.Path(
+          "heldout/start_weights_" + std::to_string(run.num_cameras) + "_views.pt");
+      WritePoemCheckpointForViews(weights, run.num_cameras, converted);
+      run.Say("heldout: the starting weights are for " + std::to_string(views) +
+              " views, measured at the capture's " + std::to_string(run.num_cameras) +
+              " (" + converted + ")");
+      weights = converted;
     }
     const std::string dir = run.Path("heldout/" + name);
     JobConfig job = CaptureJob(run, "adapt-heldout-" + name, dir);
@@ -424,8 +492,11 @@ void HeldoutStage(const Run& run) {
     job.network_weights = weights;
     job.refine_mode = RefineMode::kOff;
     const LabelSummary summary = RunJob(run, job);
-    result[name] = DistanceToFitLabels(run, dir);
+    double mpvpe_mm = 0;
+    const std::vector<JudgedAnswer> answers = JudgeAnswers(run, dir, &mpvpe_mm);
+    result[name] = AnswersJson(answers, mpvpe_mm);
     result[name]["weights"] = weights;
+    if (name == "after") ChooseAdaptedThresholds(run, answers, job.quality, &result);
     result[name]["job_metrics"] = summary.ToJson().value("metrics", nlohmann::json());
     run.Say("heldout: network " + name + ": " +
             FormatNumber(std::round(10 * result[name]["mpjpe_mm_vs_fit_labels"]
@@ -436,10 +507,17 @@ void HeldoutStage(const Run& run) {
   WriteFileAtomically(run.Path("heldout/heldout.json"), result.dump(1) + "\n");
 }
 
-void LabelStage(const Run& run) {
+void LabelStage(const AdaptRun& run) {
   JobConfig job = CaptureJob(run, "adapt-label", run.out.string());
   job.network_weights = run.Path("network.pt");
   job.refine_mode = RefineMode::kFallback;
+  const nlohmann::json heldout = ReadIfExists(run.Path("heldout/heldout.json"));
+  if (heldout.is_object() && heldout.contains("thresholds")) {
+    const nlohmann::json& refine = heldout["thresholds"]["refine"];
+    job.quality.max_reprojection_px = refine["max_reprojection_px"];
+    job.quality.max_view_disagreement_mm = refine["max_view_disagreement_mm"];
+    job.quality.max_detector_rms_px = refine["max_detector_rms_px"];
+  }
   RunJob(run, job);
 }
 
@@ -447,19 +525,20 @@ void LabelStage(const Run& run) {
 
 namespace {
 
-double FramesPerSecond(const Run& run, const std::string& stage) {
-  const double seconds = run.progress.value(stage, 0.0);
+// Frames per second of the stages together (0 when they took no time).
+double FramesPerSecond(const AdaptRun& run, std::initializer_list<const char*> stages) {
+  double seconds = 0;
+  for (const char* stage : stages) seconds += run.progress.value(stage, 0.0);
   return seconds > 0 ? run.frames.size() / seconds : 0.0;
 }
 
-nlohmann::json ReadIfExists(const std::string& path) {
-  return fs::exists(path) ? ReadJsonFileStrict(path) : nlohmann::json();
-}
 
 // What the network learned from, how long, and what it measures on held-out frames.
-nlohmann::json ModelCard(const Run& run) {
+nlohmann::json ModelCard(const AdaptRun& run) {
   const nlohmann::json selection = ReadJsonFileStrict(run.Path("train/capture_labels.json"));
   const nlohmann::json summary = ReadIfExists(run.Path("summary.json"));
+  const nlohmann::json detection = ReadIfExists(run.Path("detect.json"));
+  const bool detected = detection.is_object() && detection.value("ran", false);
   nlohmann::json card = {
       {"format", "handlabel-adapt-card"},
       {"capture", run.o.capture_dir},
@@ -477,9 +556,15 @@ nlohmann::json ModelCard(const Run& run) {
       {"plan", ReadJsonFileStrict(run.Path("train/plan.json"))},
       {"export", ReadIfExists(run.Path("export.json"))},
       {"heldout", ReadIfExists(run.Path("heldout/heldout.json"))},
-      {"labels_by_path", summary.value("by_path", nlohmann::json())},
-      {"frames_per_second", {{"fit_only", FramesPerSecond(run, "fit")},
-                             {"network_checks_fallback", FramesPerSecond(run, "label")}}},
+      {"labels_by_path",
+       summary.is_object() ? summary.value("by_path", nlohmann::json()) : nlohmann::json()},
+      // The label stage reuses the detections: the detector's time is not in it.
+      {"detection", detection},
+      {"frames_per_second",
+       {{"detect", detected ? FramesPerSecond(run, {"detect"}) : 0.0},
+        {"fit_only", FramesPerSecond(run, {"fit"})},
+        {"detect_and_fit", detected ? FramesPerSecond(run, {"detect", "fit"}) : 0.0},
+        {"network_checks_fallback", FramesPerSecond(run, {"label"})}}},
       {"seconds", run.progress},
       {"total_seconds", run.ElapsedSeconds()},
       {"version", GetBuildInfo().version}};
@@ -514,18 +599,35 @@ std::string ModelCardMarkdown(const nlohmann::json& card) {
        << HeldoutLine(card["heldout"], "before") << HeldoutLine(card["heldout"], "after")
        << "\n";
   }
+  if (card["heldout"].is_object() && card["heldout"].contains("thresholds")) {
+    const nlohmann::json& t = card["heldout"]["thresholds"];
+    md << "Quality-check thresholds chosen on the adapted answers (bad: farther than "
+       << t["accept_mm"] << " mm from the fit label; Youden's J):\n\n"
+       << "| check | current | chosen | J current | J chosen |\n|---|---|---|---|---|\n";
+    for (const nlohmann::json& c : t["checks"]) {
+      md << "| " << c["check"].get<std::string>() << " | " << c["current"] << " | "
+         << c["chosen"] << " | " << c["youden_current"] << " | " << c["youden_chosen"]
+         << " |\n";
+    }
+    md << "\nHeld-out answers passing every check: " << t["passing_current"]
+       << " with the current thresholds, " << t["passing_chosen"]
+       << " with the chosen ones. In a label job with this network:\n\n```\nrefine: "
+       << t["refine"].dump() << "\n```\n\n";
+  }
   md << "Labels (network + checks + fallback fit): " << card["labels_by_path"].dump()
-     << "; frames per second: fit only " << card["frames_per_second"]["fit_only"]
-     << ", network + checks + fallback " << card["frames_per_second"]["network_checks_fallback"]
-     << ".\n\nSeconds per stage: " << card["seconds"].dump() << ", total "
+     << ".\n\nFrames per second: detector " << card["frames_per_second"]["detect"]
+     << " (0: the capture had detections), fit only "
+     << card["frames_per_second"]["fit_only"]
+     << ", network + checks + fallback on the same detections "
+     << card["frames_per_second"]["network_checks_fallback"] << ".\n\nSeconds per stage: " << card["seconds"].dump() << ", total "
      << card["total_seconds"] << ".\n";
   return md.str();
 }
 
 // The run's frames (sorted, as jobs number them), cameras and weights.
-Run PrepareRun(const AdaptOptions& options, std::ostream* log) {
+AdaptRun PrepareRun(const AdaptOptions& options, std::ostream* log) {
   options.Check(kSource);
-  Run run;
+  AdaptRun run;
   run.o = options;
   run.log = log;
   run.o.capture_dir = fs::absolute(options.capture_dir).lexically_normal().string();
@@ -552,6 +654,7 @@ void AdaptOptions::Check(const std::string& source) const {
   RequireGreater(source, "--budget", budget_minutes, 0);
   RequireAtLeast(source, "--threads", threads, 1);
   RequireGreater(source, "--learning-rate", learning_rate, 0);
+  RequireGreater(source, "--accept-mm", accept_mm, 0);
   selection.Check(source);
 }
 
@@ -559,11 +662,12 @@ nlohmann::json AdaptOptionsJson(const AdaptOptions& o) {
   return {{"capture", o.capture_dir},        {"weights", o.weights},
           {"heldout", o.heldout},            {"label_min_views", o.selection.min_views},
           {"label_max_rms_px", o.selection.max_view_rms_px},
-          {"learning_rate", o.learning_rate}, {"seed", o.seed}};
+          {"learning_rate", o.learning_rate}, {"seed", o.seed},
+          {"accept_mm", o.accept_mm}};
 }
 
 AdaptSummary RunAdaptation(const AdaptOptions& options, std::ostream* log) {
-  Run run = PrepareRun(options, log);
+  AdaptRun run = PrepareRun(options, log);
   ClaimFolder(run);
   LoadProgress(&run);
   run.Say(std::to_string(run.frames.size()) + " frames, " + std::to_string(run.train.size()) +

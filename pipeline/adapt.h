@@ -14,9 +14,10 @@
 //             rate), batch-norm statistics measured again on the capture's training
 //             frames, float16: <out>/network.pt
 //   heldout   network-only jobs with the starting and the adapted weights on the
-//             held-out frames, compared with their fit labels: <out>/heldout/
-//   label     the capture labelled by network + quality checks + fallback fit:
-//             <out>/labels/, <out>/summary.json (the label job layout)
+//             held-out frames, compared with their fit labels, and the quality
+//             checks' thresholds chosen on the adapted answers: <out>/heldout/
+//   label     the capture labelled by network + quality checks (those thresholds)
+//             + fallback fit: <out>/labels/, <out>/summary.json (the label job layout)
 // <out>/model_card.json and .md say what the network learned from, how long, and the
 // held-out numbers; <out>/progress.json the seconds each stage took.
 
@@ -44,6 +45,10 @@ struct AdaptOptions {
   std::string heldout;
   LabelSelectionRule selection;
   double learning_rate = 1e-4;
+  // The label stage's quality-check thresholds are chosen on the adapted network's
+  // held-out answers (pipeline/adapt_thresholds.h): an answer farther than this from
+  // its fit label (mean keypoint distance, mm) counts as bad.
+  double accept_mm = 10;
   uint64_t seed = 1;  // training order, augmentation and torch seeds
   // Also write overlay pictures of the held-out and final labels.
   bool overlays = true;

@@ -136,6 +136,7 @@ void ReadRefineSection(Section& top, const std::string& path, JobConfig* job) {
                                            path, refine.Name("mode"));
   refine.Read("max_reprojection_px", &job->quality.max_reprojection_px);
   refine.Read("max_view_disagreement_mm", &job->quality.max_view_disagreement_mm);
+  refine.Read("max_detector_rms_px", &job->quality.max_detector_rms_px);
   refine.Read("min_confidence", &job->quality.min_confidence);
   refine.Read("min_views", &job->quality.min_views);
   refine.Read("min_hand_span_m", &job->quality.min_hand_span_m);
@@ -252,6 +253,7 @@ void JobConfig::Check(const std::string& source) const {
   RequireGreater(source, "refine.max_reprojection_px", quality.max_reprojection_px, 0);
   RequireGreater(source, "refine.max_view_disagreement_mm",
                  quality.max_view_disagreement_mm, 0);
+  RequireGreater(source, "refine.max_detector_rms_px", quality.max_detector_rms_px, 0);
   RequireInRange(source, "refine.min_confidence", quality.min_confidence, 0, 1,
                  "a value in [0, 1]");
   RequireAtLeast(source, "refine.min_views", quality.min_views, 1);

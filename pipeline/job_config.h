@@ -25,6 +25,12 @@ struct QualityThresholds {
   double max_reprojection_px = 12.3;
   // Largest distance (mm) between the triangulated 2D keypoints and the mesh keypoints.
   double max_view_disagreement_mm = 6.1;
+  // Where the frame has 2D keypoints from files (a detector's) and the job uses them
+  // (evidence.keypoints_2d files or both): largest median over those views of the RMS
+  // pixel distance between the answer's projected keypoints and the files' keypoints
+  // (check detector_agreement). Chosen on the real capture's held-out frames
+  // (docs/adapt.md).
+  double max_detector_rms_px = 12;
   // Views whose keypoint confidence is below this do not count as evidence.
   double min_confidence = 0.3;
   // Fewest views with the hand visible for a frame to be labelled at all.

@@ -169,6 +169,10 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
       job.refine_mode != RefineMode::kOff) {
     extra["refine_against_files"] = {job.refine_network_sigma_mm, job.refine_restart_px};
   }
+  // The network's answer judged against the file 2D too (issue 43).
+  if (!weights_sha256.empty() && job.keypoints != KeypointSource::kNetwork) {
+    extra["detector_agreement"] = q.max_detector_rms_px;
+  }
   if (!extra.empty()) j["added"] = extra;
   return Sha256Hex(j.dump());
 }

@@ -109,7 +109,10 @@ class FrameLabeler {
     label.provenance = context_.provenance;
     label.fit = nullptr;
     if (prediction_) {
-      label.quality = CheckPrediction(frame_.rig, *prediction_, job_.quality);
+      // The frame's file 2D judge the answer too, where the job uses them.
+      const bool files = job_.keypoints != KeypointSource::kNetwork;
+      label.quality = CheckPrediction(frame_.rig, *prediction_, job_.quality,
+                                      files ? &frame_.keypoints_2d : nullptr);
     }
     Choose(&label);
     if (!label.mesh.vertices.array().isFinite().all() ||

@@ -1,5 +1,6 @@
 #include "pipeline/quality_checks.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -139,6 +140,43 @@ QualityFlag ViewAgreementFlag(const Rig& rig, const MeshPrediction& prediction,
   return agreement;
 }
 
+// The median over the views with file 2D (a detector's) of the RMS pixel distance
+// between the answer's projected keypoints and that view's confident keypoints. The
+// median, because one view's detector can lock onto the wrong hand or finger.
+QualityFlag DetectorAgreementFlag(const Rig& rig, const MeshPrediction& prediction,
+                                  const std::vector<std::optional<Keypoints2d>>& files,
+                                  const QualityThresholds& t) {
+  std::vector<double> view_rms;
+  for (size_t v = 0; v < files.size() && v < rig.size(); ++v) {
+    if (!files[v] || !(files[v]->confidence.mean() >= t.min_confidence)) continue;
+    double sum_sq = 0;
+    int count = 0;
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      if (!(files[v]->confidence(k) >= t.min_confidence)) continue;
+      Eigen::Vector2d uv;
+      const bool in_front =
+          rig[v].ProjectWorld(prediction.keypoints.row(k).transpose(), &uv);
+      const double err =
+          in_front ? (uv - files[v]->uv_px.row(k).transpose()).norm() : kInf;
+      sum_sq += err * err;
+      ++count;
+    }
+    if (count > 0) view_rms.push_back(std::sqrt(sum_sq / count));
+  }
+  QualityFlag flag{"detector_agreement", false, kInf, t.max_detector_rms_px, ""};
+  if (view_rms.empty()) {
+    flag.detail = "no view with confident file 2D keypoints";
+    return flag;
+  }
+  std::sort(view_rms.begin(), view_rms.end());
+  const size_t n = view_rms.size();
+  flag.value = n % 2 ? view_rms[n / 2] : 0.5 * (view_rms[n / 2 - 1] + view_rms[n / 2]);
+  flag.passed = flag.value <= t.max_detector_rms_px;
+  flag.detail = "median over " + std::to_string(n) + " views with file 2D: RMS " +
+                Format(flag.value) + " px";
+  return flag;
+}
+
 }  // namespace
 
 nlohmann::json QualityFlagJson(const QualityFlag& f) {
@@ -165,7 +203,8 @@ std::string QualityReport::FailedNames() const {
 }
 
 QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
-                              const QualityThresholds& t) {
+                              const QualityThresholds& t,
+                              const std::vector<std::optional<Keypoints2d>>* file_2d) {
   QualityReport report;
   const int num_views = static_cast<int>(rig.size());
   const bool shapes_ok = prediction.keypoints.rows() == kNumHandKeypoints &&
@@ -178,7 +217,10 @@ QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
                              : Format(finite.value) + " non-finite values";
   if (!finite.passed) {
     report.flags.push_back(finite);
-    for (const char* name : {"range", "enough_views", "reprojection", "view_agreement"}) {
+    std::vector<std::string> names = {"range", "enough_views", "reprojection",
+                                      "view_agreement"};
+    if (file_2d && !file_2d->empty()) names.push_back("detector_agreement");
+    for (const std::string& name : names) {
       report.flags.push_back(
           {name, false, kInf, 0, "not checked: prediction not finite"});
     }
@@ -198,6 +240,9 @@ QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
   report.flags.push_back(
       ReprojectionFlag(rig, prediction, confident, confident_views, t));
   report.flags.push_back(ViewAgreementFlag(rig, prediction, confident, t));
+  if (file_2d && !file_2d->empty()) {
+    report.flags.push_back(DetectorAgreementFlag(rig, prediction, *file_2d, t));
+  }
   return report;
 }
 

@@ -7,6 +7,7 @@
 // Thresholds come from the job's `refine` section (QualityThresholds).
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,7 +18,8 @@
 namespace handlabel {
 
 struct QualityFlag {
-  std::string name;  // finite | range | enough_views | reprojection | view_agreement
+  // finite | range | enough_views | reprojection | view_agreement | detector_agreement
+  std::string name;
   bool passed = false;
   double value = 0;      // the measured quantity (units in `detail`)
   double threshold = 0;  // what it was compared with
@@ -45,8 +47,16 @@ struct QualityReport {
 //                   and 2D keypoints <= max_reprojection_px (value: px)
 //   view_agreement  mean distance between keypoints triangulated from the confident
 //                   views and the 3D keypoints <= max_view_disagreement_mm (value: mm)
-QualityReport CheckPrediction(const Rig& rig, const MeshPrediction& prediction,
-                              const QualityThresholds& thresholds);
+// With `file_2d` (the frame's 2D keypoints from files, one entry per view, e.g. a
+// detector's; not null and not empty), one more, judged against evidence the network
+// did not make:
+//   detector_agreement  median over the views with confident file 2D of the RMS pixel
+//                   distance between projected 3D keypoints and the file's confident
+//                   keypoints <= max_detector_rms_px (value: px); fails when no view
+//                   has confident file 2D
+QualityReport CheckPrediction(
+    const Rig& rig, const MeshPrediction& prediction, const QualityThresholds& thresholds,
+    const std::vector<std::optional<Keypoints2d>>* file_2d = nullptr);
 
 // Silhouette conflict: does a fit with silhouettes still agree with the 2D keypoints,
 // and does its hand cover the observed hand mask? Masks show the visible hand only, and

@@ -544,6 +544,16 @@ PoemConfig PoemCheckpointConfig(const std::string& path) {
   return ReadPoemCheckpointConfig(path);
 }
 
+void WritePoemCheckpointForViews(const std::string& in_path, int num_views,
+                                 const std::string& out_path) {
+  PoemConfig config = ReadPoemCheckpointConfig(in_path);
+  config.num_views = num_views;
+  PoemModel model(config);
+  LoadPoemCheckpointInto(model, in_path, /*as_init_weights=*/true);
+  model->to(torch::kHalf);
+  SavePoemCheckpoint(model, out_path);
+}
+
 void ConvertPoemCheckpointToHalf(const std::string& in_path,
                                  const std::string& out_path) {
   ExportPoemCheckpointAverageAsHalf({in_path}, out_path);  // the mean of one is itself

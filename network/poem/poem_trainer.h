@@ -133,6 +133,12 @@ std::string LatestPoemCheckpointModel(const std::string& out_dir);
 // pipeline/). Throws InputError naming the file when it is not one.
 PoemConfig PoemCheckpointConfig(const std::string& path);
 
+// Writes the weights of an own POEM checkpoint for a rig of `num_views` cameras (no
+// parameter depends on the view count; only the config changes), e.g. to measure
+// 8-view weights on a 5-camera rig before adapting them. float16 storage.
+void WritePoemCheckpointForViews(const std::string& in_path, int num_views,
+                                 const std::string& out_path);
+
 // Rewrites an own POEM checkpoint with float16 storage (about half the size; it loads
 // with LoadPoemCheckpoint like any other, converted back to float32).
 void ConvertPoemCheckpointToHalf(const std::string& in_path, const std::string& out_path);

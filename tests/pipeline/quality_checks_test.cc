@@ -3,7 +3,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <vector>
 
 #include "core/errors.h"
 #include "tests/pipeline/label_test_stages.h"
@@ -60,6 +63,60 @@ TEST(QualityChecks, A3dOffsetFailsReprojectionAndViewAgreementWithTheRightSize) 
   EXPECT_NEAR(Flag(report, "view_agreement").value, 20.0, 1e-6);  // exactly the offset
   // 2 cm at ~0.6 m with f = 600 px moves a point by up to ~20 px.
   EXPECT_GT(Flag(report, "reprojection").value, 12.0);
+}
+
+// A self-consistent answer away from the hand passes the checks against its own 2D;
+// only the detector's 2D exposes it. The value is the median view's RMS, so one view
+// whose detector found something else does not fail a good answer.
+TEST(QualityChecks, DetectorAgreementJudgesTheAnswerAgainstFile2d) {
+  const Rig rig = MakeFourCameraRig();
+  const MeshPrediction truth = ExactPrediction(rig);
+  std::vector<std::optional<Keypoints2d>> files(truth.keypoints_2d.begin(),
+                                                truth.keypoints_2d.end());
+  files[2]->uv_px.col(0).array() += 100.0;  // one view's detector is far off
+  files[3].reset();                         // and one view has no detection
+  const QualityReport exact = CheckPrediction(rig, truth, {}, &files);
+  ASSERT_EQ(exact.flags.size(), 6u);
+  EXPECT_TRUE(exact.Passed()) << exact.FailedNames();
+  // Views 0 and 1 agree exactly, view 2 is 100 px off: the median of {0, 0, 100}.
+  EXPECT_NEAR(Flag(exact, "detector_agreement").value, 0.0, 1e-6);
+
+  // The whole answer moved 2 cm with its own 2D projected along: self-consistent.
+  MeshPrediction moved = truth;
+  moved.keypoints.rowwise() += Eigen::RowVector3d(0.02, 0, 0);
+  moved.keypoints_2d.clear();
+  for (const RigCamera& camera : rig.cameras()) {
+    moved.keypoints_2d.push_back(ProjectKeypoints(camera, moved.keypoints));
+  }
+  EXPECT_TRUE(CheckPrediction(rig, moved, {}).Passed());
+  const QualityReport judged = CheckPrediction(rig, moved, {}, &files);
+  EXPECT_EQ(judged.FailedNames(), "detector_agreement");
+  // The median of views 0, 1 and 2 (each view's RMS of its 21 keypoints' shift),
+  // computed here from the projections.
+  std::vector<double> rms;
+  for (int v = 0; v < 3; ++v) {
+    const Keypoints2d now = ProjectKeypoints(rig[v], moved.keypoints);
+    rms.push_back(std::sqrt((now.uv_px - files[v]->uv_px).rowwise().squaredNorm().mean()));
+  }
+  std::sort(rms.begin(), rms.end());
+  EXPECT_NEAR(Flag(judged, "detector_agreement").value, rms[1], 1e-9);
+
+  QualityThresholds loose;
+  loose.max_detector_rms_px = rms[1] + 1;
+  EXPECT_TRUE(CheckPrediction(rig, moved, loose, &files).Passed());
+}
+
+TEST(QualityChecks, DetectorAgreementFailsWithoutAConfidentFileView) {
+  const Rig rig = MakeFourCameraRig();
+  const MeshPrediction truth = ExactPrediction(rig);
+  std::vector<std::optional<Keypoints2d>> files(rig.size());
+  files[0] = truth.keypoints_2d[0];
+  files[0]->confidence.setConstant(0.1);  // below min_confidence
+  const QualityReport report = CheckPrediction(rig, truth, {}, &files);
+  EXPECT_EQ(report.FailedNames(), "detector_agreement");
+  // No file 2D at all (an empty list): the check is not made.
+  const std::vector<std::optional<Keypoints2d>> none;
+  EXPECT_EQ(CheckPrediction(rig, truth, {}, &none).flags.size(), 5u);
 }
 
 TEST(QualityChecks, ThresholdsComeFromTheJob) {

@@ -5,6 +5,7 @@
 #include "core/errors.h"
 #include "network/poem/poem_checkpoint.h"
 #include "network/poem/poem_loss.h"
+#include "network/poem/poem_trainer.h"
 #include "tests/network/poem/poem_test_util.h"
 
 namespace handlabel {
@@ -141,7 +142,8 @@ TEST(PoemCheckpoint, RefusesOtherConfigNamingTheDifference) {
 // it): every tensor arrives unchanged, while another difference is still refused.
 TEST(PoemCheckpoint, InitWeightsOfAnotherViewCountLoadUnchanged) {
   PoemModel model = MakeRandomPoemModel(TinyPoemConfig(2), 11);
-  const std::string path = testing::ScratchDir() + "/tiny_2views.pt";
+  const std::string dir = testing::ScratchDir();
+  const std::string path = dir + "/tiny_2views.pt";
   SavePoemCheckpoint(model, path);
   PoemModel three(TinyPoemConfig(3));
   LoadPoemCheckpointInto(three, path, /*as_init_weights=*/true);
@@ -155,6 +157,18 @@ TEST(PoemCheckpoint, InitWeightsOfAnotherViewCountLoadUnchanged) {
   wider.crop_size *= 2;
   PoemModel other(wider);
   EXPECT_THROW(LoadPoemCheckpointInto(other, path, /*as_init_weights=*/true), InputError);
+
+  // The same weights written for a 3-camera rig (float16 storage): a checkpoint that
+  // loads on its own, with every tensor the 2-view one rounded to half precision.
+  const std::string converted = dir + "/tiny_3views.pt";
+  WritePoemCheckpointForViews(path, 3, converted);
+  EXPECT_EQ(ReadPoemCheckpointConfig(converted).num_views, 3);
+  PoemModel loaded = LoadPoemCheckpoint(converted);
+  for (const auto& [key, value] : PoemStateDict(loaded)) {
+    ASSERT_TRUE(saved.count(key)) << key;
+    const torch::Tensor expected = saved.at(key).to(torch::kHalf).to(value.dtype());
+    EXPECT_TRUE(torch::equal(value, expected)) << key;
+  }
 }
 
 TEST(PoemCheckpoint, StateDictMismatchListsKeysAndShapes) {
