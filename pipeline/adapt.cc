@@ -221,12 +221,30 @@ void FitStage(const AdaptRun& run) {
   RunJob(run, job);
 }
 
+// The frames the fit labelled (it fails a frame whose detections do not pin the hand
+// down, e.g. in fewer than two views): only they can teach or measure.
+std::vector<std::string> WithFitLabel(const AdaptRun& run,
+                                      const std::vector<std::string>& frames) {
+  std::vector<std::string> labelled;
+  for (const std::string& id : frames) {
+    if (fs::exists(LabelFilePath(run.Path("fit"), id))) labelled.push_back(id);
+  }
+  return labelled;
+}
+
 CaptureTrainingInputs TrainingInputs(const AdaptRun& run) {
   CaptureTrainingInputs in;
   in.capture_dir = run.o.capture_dir;
   in.labels_dir = run.Path("fit/labels");
-  in.train_frames = Join(run.train, ",");
-  in.val_frames = Join(run.heldout, ",");
+  const std::vector<std::string> train = WithFitLabel(run, run.train);
+  if (train.empty()) {
+    throw InputError(run.Path("fit/labels"), "labels",
+                     "fit labels of some training frames (the fit failed every one: "
+                     "see fit/summary.md)",
+                     "none of " + std::to_string(run.train.size()));
+  }
+  in.train_frames = Join(train, ",");
+  in.val_frames = Join(WithFitLabel(run, run.heldout), ",");
   in.selection = run.o.selection;
   return in;
 }
@@ -345,9 +363,11 @@ void TrainStage(AdaptRun* run) {
                       LabelSelectionJson(run->o.selection, samples.data.selection).dump(1) +
                           "\n");
   run->Say("train: " + std::to_string(samples.data.train.size()) + " of " +
-           std::to_string(samples.data.selection.size()) +
-           " training frames kept (train/capture_labels.json), " +
-           std::to_string(samples.data.validation.size()) + " held out");
+           std::to_string(run->train.size()) + " training frames kept (" +
+           std::to_string(run->train.size() - samples.data.selection.size()) +
+           " without a fit label; train/capture_labels.json), " +
+           std::to_string(samples.data.validation.size()) + " of " +
+           std::to_string(run->heldout.size()) + " held-out frames with a fit label");
   const std::string plan_path = run->Path("train/plan.json");
   if (!fs::exists(plan_path)) {
     const Clock::time_point t0 = Clock::now();
@@ -411,7 +431,7 @@ std::vector<JudgedAnswer> JudgeAnswers(const AdaptRun& run, const std::string& j
                                        double* mpvpe_mm) {
   std::vector<JudgedAnswer> answers;
   double vertices = 0;
-  for (const std::string& id : run.heldout) {
+  for (const std::string& id : WithFitLabel(run, run.heldout)) {
     const LabelRecord answer = ReadLabelFile(LabelFilePath(job_dir, id));
     const LabelRecord fit = ReadLabelFile(LabelFilePath(run.Path("fit"), id));
     answers.push_back(
@@ -548,6 +568,7 @@ nlohmann::json ModelCard(const AdaptRun& run) {
       {"start_weights", run.o.weights},
       {"network", run.Path("network.pt")},
       {"training_frames", run.train.size()},
+      {"training_frames_with_fit_label", selection["training_frames"]},
       {"training_labels_kept", selection["kept"]},
       {"selection_rule", selection["rule"]},
       {"heldout_frames",
@@ -571,13 +592,21 @@ nlohmann::json ModelCard(const AdaptRun& run) {
   return card;
 }
 
+// A number of the card for reading: 3 significant digits.
+std::string Sig(const nlohmann::json& value) {
+  if (!value.is_number()) return value.dump();
+  std::ostringstream out;
+  out.precision(3);
+  out << value.get<double>();
+  return out.str();
+}
+
 std::string HeldoutLine(const nlohmann::json& h, const std::string& name) {
   if (!h.contains(name)) return "";
   const nlohmann::json& r = h[name];
-  if (r.contains("skipped")) return "| " + name + " | skipped: " + r["skipped"].get<std::string>() + " | | |\n";
-  return "| " + name + " | " + FormatNumber(std::round(10 * r["mpjpe_mm_vs_fit_labels"].get<double>()) / 10) +
-         " | " + FormatNumber(std::round(10 * r["mpvpe_mm_vs_fit_labels"].get<double>()) / 10) +
-         " | " + r["passed_every_check"].dump() + " of " + r["frames"].dump() + " |\n";
+  return "| " + name + " | " + Sig(r["mpjpe_mm_vs_fit_labels"]) + " | " +
+         Sig(r["mpvpe_mm_vs_fit_labels"]) + " | " + r["passed_every_check"].dump() +
+         " of " + r["frames"].dump() + " |\n";
 }
 
 std::string ModelCardMarkdown(const nlohmann::json& card) {
@@ -585,9 +614,10 @@ std::string ModelCardMarkdown(const nlohmann::json& card) {
   const nlohmann::json& plan = card["plan"];
   md << "# Adapted network: " << card["network"].get<std::string>() << "\n\n"
      << "Started from " << card["start_weights"].get<std::string>() << ", trained "
-     << plan["steps"] << " steps (" << plan["seconds_per_step"] << " s/step on "
+     << plan["steps"] << " steps (" << Sig(plan["seconds_per_step"]) << " s/step on "
      << plan["threads"] << " threads of " << plan["cpu"].get<std::string>() << ") on "
-     << card["training_labels_kept"] << " of " << card["training_frames"]
+     << card["training_labels_kept"] << " of " << card["training_frames"] << " ("
+     << card["training_frames_with_fit_label"] << " with a fit label)"
      << " training frames of " << card["capture"].get<std::string>() << " ("
      << card["cameras"] << " cameras), their fit labels kept by the rule: "
      << card["selection_rule"].get<std::string>() << ".\n\n";
@@ -605,22 +635,30 @@ std::string ModelCardMarkdown(const nlohmann::json& card) {
        << t["accept_mm"] << " mm from the fit label; Youden's J):\n\n"
        << "| check | current | chosen | J current | J chosen |\n|---|---|---|---|---|\n";
     for (const nlohmann::json& c : t["checks"]) {
-      md << "| " << c["check"].get<std::string>() << " | " << c["current"] << " | "
-         << c["chosen"] << " | " << c["youden_current"] << " | " << c["youden_chosen"]
-         << " |\n";
+      md << "| " << c["check"].get<std::string>() << " | " << Sig(c["current"]) << " | "
+         << Sig(c["chosen"]) << " | " << Sig(c["youden_current"]) << " | "
+         << Sig(c["youden_chosen"]) << " |\n";
     }
     md << "\nHeld-out answers passing every check: " << t["passing_current"]
        << " with the current thresholds, " << t["passing_chosen"]
        << " with the chosen ones. In a label job with this network:\n\n```\nrefine: "
-       << t["refine"].dump() << "\n```\n\n";
+       << "{max_reprojection_px: " << Sig(t["refine"]["max_reprojection_px"])
+       << ", max_view_disagreement_mm: " << Sig(t["refine"]["max_view_disagreement_mm"])
+       << ", max_detector_rms_px: " << Sig(t["refine"]["max_detector_rms_px"])
+       << "}\n```\n\n";
   }
   md << "Labels (network + checks + fallback fit): " << card["labels_by_path"].dump()
-     << ".\n\nFrames per second: detector " << card["frames_per_second"]["detect"]
+     << ".\n\nFrames per second: detector " << Sig(card["frames_per_second"]["detect"])
      << " (0: the capture had detections), fit only "
-     << card["frames_per_second"]["fit_only"]
+     << Sig(card["frames_per_second"]["fit_only"])
      << ", network + checks + fallback on the same detections "
-     << card["frames_per_second"]["network_checks_fallback"] << ".\n\nSeconds per stage: " << card["seconds"].dump() << ", total "
-     << card["total_seconds"] << ".\n";
+     << Sig(card["frames_per_second"]["network_checks_fallback"])
+     << ".\n\nSeconds per stage:";
+  for (const auto& [stage, seconds] : card["seconds"].items()) {
+    md << " " << stage << " " << Sig(seconds);
+  }
+  md << "; total " << Sig(card["total_seconds"]) << " (" << Sig(card["total_seconds"].get<double>() / 60)
+     << " min).\n";
   return md.str();
 }
 
