@@ -52,7 +52,10 @@ TEST_F(LabelNetwork, RefineOffLabelsEveryFrameWithTheNetworkAndItsQualityFlags) 
   EXPECT_THAT(r.err, HasSubstr("2 labelled (network 2)"));
   const LabelRecord label = ReadLabelFile(LabelFilePath(dir_ + "/off-none", "000000"));
   EXPECT_EQ(label.path, LabelPath::kNetwork);
-  EXPECT_EQ(label.quality.flags.size(), 5u);
+  // The five checks against the network's own 2D, and detector_agreement: the job's
+  // evidence (keypoints_2d: both) includes the capture's file 2D.
+  ASSERT_EQ(label.quality.flags.size(), 6u);
+  EXPECT_EQ(label.quality.flags.back().name, "detector_agreement");
   EXPECT_EQ(label.mesh.vertices.rows(), 778);
   EXPECT_EQ(label.provenance.weights_sha256, Sha256OfFile(dir_ + "/tiny.pt"));
   EXPECT_THAT(label.provenance.network_model, HasSubstr("poem"));
