@@ -457,36 +457,18 @@ nlohmann::json AnswersJson(const std::vector<JudgedAnswer>& answers, double mpvp
           {"passed_every_check", passed}};
 }
 
-// Whether each answer passes under other thresholds (the flags' values judged again).
-int PassingUnder(const std::vector<JudgedAnswer>& answers, const QualityThresholds& t) {
-  int passing = 0;
-  for (const JudgedAnswer& a : answers) {
-    bool all = true;
-    for (const QualityFlag& f : a.quality.flags) {
-      if (f.name == "reprojection") all = all && f.value <= t.max_reprojection_px;
-      else if (f.name == "view_agreement") all = all && f.value <= t.max_view_disagreement_mm;
-      else if (f.name == "detector_agreement") all = all && f.value <= t.max_detector_rms_px;
-      else all = all && f.passed;
-    }
-    passing += all;
-  }
-  return passing;
-}
-
 // The adapted network's thresholds, chosen on its held-out answers
 // (adapt_thresholds.h), for the label stage (heldout.json's thresholds).
 void ChooseAdaptedThresholds(const AdaptRun& run, const std::vector<JudgedAnswer>& answers,
                              const QualityThresholds& current, nlohmann::json* result) {
-  std::vector<ThresholdChoice> choices;
+  ThresholdStudy study;
   const QualityThresholds chosen =
-      ChooseThresholds(answers, current, run.o.accept_mm, &choices);
-  nlohmann::json study = ThresholdChoicesJson(choices, run.o.accept_mm);
-  study["passing_current"] = PassingUnder(answers, current);
-  study["passing_chosen"] = PassingUnder(answers, chosen);
-  study["refine"] = {{"max_reprojection_px", chosen.max_reprojection_px},
-                     {"max_view_disagreement_mm", chosen.max_view_disagreement_mm},
-                     {"max_detector_rms_px", chosen.max_detector_rms_px}};
-  (*result)["thresholds"] = study;
+      ChooseThresholds(answers, current, run.o.accept_mm, &study);
+  nlohmann::json json = study.ToJson();
+  json["refine"] = {{"max_reprojection_px", chosen.max_reprojection_px},
+                    {"max_view_disagreement_mm", chosen.max_view_disagreement_mm},
+                    {"max_detector_rms_px", chosen.max_detector_rms_px}};
+  (*result)["thresholds"] = json;
 }
 
 // The network alone (no refine) before and after, on the held-out frames.
@@ -632,16 +614,17 @@ std::string ModelCardMarkdown(const nlohmann::json& card) {
   if (card["heldout"].is_object() && card["heldout"].contains("thresholds")) {
     const nlohmann::json& t = card["heldout"]["thresholds"];
     md << "Quality-check thresholds chosen on the adapted answers (bad: farther than "
-       << t["accept_mm"] << " mm from the fit label; Youden's J):\n\n"
-       << "| check | current | chosen | J current | J chosen |\n|---|---|---|---|---|\n";
+       << Sig(t["accept_mm"]) << " mm from the fit label; " << t["bad_answers"]
+       << " of " << t["bad_answers"].get<int>() + t["good_answers"].get<int>()
+       << " are): the joint decision's Youden's J " << Sig(t["youden_current"]) << " -> "
+       << Sig(t["youden_chosen"]) << ", answers kept " << t["kept_current"] << " ("
+       << t["kept_bad_current"] << " bad) -> " << t["kept_chosen"] << " ("
+       << t["kept_bad_chosen"] << " bad).\n\n| check | current | chosen |\n|---|---|---|\n";
     for (const nlohmann::json& c : t["checks"]) {
       md << "| " << c["check"].get<std::string>() << " | " << Sig(c["current"]) << " | "
-         << Sig(c["chosen"]) << " | " << Sig(c["youden_current"]) << " | "
-         << Sig(c["youden_chosen"]) << " |\n";
+         << Sig(c["chosen"]) << " |\n";
     }
-    md << "\nHeld-out answers passing every check: " << t["passing_current"]
-       << " with the current thresholds, " << t["passing_chosen"]
-       << " with the chosen ones. In a label job with this network:\n\n```\nrefine: "
+    md << "\nIn a label job with this network:\n\n```\nrefine: "
        << "{max_reprojection_px: " << Sig(t["refine"]["max_reprojection_px"])
        << ", max_view_disagreement_mm: " << Sig(t["refine"]["max_view_disagreement_mm"])
        << ", max_detector_rms_px: " << Sig(t["refine"]["max_detector_rms_px"])
