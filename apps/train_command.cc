@@ -109,9 +109,10 @@ void AddTrainOptions(CLI::App* app, TrainFlags* f) {
       ->needs(export_option);
   app->add_option("--bn-samples", f->bn_samples,
                   "with --average: measure the mean's batch-norm statistics again on "
-                  "this many training samples of the config's data (SWA's batch-norm "
-                  "update) instead of averaging the checkpoints' statistics; 0 = average "
-                  "them")
+                  "this many training samples of the config's data, or with --capture "
+                  "of the capture's training frames as inference crops them (SWA's "
+                  "batch-norm update), instead of averaging the checkpoints' "
+                  "statistics; 0 = average them")
       ->needs("--average")
       ->check(CLI::NonNegativeNumber);
   AddCaptureOptions(app, f);
@@ -140,6 +141,16 @@ TrainConfig LoadConfigWithOverrides(const TrainFlags& f) {
 void ExportAverage(const TrainConfig& config, const TrainFlags& f) {
   if (f.bn_samples == 0) {
     ExportPoemCheckpointAverageAsHalf(f.average, f.export_path);
+  } else if (!f.capture.capture_dir.empty()) {
+    // With --capture: on the capture's training frames, cropped as inference crops
+    // them (no augmentation), the domain the weights will label.
+    std::string hand_source;
+    const HandModel hand = LoadTrainingHandModel(config, &hand_source);
+    const CaptureTrainingData data = LoadCaptureTrainingData(f.capture, hand.num_vertices());
+    const CaptureTrainingSamples train(*data.source, data.train,
+                                       CaptureSampleOptionsFor(config, true));
+    ExportPoemCheckpointAverageAsHalf(f.average, f.export_path, &train, f.bn_samples,
+                                      config.trainer.batch_size);
   } else {
     std::string hand_source;
     const HandModel hand = LoadTrainingHandModel(config, &hand_source);
@@ -147,10 +158,12 @@ void ExportAverage(const TrainConfig& config, const TrainFlags& f) {
     ExportPoemCheckpointAverageAsHalf(f.average, f.export_path, &train, f.bn_samples,
                                       config.trainer.batch_size);
   }
+  const std::string bn_data =
+      f.capture.capture_dir.empty() ? " samples" : " samples of the capture's frames";
   std::cout << "wrote " << f.export_path << " (mean of " << f.average.size()
             << " checkpoints"
             << (f.bn_samples > 0 ? ", batch-norm statistics from " +
-                                       std::to_string(f.bn_samples) + " samples"
+                                       std::to_string(f.bn_samples) + bn_data
                                  : std::string())
             << ", float16)\n";
 }

@@ -258,6 +258,44 @@ TEST(TrainCommand, TrainsOnACapturesLabelsAndValidatesBeforeTheFirstStep) {
   EXPECT_THAT(no_labels.err, HasSubstr("--labels"));
 }
 
+// The batch-norm update of an averaged export measures on the capture's training
+// frames with --capture (the data the weights will label), not on synthetic ones:
+// a different file from the synthetic update, and made again, the same bytes.
+TEST(TrainCommand, BatchNormOfAnExportFromTheCapturesFrames) {
+  const std::string dir = testing::ScratchDir();
+  const std::string capture = CaptureWithTruthLabels(dir);
+  const std::string config =
+      TrainConfigFile(dir, "run", "  keep_checkpoints: 1\n  keep_every: 1\n", false);
+  ASSERT_EQ(RunHandlabelCommand({"train", "--config", config}).status, 0);
+  const std::string one = dir + "/run/checkpoints/step_00000001.pt",
+                    two = dir + "/run/checkpoints/step_00000002.pt";
+  const auto export_to = [&](const std::string& out, bool from_capture) {
+    std::vector<std::string> args = {"train", "--config", config, "--export", out,
+                                     "--average", one, two, "--bn-samples", "2"};
+    if (from_capture) {
+      for (const std::string& a : {std::string("--capture"), capture,
+                                   std::string("--labels"), dir + "/fit/labels",
+                                   std::string("--train-frames"), std::string("0:3")}) {
+        args.push_back(a);
+      }
+    }
+    return RunHandlabelCommand(args);
+  };
+  const auto synthetic = export_to(dir + "/synthetic_bn.pt", false);
+  ASSERT_EQ(synthetic.status, 0) << synthetic.err;
+  const auto real = export_to(dir + "/capture_bn.pt", true);
+  ASSERT_EQ(real.status, 0) << real.err;
+  EXPECT_THAT(real.out, HasSubstr("from 2 samples of the capture's frames"));
+  // (Checkpoint archives name their file inside: compare files of one name.)
+  std::filesystem::create_directories(dir + "/again");
+  ASSERT_EQ(export_to(dir + "/again/synthetic_bn.pt", true).status, 0);
+  EXPECT_TRUE(testing::ReadFileBytes(dir + "/synthetic_bn.pt") !=
+              testing::ReadFileBytes(dir + "/again/synthetic_bn.pt"));
+  ASSERT_EQ(export_to(dir + "/again/capture_bn.pt", true).status, 0);
+  EXPECT_TRUE(testing::ReadFileBytes(dir + "/capture_bn.pt") ==
+              testing::ReadFileBytes(dir + "/again/capture_bn.pt"));
+}
+
 TEST(TrainCommand, MaskHeadTrainingNeedsAHead) {
   const std::string dir = testing::ScratchDir();
   const auto r = RunHandlabelCommand(
