@@ -20,6 +20,12 @@
 //             + fallback fit: <out>/labels/, <out>/summary.json (the label job layout)
 // <out>/model_card.json and .md say what the network learned from, how long, and the
 // held-out numbers; <out>/progress.json the seconds each stage took.
+// It lives in pipeline/ because it builds and runs label jobs (JobConfig, their
+// quality thresholds) and a training config around the network and the fitter. The
+// code: adapt.cc (options, output folder, the stages in order; detect, fit, label),
+// adapt_training.cc (train, export), adapt_report.cc (held-out measurement, model
+// card), adapt_thresholds.h (the thresholds' choice); adapt_run.h is their shared,
+// internal state.
 
 #include <ostream>
 #include <string>

@@ -1,0 +1,66 @@
+#pragma once
+// Internal to pipeline/ (scripts/check-header-deps): one `handlabel adapt` run's state
+// and its stages, shared by adapt.cc (options, output folder, the stages in order;
+// detect, fit and label), adapt_training.cc (train and export) and adapt_report.cc
+// (held-out measurement, thresholds and the model card). pipeline/adapt.h has the
+// command's interface.
+
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/adapt.h"
+#include "pipeline/job_config.h"
+#include "pipeline/label_summary.h"
+
+namespace handlabel {
+namespace adapt {
+
+// The run's state: its options, folders, frames and the seconds each stage took.
+struct AdaptRun {
+  AdaptOptions o;
+  std::ostream* log = nullptr;
+  std::filesystem::path out;
+  std::vector<std::string> frames, train, heldout;
+  int num_cameras = 0;
+  nlohmann::json progress = nlohmann::json::object();  // stage -> seconds
+
+  void Say(const std::string& line) const {
+    if (log) *log << "handlabel adapt: " << line << std::endl;
+  }
+  std::string Path(const std::string& relative) const { return (out / relative).string(); }
+  double ElapsedSeconds() const {
+    double s = 0;
+    for (const auto& [stage, seconds] : progress.items()) s += seconds.get<double>();
+    return s;
+  }
+};
+
+
+// The file's JSON, or null when there is none.
+nlohmann::json ReadIfExists(const std::string& path);
+
+// A job over the capture's detections without masks (their 2D is the evidence).
+JobConfig CaptureJob(const AdaptRun& run, const std::string& name, const std::string& out);
+// Runs (or continues) a job of the run.
+LabelSummary RunJob(const AdaptRun& run, const JobConfig& job);
+// The frames the fit labelled (it fails a frame whose detections do not pin the hand
+// down, e.g. in fewer than two views): only they can teach or measure.
+std::vector<std::string> WithFitLabel(const AdaptRun& run,
+                                      const std::vector<std::string>& frames);
+
+// The stages of adapt_training.cc and adapt_report.cc (pipeline/adapt.h says what each
+// does and writes).
+void TrainStage(AdaptRun* run);
+void ExportStage(const AdaptRun& run);
+void HeldoutStage(const AdaptRun& run);
+
+// The model card (model_card.json) and its Markdown (model_card.md).
+nlohmann::json ModelCard(const AdaptRun& run);
+std::string ModelCardMarkdown(const nlohmann::json& card);
+
+}  // namespace adapt
+}  // namespace handlabel

@@ -1,0 +1,249 @@
+#include "pipeline/adapt_run.h"
+
+// `handlabel adapt`'s train and export stages (pipeline/adapt.h): the capture's
+// selected frames train the starting weights for as many steps as the budget pays for;
+// the export averages the low-learning-rate checkpoints and measures batch norm on the
+// capture.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "core/atomic_file.h"
+#include "core/errors.h"
+#include "core/json_util.h"
+#include "core/stopwatch.h"
+#include "core/text.h"
+#include "network/poem/loss_plot.h"
+#include "network/poem/poem_trainer.h"
+#include "pipeline/capture_training_data.h"
+#include "pipeline/label_record.h"
+#include "pipeline/train_config.h"
+#include "training/capture_training_samples.h"
+
+namespace handlabel {
+namespace adapt {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Steps timed before the plan (the first 10 include the start-up).
+constexpr int64_t kTimingSteps = 20;
+// The averaged checkpoints: those of the last 30 % of the steps, where the rate is low.
+constexpr double kDecayAt = 0.7;
+constexpr int kMaxBatchNormSamples = 256;
+
+std::string CpuModelName() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const size_t colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(colon + 2);
+    }
+  }
+  return "unknown";
+}
+
+CaptureTrainingInputs TrainingInputs(const AdaptRun& run) {
+  CaptureTrainingInputs in;
+  in.capture_dir = run.o.capture_dir;
+  in.labels_dir = run.Path("fit/labels");
+  const std::vector<std::string> train = WithFitLabel(run, run.train);
+  if (train.empty()) {
+    throw InputError(run.Path("fit/labels"), "labels",
+                     "fit labels of some training frames (the fit failed every one: "
+                     "see fit/summary.md)",
+                     "none of " + std::to_string(run.train.size()));
+  }
+  in.train_frames = Join(train, ",");
+  in.val_frames = Join(WithFitLabel(run, run.heldout), ",");
+  in.selection = run.o.selection;
+  return in;
+}
+
+// The run's training: the starting weights' network on the capture's views.
+TrainConfig AdaptTrainConfig(const AdaptRun& run) {
+  TrainConfig c;
+  c.source_file = "handlabel adapt";
+  c.network_name = "the starting weights' (" + run.o.weights + ")";
+  c.network = PoemCheckpointConfig(run.o.weights);
+  c.network.num_views = run.num_cameras;
+  c.synth.seed = run.o.seed;  // the capture samples' order and augmentation
+  PoemTrainerOptions& t = c.trainer;
+  t.learning_rate = run.o.learning_rate;
+  t.warmup_steps = kTimingSteps;
+  t.decay_at = kDecayAt;
+  t.decay_factor = 0.1;
+  t.keep_checkpoints = 3;
+  t.log_every = 10;
+  t.validate_at_start = true;
+  t.seed = run.o.seed;
+  t.threads = run.o.threads;
+  t.out_dir = run.Path("train");
+  t.init_weights = run.o.weights;
+  return c;
+}
+
+// The capture's labelled frames as training and held-out samples.
+struct AdaptSamples {
+  CaptureTrainingData data;
+  std::unique_ptr<CaptureTrainingSamples> train, heldout, batch_norm;
+};
+
+AdaptSamples LoadSamples(const AdaptRun& run, const TrainConfig& c, const HandModel& hand) {
+  AdaptSamples s;
+  s.data = LoadCaptureTrainingData(TrainingInputs(run), hand.num_vertices());
+  s.train = std::make_unique<CaptureTrainingSamples>(*s.data.source, s.data.train,
+                                                     CaptureSampleOptionsFor(c, false));
+  // Batch-norm statistics are measured on the training frames as inference crops them.
+  s.batch_norm = std::make_unique<CaptureTrainingSamples>(
+      *s.data.source, s.data.train, CaptureSampleOptionsFor(c, true));
+  if (!s.data.validation.empty()) {
+    s.heldout = std::make_unique<CaptureTrainingSamples>(
+        *s.data.source, s.data.validation, CaptureSampleOptionsFor(c, true));
+  }
+  return s;
+}
+
+PoemTrainSummary TrainUntil(const AdaptRun& run, const TrainConfig& c, const HandModel& hand,
+                            const AdaptSamples& s, int64_t stop_at) {
+  PoemTrainerOptions t = c.trainer;
+  t.validation_samples = std::max<int>(1, static_cast<int>(s.data.validation.size()));
+  if (!s.heldout) {
+    t.validate_every = 0;
+    t.validate_at_start = false;
+  }
+  PoemTrainerHooks hooks;
+  hooks.progress = [&run](const std::string& line) { run.Say("train: " + line); };
+  const std::string dir = t.out_dir;
+  hooks.logs_written = [dir] { DrawTrainingCurves(dir); };
+  PoemTrainer trainer(c.network, hand, *s.train, s.heldout.get(), t, hooks);
+  return trainer.Run(/*resume=*/true, stop_at);
+}
+
+// Seconds per step from loss.csv's wall clock between the timing run's two rows (the
+// first row also holds the start-up).
+double MeasuredSecondsPerStep(const std::string& train_dir) {
+  const std::string path = train_dir + "/loss.csv";
+  const CsvTable loss = ReadCsvTable(path);
+  const std::vector<double> steps = loss.Column("step"), wall = loss.Column("wall_s");
+  for (size_t i = 1; i < steps.size() && i < wall.size(); ++i) {
+    if (steps[i] == kTimingSteps && steps[i] > steps[i - 1] && wall[i] > wall[i - 1]) {
+      return (wall[i] - wall[i - 1]) / (steps[i] - steps[i - 1]);
+    }
+  }
+  throw InputError(path, "wall_s", "rows at steps 10 and 20 of the timing run",
+                   std::to_string(steps.size()) + " rows");
+}
+
+// How many steps the budget pays for: what is left of it after the stages so far and a
+// reserve for the ones after training (export, held-out jobs, the label job, which
+// fits where the network fails: about as long as the fit stage).
+nlohmann::json PlanTraining(const AdaptRun& run, double seconds_per_step) {
+  const double reserve = 1.2 * run.progress.value("fit", 0.0) + 150;
+  const double budget = run.o.budget_minutes * 60;
+  const double left = budget - run.ElapsedSeconds() - reserve;
+  const int64_t extra =
+      left > 0 ? static_cast<int64_t>(0.95 * left / seconds_per_step) : kTimingSteps;
+  const int64_t steps = kTimingSteps + std::max<int64_t>(extra, kTimingSteps);
+  const int64_t every = std::max<int64_t>(10, (steps / 20 + 5) / 10 * 10);
+  return {{"steps", steps},
+          {"seconds_per_step", seconds_per_step},
+          {"budget_seconds", budget},
+          {"seconds_before_training", run.ElapsedSeconds()},
+          {"reserve_seconds", reserve},
+          {"checkpoint_every", every},
+          {"validate_every", std::max<int64_t>(100, (steps / 10 + 50) / 100 * 100)},
+          {"budget_too_small", !(left > 0)},
+          {"cpu", CpuModelName()},
+          {"threads", run.o.threads}};
+}
+
+void ApplyPlan(const nlohmann::json& plan, TrainConfig* c) {
+  c->trainer.steps = plan["steps"].get<int64_t>();
+  c->trainer.checkpoint_every = plan["checkpoint_every"].get<int64_t>();
+  c->trainer.keep_every = c->trainer.checkpoint_every;
+  c->trainer.validate_every = plan["validate_every"].get<int64_t>();
+}
+
+// The checkpoints of the last 30 % of the steps (the latest one if none).
+std::vector<std::string> AveragedCheckpoints(const std::string& train_dir, int64_t steps) {
+  std::vector<std::string> paths;
+  const int64_t first = static_cast<int64_t>(std::ceil(kDecayAt * steps));
+  for (const auto& entry : fs::directory_iterator(train_dir + "/checkpoints")) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("step_", 0) != 0 || entry.path().extension() != ".pt") continue;
+    if (std::stoll(name.substr(5)) >= first) paths.push_back(entry.path().string());
+  }
+  std::sort(paths.begin(), paths.end());
+  if (paths.empty()) paths.push_back(LatestPoemCheckpointModel(train_dir));
+  return paths;
+}
+
+}  // namespace
+
+void TrainStage(AdaptRun* run) {
+  TrainConfig c = AdaptTrainConfig(*run);
+  std::string hand_source;
+  const HandModel hand = LoadTrainingHandModel(c, &hand_source);
+  const AdaptSamples samples = LoadSamples(*run, c, hand);
+  WriteFileAtomically(run->Path("train/capture_labels.json"),
+                      LabelSelectionJson(run->o.selection, samples.data.selection).dump(1) +
+                          "\n");
+  run->Say("train: " + std::to_string(samples.data.train.size()) + " of " +
+           std::to_string(run->train.size()) + " training frames kept (" +
+           std::to_string(run->train.size() - samples.data.selection.size()) +
+           " without a fit label; train/capture_labels.json), " +
+           std::to_string(samples.data.validation.size()) + " of " +
+           std::to_string(run->heldout.size()) + " held-out frames with a fit label");
+  const std::string plan_path = run->Path("train/plan.json");
+  if (!fs::exists(plan_path)) {
+    const Clock::time_point t0 = Clock::now();
+    c.trainer.steps = 1000000;  // only the warm-up's steps run before the plan
+    c.trainer.checkpoint_every = kTimingSteps;
+    c.trainer.validate_every = 0;
+    TrainUntil(*run, c, hand, samples, kTimingSteps);
+    run->progress["train_timing"] = SecondsSince(t0);
+    const nlohmann::json plan =
+        PlanTraining(*run, MeasuredSecondsPerStep(c.trainer.out_dir));
+    WriteFileAtomically(plan_path, plan.dump(1) + "\n");
+    run->progress.erase("train_timing");  // the stage's own time counts it
+  }
+  const nlohmann::json plan = ReadJsonFileStrict(plan_path);
+  run->Say("train: " + plan["steps"].dump() + " steps planned at " +
+           FormatNumber(plan["seconds_per_step"].get<double>()) + " s/step (" +
+           plan_path + ")");
+  ApplyPlan(plan, &c);
+  TrainUntil(*run, c, hand, samples, -1);
+}
+
+void ExportStage(const AdaptRun& run) {
+  const TrainConfig c = AdaptTrainConfig(run);
+  std::string hand_source;
+  const HandModel hand = LoadTrainingHandModel(c, &hand_source);
+  const AdaptSamples samples = LoadSamples(run, c, hand);
+  const nlohmann::json plan = ReadJsonFileStrict(run.Path("train/plan.json"));
+  const std::vector<std::string> paths =
+      AveragedCheckpoints(c.trainer.out_dir, plan["steps"].get<int64_t>());
+  const int batch = c.trainer.batch_size;
+  const int bn_samples =
+      std::min<int>(kMaxBatchNormSamples,
+                    4 * static_cast<int>(samples.data.train.size())) / batch * batch;
+  ExportPoemCheckpointAverageAsHalf(paths, run.Path("network.pt"),
+                                    samples.batch_norm.get(), bn_samples, batch);
+  nlohmann::json names = nlohmann::json::array();
+  for (const std::string& p : paths) names.push_back(fs::path(p).filename().string());
+  WriteFileAtomically(run.Path("export.json"),
+                      nlohmann::json{{"averaged_checkpoints", names},
+                                     {"batch_norm_samples", bn_samples}}
+                              .dump(1) +
+                          "\n");
+}
+
+}  // namespace adapt
+}  // namespace handlabel
