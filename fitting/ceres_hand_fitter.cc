@@ -122,8 +122,35 @@ HandParams CeresHandFitter::InitFromViews(const std::vector<KeypointView>& views
       .InitFromKeypoints3d(keypoints, weights, fallback, /*solve=*/false);
 }
 
+std::vector<std::string> ViewsWithKeypoints(const std::vector<KeypointView>& views) {
+  std::vector<std::string> names;
+  for (const KeypointView& view : views) {
+    const Keypoints2d& k = view.keypoints;
+    for (int i = 0; i < kNumHandKeypoints; ++i) {
+      if (k.confidence[i] > 0.0 && k.uv_px.row(i).allFinite()) {
+        names.push_back(view.camera.name);
+        break;
+      }
+    }
+  }
+  return names;
+}
+
+void CeresHandFitter::RequireDepthEvidence(const HandFitInput& input) const {
+  const bool pulled = (config_.use_points3d && input.targets3d) ||
+                      (config_.use_temporal && input.previous);
+  if (pulled || !config_.use_keypoints) return;
+  const std::vector<std::string> views = ViewsWithKeypoints(input.views);
+  if (views.size() >= 2) return;
+  throw Error(std::string("2D keypoints in ") +
+              (views.empty() ? "no view" : "only 1 view (" + views[0] + ")") +
+              ": depth is not determined (a fit from 2D needs keypoints in 2 or more "
+              "views, or a network answer or previous frame to pull towards)");
+}
+
 HandFitResult CeresHandFitter::Fit(const HandFitInput& input,
                                    const HandParams& init) const {
+  RequireDepthEvidence(input);
   if (evaluator_.pose_dim() == 12) {
     return FitRun<12>(model_, evaluator_, anatomy_, limits_, config_, options_)
         .Fit(input, init);

@@ -144,6 +144,10 @@ struct HandFitInput {
   std::optional<HandParams> previous;
 };
 
+// The names of the views that hold a keypoint the fit uses (confidence > 0 and a finite
+// position), in the order of `views`.
+std::vector<std::string> ViewsWithKeypoints(const std::vector<KeypointView>& views);
+
 // The result of the keypoint stage (before any silhouette round): what the same fit
 // without silhouettes gives, kept so that a silhouette fit can be checked against it.
 struct HandFitStageResult {
@@ -199,10 +203,17 @@ class CeresHandFitter {
   // or fewer than 3 palm keypoints the 3D solve still runs.
   HandParams InitFromViews(const std::vector<KeypointView>& views) const;
 
-  // Staged solve from `init`.
+  // Staged solve from `init`. Throws Error when nothing places the hand in depth: 2D
+  // keypoints in fewer than 2 views (ViewsWithKeypoints) and neither 3D targets nor a
+  // previous frame to pull towards. One view's rays leave the distance free (only the
+  // shape prior holds the hand's size): such fits ended metres off with a small
+  // reprojection error, so the frame must fail by name instead.
   HandFitResult Fit(const HandFitInput& input, const HandParams& init) const;
 
  private:
+  // The check of Fit's comment.
+  void RequireDepthEvidence(const HandFitInput& input) const;
+
   HandModel model_;
   HandFitConfig config_;
   HandFitOptions options_;

@@ -228,6 +228,12 @@ HandFitResult CeresLabelFitter::RefineAgainstFiles(const LabelFitRequest& reques
       from_network, fitter.InitFromKeypoints3d(net.keypoints,
                                                Eigen::VectorXd::Ones(kNumHandKeypoints)));
   if (WorstViewRmsPx(input.views, net.keypoints) <= options_.restart_px) return fit;
+  // A restart from the views alone needs two of them (CeresHandFitter::Fit): from one,
+  // the network's pull is all that places the hand in depth.
+  if (ViewsWithKeypoints(input.views).size() < 2) {
+    *start = "network (one view: no triangulated restart)";
+    return fit;
+  }
   HandFitResult from_views = fitter.Fit(input, fitter.InitFromViews(input.views));
   if (EvidenceCost(from_views) < EvidenceCost(fit)) {
     *start = "triangulated_views (network start too far)";

@@ -10,7 +10,9 @@
 //   fit from 2D only           the paper's multi-view fitting baseline (`handlabel fit`
 //                              and a job without network): start per `init` (job
 //                              field fit.init; by default robust triangulation of the
-//                              2D keypoints + IK alignment), then fit
+//                              2D keypoints + IK alignment), then fit; a frame
+//                              with 2D keypoints in fewer than 2 views fails
+//                              (depth is not determined: CeresHandFitter::Fit)
 // Silhouettes are used when the request carries them (the network's, evidence.masks:
 // network), or when use_masks is set and the frame has mask files (read with the one
 // mask rule of image/mask_image.h). A fit with silhouettes is checked against the

@@ -22,20 +22,8 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using testing::RunHandlabelCommand;
 
-void EditJson(const std::string& path, const std::function<void(nlohmann::json&)>& edit) {
-  nlohmann::json j = nlohmann::json::parse(testing::ReadFileBytes(path));
-  edit(j);
-  std::ofstream(path, std::ios::trunc) << j.dump();
-}
-
-// The manifest entry of `frame` in a labelled folder.
-nlohmann::json ManifestEntry(const std::string& out, const std::string& frame) {
-  const auto manifest = nlohmann::json::parse(testing::ReadFileBytes(ManifestPath(out)));
-  for (const auto& e : manifest["frames"]) {
-    if (e["frame"] == frame) return e;
-  }
-  return nullptr;
-}
+using testing::EditJson;
+using testing::ManifestEntry;
 
 // Detections with every confidence 0 (a detector that saw nothing), a confidence of
 // 7.5, and a broken image in a fit-only job with overlays: those frames fail by name,

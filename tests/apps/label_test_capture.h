@@ -5,10 +5,14 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "capture/synth_capture.h"
 #include "hand/capsule_hand.h"
+#include "pipeline/label_outputs.h"
+#include "tests/test_util.h"
 
 namespace handlabel::testing {
 
@@ -36,6 +40,23 @@ inline std::string WriteTestJob(const std::string& dir, const std::string& name,
                       << "output: {dir: " << output << ", meshes: [ply], overlays: false"
                       << extra_output << "}\n";
   return path;
+}
+
+// Rewrites the JSON file `path` with `edit` applied.
+inline void EditJson(const std::string& path,
+                     const std::function<void(nlohmann::json&)>& edit) {
+  nlohmann::json j = nlohmann::json::parse(ReadFileBytes(path));
+  edit(j);
+  std::ofstream(path, std::ios::trunc) << j.dump();
+}
+
+// The manifest entry of `frame` in a labelled folder (null if none).
+inline nlohmann::json ManifestEntry(const std::string& out, const std::string& frame) {
+  const auto manifest = nlohmann::json::parse(ReadFileBytes(ManifestPath(out)));
+  for (const auto& e : manifest["frames"]) {
+    if (e["frame"] == frame) return e;
+  }
+  return nullptr;
 }
 
 }  // namespace handlabel::testing
