@@ -12,8 +12,10 @@
 #include "capture/capture_manifest_file.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/file_lock.h"
 #include "core/option_checks.h"
 #include "core/stopwatch.h"
+#include "core/text.h"
 #include "core/version.h"
 #include "media/frame_readers.h"
 
@@ -111,17 +113,43 @@ Rig ReadManifestRig(const std::string& dir, const CaptureManifest& manifest) {
   return rig;
 }
 
-// Applies resume / overwrite to a manifest that already lists frames.
+// Removes from the manifest every kind of file but the images (detections, keypoints,
+// masks, ground truth, ...): what was made from or for the images an --overwrite
+// import replaces. Returns them as "kind (pattern)".
+std::vector<std::string> UnlistDerivedFiles(CaptureManifest* manifest) {
+  std::vector<std::string> dropped;
+  for (auto it = manifest->files.begin(); it != manifest->files.end();) {
+    if (it->first == kFileImage) {
+      ++it;
+      continue;
+    }
+    dropped.push_back(it->first + " (" + it->second + ")");
+    it = manifest->files.erase(it);
+  }
+  return dropped;
+}
+
+// Applies resume / overwrite to a manifest that already lists frames (or, with
+// overwrite, other files than images); what was dropped goes to `notes`.
 void PrepareFrames(const std::string& dir, const CaptureImportOptions& o,
-                   const json& settings, CaptureManifest* manifest) {
+                   const json& settings, CaptureManifest* manifest,
+                   std::vector<std::string>* notes) {
   const std::string path = CaptureManifestPath(dir);
-  if (manifest->frames.empty()) return;
   if (o.overwrite) {
+    const std::vector<std::string> dropped = UnlistDerivedFiles(manifest);
+    if (!dropped.empty()) {
+      notes->push_back("--overwrite: capture.json no longer lists " + Join(dropped, ", ") +
+                       ": they describe the images being replaced (their files stay on "
+                       "disk; `handlabel detect --capture` makes detections of the new "
+                       "images)");
+    }
+    if (manifest->frames.empty() && dropped.empty()) return;
     manifest->frames.clear();
     WriteCaptureManifest(dir, *manifest);  // first: no listed frame loses its images
     fs::remove_all(fs::path(dir) / kImportImagesFolder);
     return;
   }
+  if (manifest->frames.empty()) return;
   const std::string count = std::to_string(manifest->frames.size()) + " frames";
   if (!o.resume) {
     throw InputError(path, "frames",
@@ -251,11 +279,13 @@ CaptureImportReport ImportCapture(const std::string& capture_dir,
     report.notes.push_back(text);
     if (callbacks.note) callbacks.note(text);
   };
+  ReadInitializedCapture(capture_dir);  // a missing capture is named before any lock
+  const FileLock writer =
+      LockFolderForWriting(capture_dir, "capture import", "--capture", "");
+  // Read again under the lock: as the last writer left it.
   CaptureManifest manifest = ReadInitializedCapture(capture_dir);
   const Rig rig = ReadManifestRig(capture_dir, manifest);
   const json settings = ImportSettings(o);
-  PrepareFrames(capture_dir, o, settings, &manifest);
-
   std::vector<std::string> notes;
   OpenedSources sources = OpenSources(rig, o, &notes);
   const std::vector<PlannedFrame> plan =
@@ -267,6 +297,10 @@ CaptureImportReport ImportCapture(const std::string& capture_dir,
                      "at least one frame in the range (--start, --end, --stride)",
                      "none");
   }
+  // Only with sources that give frames does --overwrite drop what the capture held.
+  notes.clear();
+  PrepareFrames(capture_dir, o, settings, &manifest, &notes);
+  for (const std::string& text : notes) note(text);
   CheckKeptFrames(capture_dir, plan, manifest);
   report.frames_total = static_cast<int>(plan.size());
   report.frames_kept = static_cast<int>(manifest.frames.size());

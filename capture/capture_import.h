@@ -76,7 +76,10 @@ struct CaptureImportOptions {
   // Continue an interrupted import with the same sources and settings: frames already
   // in capture.json are kept and not read again.
   bool resume = false;
-  // Discard frames already imported (removes images/) and import again.
+  // Discard frames already imported (removes images/) and import again. capture.json
+  // then lists the new images only: detections, keypoints, masks, ground truth and any
+  // other kind of file it listed describe the old ones (a note names them; their
+  // files stay on disk). Nothing is dropped before the sources are found to give frames.
   bool overwrite = false;
   // capture.json is rewritten after every this many frames (what a killed import keeps).
   int checkpoint_frames = 20;
@@ -105,7 +108,10 @@ struct CaptureImportCallbacks {
   std::function<void(int, int)> progress;
 };
 
-// Imports into the capture `capture_dir` made by InitCapture. Throws InputError for a
+// Imports into the capture `capture_dir` made by InitCapture, holding the folder's
+// writer lock (core/file_lock.h) throughout: another import, `capture init
+// --overwrite` or `detect --capture` on the folder meanwhile is refused naming this
+// one, and this one is refused while they run. Throws InputError for a
 // rig camera without a source, an image whose size differs from its camera's (naming
 // the file, the camera and both sizes), an unreadable image or video, a capture that
 // already has frames (without resume / overwrite), or resume with other settings.

@@ -7,6 +7,7 @@
 #include "capture/capture_import.h"
 #include "capture/capture_manifest_file.h"
 #include "core/errors.h"
+#include "core/file_lock.h"
 #include "core/text.h"
 #include "core/version.h"
 #include "hand/hand_model.h"
@@ -74,6 +75,8 @@ void InitCapture(const Rig& rig, const RigFileInfo& rig_info, const std::string&
     throw InputError(out_dir, "--out", "a folder (or a path to create)",
                      "an existing file");
   }
+  fs::create_directories(root);
+  const FileLock writer = LockFolderForWriting(out_dir, "capture init", "--out", "");
   if (fs::exists(root / kCaptureManifestFile)) {
     if (!options.overwrite) {
       throw InputError(out_dir, "--out", "a folder without a capture (or --overwrite)",

@@ -5,9 +5,11 @@
 #include <limits>
 
 #include "capture/capture_format.h"
+#include "capture/capture_manifest_file.h"
 #include "capture/capture_reader.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/file_lock.h"
 #include "core/json_util.h"
 #include "core/stopwatch.h"
 #include "image/image_file.h"
@@ -94,6 +96,13 @@ DetectCaptureSummary DetectCapture(const std::string& capture_dir,
                                    const DetectCaptureOptions& options,
                                    const std::function<void(int, int)>& on_frame) {
   options.Check("detect");
+  // A folder that is not a capture is named before any lock file is made in it (an
+  // import beside may not have listed a frame yet: the lock names it below).
+  ReadCaptureManifest(capture_dir, "a native capture: `handlabel synth` or `capture "
+                                   "init` + `capture import` make one");
+  const FileLock writer =
+      LockFolderForWriting(capture_dir, "detect --capture", "--capture", "");
+  // Read under the lock: as the last writer (an import) left it.
   const CaptureReader capture(capture_dir);
   if (capture.Has(kFileDetections) && !options.overwrite) {
     throw InputError(capture_dir + "/capture.json", "files.detections",
