@@ -5,11 +5,14 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "capture/synth_capture.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "network/poem/loss_plot.h"
@@ -188,6 +191,9 @@ struct TrainingSources {
   std::unique_ptr<MixedTrainingSamples> mixed;
   const TrainingSampleSource* train = nullptr;
   const TrainingSampleSource* validation = nullptr;
+  // With a capture: what the run learns from, written beside its checkpoints
+  // (capture_labels.json) once the trainer holds the run folder.
+  std::optional<nlohmann::json> capture_labels;
 };
 
 // The capture's labelled frames (mixed with synthetic ones below --real-share 1) and,
@@ -223,11 +229,7 @@ void AddCaptureSources(const TrainConfig& config, const HandModel& hand,
             << " labels left out, capture_labels.json) and "
             << s->capture.validation.size() << " validation frames of "
             << s->capture.source->Describe() << ", real share " << f.real_share << "\n";
-  // What the run learned from, beside its checkpoints.
-  std::filesystem::create_directories(config.trainer.out_dir);
-  WriteFileAtomically(
-      (std::filesystem::path(config.trainer.out_dir) / "capture_labels.json").string(),
-      LabelSelectionJson(f.capture.selection, s->capture.selection).dump(1) + "\n");
+  s->capture_labels = LabelSelectionJson(f.capture.selection, s->capture.selection);
 }
 
 TrainingSources MakeTrainingSources(const TrainConfig& config, const HandModel& hand,
@@ -248,16 +250,51 @@ TrainingSources MakeTrainingSources(const TrainConfig& config, const HandModel& 
   return s;
 }
 
+// What decides the run's samples (PoemTrainerOptions::data_settings): a resume with
+// other values is refused naming the setting.
+nlohmann::json TrainingDataSettings(const TrainConfig& config, const TrainFlags& f) {
+  // The crop size, masks and augmentation seed follow from the network and the synth
+  // seed (LoadTrainConfig); the checkpoint's own config guards the network.
+  const TrainingSampleOptions& s = config.samples;
+  nlohmann::json data = {{"samples",
+                          {{"box_scale", s.box_scale},
+                           {"min_box_px", s.min_box_px},
+                           {"frame_reuse", s.frame_reuse}}}};
+  const CaptureTrainingInputs& c = f.capture;
+  if (c.capture_dir.empty() || f.real_share < 1) {
+    data["synth"] = SynthOptionsToJson(config.synth);
+  }
+  if (!c.capture_dir.empty()) {
+    const auto absolute = [](const std::string& path) {
+      return std::filesystem::absolute(path).lexically_normal().string();
+    };
+    data["capture"] = {{"dir", absolute(c.capture_dir)},
+                       {"labels", absolute(c.labels_dir)},
+                       {"train_frames", c.train_frames},
+                       {"val_frames", c.val_frames},
+                       {"label_min_views", c.selection.min_views},
+                       {"label_max_rms_px", c.selection.max_view_rms_px},
+                       {"real_share", f.real_share}};
+  }
+  return data;
+}
+
 void Train(const TrainConfig& config, const TrainFlags& f) {
   std::string hand_source;
   const HandModel hand = LoadTrainingHandModel(config, &hand_source);
   std::cerr << "handlabel train: hand model " << hand_source << "\n";
   PoemTrainerOptions trainer_options = config.trainer;
+  trainer_options.data_settings = TrainingDataSettings(config, f);
   const TrainingSources sources = MakeTrainingSources(config, hand, f, &trainer_options);
   const std::string run = config.trainer.out_dir;
   PoemTrainerHooks hooks;
   hooks.progress = [](const std::string& line) { std::cout << line << std::endl; };
   hooks.logs_written = [run] { DrawTrainingCurves(run); };
+  hooks.folder_locked = [&] {
+    if (!sources.capture_labels) return;
+    WriteFileAtomically((std::filesystem::path(run) / "capture_labels.json").string(),
+                        sources.capture_labels->dump(1) + "\n");
+  };
   PoemTrainer trainer(config.network, hand, *sources.train, sources.validation,
                       trainer_options, hooks);
   const PoemTrainSummary s = trainer.Run(f.resume, f.stop_at);

@@ -47,13 +47,19 @@ void WriteFileAtomically(const std::string& path, const std::string& content) {
   const std::string temp = path + ".tmp." + std::to_string(::getpid());
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) Fail("cannot create", temp);
-  WriteAll(fd, content, temp);
-  if (::fsync(fd) != 0) {
+  // A failed write (a full disk) names the file meant and leaves no temporary behind.
+  try {
+    WriteAll(fd, content, path);
+    if (::fsync(fd) != 0) {
+      ::close(fd);
+      Fail("cannot flush", path);
+    }
     ::close(fd);
-    Fail("cannot flush", temp);
+    if (::rename(temp.c_str(), path.c_str()) != 0) Fail("cannot rename into", path);
+  } catch (...) {
+    ::unlink(temp.c_str());
+    throw;
   }
-  ::close(fd);
-  if (::rename(temp.c_str(), path.c_str()) != 0) Fail("cannot rename into", path);
   SyncDirectory(target.parent_path());
 }
 

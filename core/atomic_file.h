@@ -7,7 +7,8 @@
 
 namespace handlabel {
 
-// Throws Error naming the path if any step fails. Creates missing parent folders.
+// Throws Error naming the path if any step fails (a full disk: "cannot write 'PATH':
+// No space left on device"); the temporary is removed. Creates missing parent folders.
 void WriteFileAtomically(const std::string& path, const std::string& content);
 
 // Appends one line (a '\n' is added) and flushes it to disk before returning, so a

@@ -1,5 +1,10 @@
 #include "pipeline/train_config.h"
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
@@ -32,15 +37,43 @@ void ResolveNetwork(const std::string& overrides_json, const std::string& path,
   }
 }
 
+// This machine's physical memory in bytes (0 if unknown).
+double PhysicalMemoryBytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * page : 0.0;
+}
+
+// train.batch_size, checked before anything is allocated: >= 1, and the batches in
+// flight (the one trained and prefetch_batches made ahead) of input crops alone (float
+// RGB per view; the network's activations take several times more) fit in memory. A
+// batch size of 1e9 otherwise ran for minutes without a step.
+void CheckBatchSize(const std::string& path, const TrainConfig& c) {
+  const int batch = c.trainer.batch_size;
+  if (batch < 1) {
+    throw InputError(path, "train.batch_size", "an integer >= 1", std::to_string(batch));
+  }
+  const double crop = c.network.crop_size;
+  const double sample_bytes = c.network.num_views * 3.0 * crop * crop * sizeof(float);
+  const double memory = PhysicalMemoryBytes();
+  const int in_flight = std::max(1, c.trainer.prefetch_batches + 1);
+  const double largest = memory > 0 ? std::floor(memory / (sample_bytes * in_flight)) : 0;
+  if (memory > 0 && batch > largest) {
+    char detail[200];
+    std::snprintf(detail, sizeof(detail),
+                  "a batch whose input crops fit in memory: at most %.0f samples (%d views "
+                  "of %d px take %.1f MB each, %d batch(es) in flight, %.1f GB of memory)",
+                  largest, c.network.num_views, c.network.crop_size, sample_bytes / 1e6,
+                  in_flight, memory / 1e9);
+    throw InputError(path, "train.batch_size", detail, std::to_string(batch));
+  }
+}
+
 // Sample options that follow from the network and trainer, then the final checks.
 void DeriveSampleOptions(const std::string& path, TrainConfig* c) {
   c->samples.crop_size = c->network.crop_size;
   c->samples.masks = c->network.mask_head;  // the mask head's targets
   // Checked here, by its own name: it becomes the samples' internal reuse_group.
-  if (c->trainer.batch_size < 1) {
-    throw InputError(path, "train.batch_size", "an integer >= 1",
-                     std::to_string(c->trainer.batch_size));
-  }
+  CheckBatchSize(path, *c);
   c->samples.reuse_group = c->trainer.batch_size;
   c->samples.augment_seed = c->synth.seed;
   c->samples.Check(path);

@@ -9,7 +9,9 @@
 #include <filesystem>
 #include <limits>
 #include <set>
+#include <sstream>
 
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "network/poem/tensor_shape.h"
 
@@ -131,7 +133,7 @@ Archive ReadArchive(const std::string& path) {
     throw;
   } catch (const std::exception& e) {
     throw InputError(path, "", "a handlabel POEM checkpoint (LibTorch archive)",
-                     std::string("unreadable: ") + e.what());
+                     "unreadable: " + TorchErrorText(e));
   }
   const c10::IValue format = Attribute(attributes, "format");
   if (!format.isString() || format.toStringRef() != kFormat) {
@@ -228,12 +230,21 @@ void SavePoemCheckpoint(PoemModel& model, const std::string& path) {
   archive.write("format", c10::IValue(std::string(kFormat)));
   archive.write("config", c10::IValue(model->config().ToJson()));
   archive.write("state_dict", c10::IValue(dict));
-  const std::filesystem::path p(path);
-  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-  // Write next to the target and rename, so a killed job never leaves half a file.
-  const std::string tmp = path + ".tmp";
-  archive.save_to(tmp);
-  std::filesystem::rename(tmp, path);
+  SaveArchiveAtomically(archive, path);
+}
+
+void SaveArchiveAtomically(torch::serialize::OutputArchive& archive,
+                           const std::string& path) {
+  std::ostringstream bytes;
+  archive.save_to(bytes);
+  WriteFileAtomically(path, bytes.str());
+}
+
+std::string TorchErrorText(const std::exception& error) {
+  if (const auto* torch_error = dynamic_cast<const c10::Error*>(&error)) {
+    return torch_error->what_without_backtrace();
+  }
+  return error.what();
 }
 
 PoemConfig ReadPoemCheckpointConfig(const std::string& path) {

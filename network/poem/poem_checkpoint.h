@@ -33,7 +33,16 @@ StateDictReport LoadPoemStateDict(PoemModel& model,
                                   const std::string& source,
                                   const std::vector<std::string>& ignored_prefixes = {});
 
+// Written atomically (SaveArchiveAtomically).
 void SavePoemCheckpoint(PoemModel& model, const std::string& path);
+// Serialises `archive` in memory, then writes it with WriteFileAtomically
+// (core/atomic_file.h): a full disk is an Error naming `path` and leaves neither a
+// partial file nor a temporary (LibTorch's own file writer aborted the process when its
+// destructor failed to finish the file).
+void SaveArchiveAtomically(torch::serialize::OutputArchive& archive,
+                           const std::string& path);
+// A LibTorch exception's message without its backtrace (c10::Error), else what().
+std::string TorchErrorText(const std::exception& error);
 // The config embedded in an own checkpoint. Throws InputError if the file is not one.
 PoemConfig ReadPoemCheckpointConfig(const std::string& path);
 // Builds the model from the embedded config and loads the weights.

@@ -17,6 +17,7 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/file_lock.h"
 #include "core/json_util.h"
 #include "core/option_checks.h"
 #include "core/random.h"
@@ -43,18 +44,65 @@ std::string ReadText(const std::string& path) {
 struct LatestCheckpoint {
   int64_t step = 0;
   std::string model, optimizer;  // relative to the training folder
+  // What a resume must keep: seed, batch_size and (when recorded) data.
+  nlohmann::json settings = nlohmann::json::object();
 };
 
 LatestCheckpoint ReadLatestJson(const std::string& path) {
   const nlohmann::json j = ReadJsonFileStrict(path);
   RejectUnknownKeys(
-      j, {"step", "model", "optimizer", "config", "seed", "batch_size", "steps"}, path);
+      j, {"step", "model", "optimizer", "config", "seed", "batch_size", "steps", "data"},
+      path);
   const nlohmann::json& step = JsonMember(j, "step", path);
   if (!step.is_number_integer() || step.get<int64_t>() < 0) {
     throw InputError(path, "step", "a non-negative integer", step.dump());
   }
-  return {step.get<int64_t>(), JsonString(j, "model", path),
-          JsonString(j, "optimizer", path)};
+  LatestCheckpoint latest{step.get<int64_t>(), JsonString(j, "model", path),
+                          JsonString(j, "optimizer", path)};
+  for (const char* key : {"seed", "batch_size", "data"}) {
+    if (j.contains(key)) latest.settings[key] = j[key];
+  }
+  return latest;
+}
+
+// The settings of a run that a resume must keep, as latest.json records them.
+nlohmann::json ResumeSettings(const PoemTrainerOptions& o) {
+  nlohmann::json settings = {{"seed", o.seed}, {"batch_size", o.batch_size}};
+  if (!o.data_settings.empty()) settings["data"] = o.data_settings;
+  return settings;
+}
+
+// "/data/synth/seed" (a flattened JSON key) -> "data.synth.seed".
+std::string SettingName(const std::string& pointer) {
+  std::string name = pointer.substr(1);
+  std::replace(name.begin(), name.end(), '/', '.');
+  return name;
+}
+
+// Throws InputError naming the first setting (e.g. data.synth.seed) whose recorded
+// value differs from this run's. Settings latest.json does not record (a run written
+// before they were), and data when this run gives none, are not checked.
+void CheckResumeSettings(const nlohmann::json& recorded, const nlohmann::json& now,
+                         const std::string& path) {
+  const nlohmann::json was = recorded.flatten(), is = now.flatten();
+  const auto is_data = [](const std::string& key) { return key.rfind("/data/", 0) == 0; };
+  for (const auto& [key, value] : was.items()) {
+    if (is_data(key) && !now.contains("data")) continue;
+    const auto it = is.find(key);
+    if (it != is.end() && *it == value) continue;
+    throw InputError(path, SettingName(key),
+                     "the value the run began with, " + value.dump() +
+                         " (--resume continues a run on the data and batches it "
+                         "began with; train into a new folder for other settings)",
+                     it == is.end() ? "nothing" : it->dump());
+  }
+  if (!recorded.contains("data")) return;
+  for (const auto& [key, value] : is.items()) {
+    if (is_data(key) && !was.contains(key)) {
+      throw InputError(path, SettingName(key),
+                       "no value (the run began without this setting)", value.dump());
+    }
+  }
 }
 
 std::string StepName(int64_t step) {
@@ -282,19 +330,16 @@ struct PoemTrainer::State {
   void SaveCheckpoint(int64_t step) {
     fs::create_directories(Path("checkpoints"));
     const std::string base = "checkpoints/" + StepName(step);
-    SavePoemCheckpoint(model, Path(base + ".pt"));  // writes .tmp and renames
+    SavePoemCheckpoint(model, Path(base + ".pt"));  // atomically
     torch::serialize::OutputArchive archive;
     optimizer->save(archive);
     archive.write("step", torch::tensor(static_cast<int64_t>(step)));
-    archive.save_to(Path(base + ".optim.tmp"));
-    fs::rename(Path(base + ".optim.tmp"), Path(base + ".optim"));
-    nlohmann::json latest;
+    SaveArchiveAtomically(archive, Path(base + ".optim"));
+    nlohmann::json latest = ResumeSettings(options);
     latest["step"] = step;
     latest["model"] = base + ".pt";
     latest["optimizer"] = base + ".optim";
     latest["config"] = nlohmann::json::parse(config.ToJson());
-    latest["seed"] = options.seed;
-    latest["batch_size"] = options.batch_size;
     latest["steps"] = options.steps;
     WriteFileAtomically(Path("latest.json"), latest.dump(2) + "\n");
     // Drop old checkpoints beyond keep_checkpoints, but the weights at keep_every.
@@ -429,12 +474,22 @@ struct PoemTrainer::State {
 
   int64_t LoadLatest() {
     const LatestCheckpoint latest = ReadLatestJson(Path("latest.json"));
+    CheckResumeSettings(latest.settings, ResumeSettings(options), Path("latest.json"));
     LoadPoemCheckpointInto(model, Path(latest.model));
-    torch::serialize::InputArchive archive;
-    archive.load_from(Path(latest.optimizer));
-    optimizer->load(archive);
+    const std::string optim = Path(latest.optimizer);
     torch::Tensor step;
-    archive.read("step", step);
+    try {
+      torch::serialize::InputArchive archive;
+      archive.load_from(optim);
+      optimizer->load(archive);
+      archive.read("step", step);
+    } catch (const c10::Error& e) {  // truncated, damaged or of another network
+      throw InputError(optim, "",
+                       "the optimizer state handlabel train wrote with the checkpoint "
+                       "(to go on from the weights alone, start a new run with "
+                       "--init-weights " + Path(latest.model) + ")",
+                       "unreadable: " + TorchErrorText(e));
+    }
     return step.item<int64_t>();
   }
 };
@@ -487,6 +542,9 @@ PoemTrainSummary PoemTrainer::Run(bool resume, int64_t stop_at_step) {
   const PoemTrainerOptions& o = s.options;
   torch::set_num_threads(o.threads);
   fs::create_directories(o.out_dir);
+  const FileLock writer =
+      LockFolderForWriting(o.out_dir, "train", "train.out_dir (--out)", "");
+  if (s.hooks.folder_locked) s.hooks.folder_locked();
   PoemTrainSummary summary;
   const bool new_run = !fs::exists(s.Path("latest.json"));
   int64_t step = s.StartStep(resume);

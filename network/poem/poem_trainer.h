@@ -10,7 +10,9 @@
 // as the uninterrupted run would (same thread count).
 //
 // Output folder:
-//   latest.json                       which checkpoint to resume from (written last)
+//   .handlabel.lock                   the running trainer's lock (core/file_lock.h)
+//   latest.json                       which checkpoint to resume from (written last),
+//                                     and the settings a resume must keep
 //   checkpoints/step_XXXXXXXX.pt      model (an own POEM checkpoint, usable as weights)
 //   checkpoints/step_XXXXXXXX.optim   optimizer state and step
 //   loss.csv                          step, lr, total, every loss term, samples/s, wall s
@@ -21,6 +23,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -73,6 +76,12 @@ struct PoemTrainerOptions {
   double vertices_weight = 1.0;
   double joints_2d_weight = 1.0;
   double mask_weight = 1.0;
+  // What decides the training samples (the caller's data and sampling settings, e.g.
+  // the synthetic data's seed, image size and objects), recorded in latest.json with
+  // batch_size and seed. A resume with other values of any of them is an InputError
+  // naming the first that differs: the run would go on silently on other data. Empty:
+  // not recorded, not checked.
+  nlohmann::json data_settings = nlohmann::json::object();
   void Check(const std::string& source) const;
 };
 
@@ -92,6 +101,9 @@ struct PoemTrainerHooks {
   std::function<void(const std::string&)> progress;
   // Called after loss.csv / validation.csv were extended (e.g. to redraw a plot).
   std::function<void()> logs_written;
+  // Called once Run holds the run folder, before it writes anything there: where a
+  // caller writes its own files of the run (e.g. which labels it learned from).
+  std::function<void()> folder_locked;
 };
 
 struct PoemTrainSummary {
@@ -114,6 +126,8 @@ class PoemTrainer {
   // Trains until options.steps, or until `stop_at_step` (>= 0) if that comes first,
   // writing a checkpoint at the end. With `resume`, continues from latest.json if the
   // folder has one; without it, a folder that already holds a run is an InputError.
+  // One writer per run folder: holds its lock (core/file_lock.h) throughout; a second
+  // run on the folder meanwhile is an InputError naming the holder.
   PoemTrainSummary Run(bool resume, int64_t stop_at_step = -1);
 
   // Writes the current weights as an own POEM checkpoint (float16 storage if `half`).

@@ -3,6 +3,8 @@
 // as a real child process of the built binary (SpawnHandlabel), for tests of several
 // processes at once.
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -32,13 +34,20 @@ inline CommandResult RunHandlabelCommand(std::vector<std::string> args) {
 }
 
 // Starts build/apps/handlabel with `args`; stdout and stderr are appended to `log`.
-inline pid_t SpawnHandlabel(const std::vector<std::string>& args,
-                            const std::string& log) {
+// With `file_size_limit` > 0, the child cannot write a file beyond that many bytes
+// (RLIMIT_FSIZE; the write fails with EFBIG, SIGXFSZ ignored): a disk that fills up.
+inline pid_t SpawnHandlabel(const std::vector<std::string>& args, const std::string& log,
+                            rlim_t file_size_limit = 0) {
   const pid_t pid = fork();
   if (pid == 0) {
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
     dup2(fd, 1);
     dup2(fd, 2);
+    if (file_size_limit > 0) {
+      signal(SIGXFSZ, SIG_IGN);  // kept across exec
+      const rlimit limit{file_size_limit, file_size_limit};
+      if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(126);
+    }
     std::string binary = std::string(HANDLABEL_BINARY_DIR) + "/apps/handlabel";
     std::vector<std::string> copy = args;
     std::vector<char*> argv = {binary.data()};

@@ -139,6 +139,39 @@ TEST(TrainCommand, ResumesWithLongerScheduleAndNewLearningRate) {
   EXPECT_THAT(bad.err, HasSubstr("--learning-rate"));
 }
 
+// A disk that fills up while a checkpoint is written (here: a file size limit below the
+// checkpoint's size; the write fails like on a full disk) ended the process with an
+// uncaught LibTorch error (exit 134). Now: exit 1 naming the file, no partial
+// checkpoint or temporary left; a resume with room finishes. A resume with another
+// data seed or batch size is refused naming the setting.
+TEST(TrainCommand, AFullDiskNamesTheCheckpointAndOtherDataRefusesTheResume) {
+  const std::string dir = testing::ScratchDir();
+  const std::string config = TrainConfigFile(dir, "run", "", false);
+  ASSERT_EQ(testing::WaitForExit(testing::SpawnHandlabel({"train", "--config", config},
+                                                          dir + "/full.log", 16384)),
+            1);
+  const std::string log = testing::ReadFileBytes(dir + "/full.log");
+  EXPECT_THAT(log, HasSubstr("cannot write '" + dir + "/run/checkpoints/step_00000001.pt'"));
+  EXPECT_THAT(log, HasSubstr("File too large"));  // EFBIG; a full disk says ENOSPC
+  EXPECT_THAT(log, ::testing::Not(HasSubstr("Exception raised from")));
+  for (const auto& [name, bytes] : testing::FilesUnder(dir + "/run")) {
+    EXPECT_THAT(name, ::testing::Not(HasSubstr(".tmp"))) << name;
+    EXPECT_THAT(name, ::testing::Not(HasSubstr("checkpoints/"))) << name;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/run/latest.json"));
+  const auto resumed = RunHandlabelCommand({"train", "--config", config, "--resume"});
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+
+  std::string other = testing::ReadFileBytes(config);
+  other.replace(other.find("seed: 4"), 7, "seed: 5");
+  std::ofstream(dir + "/other.yaml") << other;
+  const auto refused = RunHandlabelCommand(
+      {"train", "--config", dir + "/other.yaml", "--resume", "--steps", "3"});
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_THAT(refused.err, HasSubstr("latest.json: field 'data.synth.seed'"));
+  EXPECT_THAT(refused.err, HasSubstr("got 5"));
+}
+
 TEST(TrainCommand, KeepEveryAndExportTheAverageOfCheckpoints) {
   const std::string dir = testing::ScratchDir();
   const std::string config =

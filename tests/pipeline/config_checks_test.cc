@@ -64,6 +64,13 @@ TEST(ConfigChecks, TrainBatchSizeIsCheckedByItsOwnName) {
   const std::string twice = config("  batch_size: 2\n  batch_size: 4\n");
   EXPECT_THAT(testing::InputErrorOf([&] { LoadTrainConfig(twice); }),
               HasSubstr("train.batch_size"));
+  // A batch whose input crops alone exceed the machine's memory is refused when the
+  // file is read, before anything is allocated (it ran for minutes without a step).
+  const std::string huge = config("  batch_size: 1000000000\n");
+  const std::string huge_error = testing::InputErrorOf([&] { LoadTrainConfig(huge); });
+  EXPECT_THAT(huge_error, HasSubstr("train.batch_size"));
+  EXPECT_THAT(huge_error, HasSubstr("fit in memory"));
+  EXPECT_THAT(huge_error, HasSubstr("got 1000000000"));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "network/poem/poem_trainer.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -202,6 +203,90 @@ TEST(PoemTrainer, RefusesToOverwriteARunWithoutResume) {
   PoemTrainer(c, MakeRegressorModel(), train, nullptr, o).Run(false);
   PoemTrainer again(c, MakeRegressorModel(), train, nullptr, o);
   EXPECT_THROW(again.Run(false), InputError);
+}
+
+// One writer per run folder: a second trainer on the folder while the first runs (two
+// `train --resume` at once duplicated loss.csv rows) is refused naming the folder and
+// the holder; the first completes with each step logged once; the lock is released at
+// the end.
+TEST(PoemTrainer, ASecondTrainerOnTheRunFolderIsRefusedAndTheFirstCompletes) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const FakeSamples train(c, 5, false);
+  const HandModel hand = MakeRegressorModel();
+  const std::string run = testing::ScratchDir() + "/run";
+  PoemTrainerOptions o = TinyOptions(run);
+  o.validate_every = 0;
+  PoemTrainer second(c, hand, train, nullptr, o);
+  std::string refusal;
+  int folder_locked = 0;
+  PoemTrainerHooks hooks;
+  hooks.folder_locked = [&] {
+    ++folder_locked;
+    EXPECT_FALSE(std::filesystem::exists(run + "/loss.csv"));  // before any write
+  };
+  hooks.progress = [&](const std::string&) {
+    if (refusal.empty()) refusal = testing::InputErrorOf([&] { second.Run(true); });
+  };
+  PoemTrainer first(c, hand, train, nullptr, o, hooks);
+  EXPECT_EQ(first.Run(false).end_step, 6);
+  EXPECT_EQ(folder_locked, 1);
+  EXPECT_NE(refusal.find(run), std::string::npos) << refusal;
+  EXPECT_NE(refusal.find("in use by train, pid " + std::to_string(::getpid())),
+            std::string::npos)
+      << refusal;
+  std::ifstream in(run + "/loss.csv");
+  std::vector<std::string> steps;
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) steps.push_back(line.substr(0, line.find(',')));
+  EXPECT_EQ(steps, (std::vector<std::string>{"1", "2", "3", "4", "5", "6"}));
+  EXPECT_EQ(second.Run(true).end_step, 6);  // released: the resume has nothing to do
+}
+
+// latest.json records what decides the samples (the caller's data settings), the batch
+// size and the seed: a resume with another value of any of them is refused naming it
+// (it continued silently on other data); the same settings resume. A truncated
+// optimizer state names its file (it was a bare LibTorch message and backtrace).
+TEST(PoemTrainer, ResumeWithOtherDataOrBatchesIsRefusedAndADamagedStateNamed) {
+  const PoemConfig c = TinyPoemConfig(2);
+  const FakeSamples train(c, 5, false);
+  const HandModel hand = MakeRegressorModel();
+  const std::string run = testing::ScratchDir() + "/run";
+  PoemTrainerOptions o = TinyOptions(run);
+  o.steps = 2;
+  o.validate_every = 0;
+  o.data_settings = {{"synth", {{"seed", 4}, {"rig", {{"width", 320}}}}}};
+  PoemTrainer(c, hand, train, nullptr, o).Run(false);
+  const auto refusal = [&](const PoemTrainerOptions& other) {
+    return testing::InputErrorOf(
+        [&] { PoemTrainer(c, hand, train, nullptr, other).Run(true); });
+  };
+  o.steps = 4;
+  PoemTrainerOptions other = o;
+  other.data_settings["synth"]["seed"] = 5;
+  std::string error = refusal(other);
+  EXPECT_NE(error.find(run + "/latest.json"), std::string::npos) << error;
+  EXPECT_NE(error.find("data.synth.seed"), std::string::npos) << error;
+  EXPECT_NE(error.find("began with, 4"), std::string::npos) << error;
+  EXPECT_NE(error.find("got 5"), std::string::npos) << error;
+  other = o;
+  other.data_settings["synth"]["rig"]["width"] = 640;
+  EXPECT_NE(refusal(other).find("data.synth.rig.width"), std::string::npos);
+  other = o;
+  other.batch_size = 3;
+  EXPECT_NE(refusal(other).find("field 'batch_size'"), std::string::npos);
+  EXPECT_EQ(LatestPoemCheckpointStep(run), 2);  // nothing was trained by the refused
+  PoemTrainer(c, hand, train, nullptr, o).Run(true);
+  EXPECT_EQ(LatestPoemCheckpointStep(run), 4);
+
+  const std::string optim = run + "/checkpoints/step_00000004.optim";
+  ASSERT_TRUE(std::filesystem::exists(optim));
+  std::filesystem::resize_file(optim, std::filesystem::file_size(optim) / 2);
+  o.steps = 6;
+  error = refusal(o);
+  EXPECT_NE(error.find(optim), std::string::npos) << error;
+  EXPECT_NE(error.find("unreadable"), std::string::npos) << error;
+  EXPECT_EQ(error.find("Exception raised from"), std::string::npos) << error;
 }
 
 TEST(PoemTrainer, LearningRateScheduleWarmsUpAndDecays) {
