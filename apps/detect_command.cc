@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
@@ -72,11 +73,18 @@ int RunDetect(int argc, char** argv) {
   }
   if (!capture_dir.empty()) {
     return RunReportingErrors("detect", [&] {
-      Progress progress(CountCaptureFrames(capture_dir), std::cerr,
-                        Progress::IsTerminal(STDERR_FILENO), "detect");
+      // Made at the first frame: the capture is read under DetectCapture's writer
+      // lock (an import beside it may not have listed its frames yet).
+      std::unique_ptr<Progress> progress;
       const DetectCaptureSummary s =
-          DetectCapture(capture_dir, dc, [&](int done, int) { progress.Update(done); });
-      progress.Finish();
+          DetectCapture(capture_dir, dc, [&](int done, int total) {
+            if (!progress) {
+              progress = std::make_unique<Progress>(
+                  total, std::cerr, Progress::IsTerminal(STDERR_FILENO), "detect");
+            }
+            progress->Update(done);
+          });
+      if (progress) progress->Finish();
       std::printf(
           "frames %d, hand found in %d; views with a detection %d of %d (%d from "
           "their own palm); %.1f s\n",

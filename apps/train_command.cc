@@ -15,6 +15,7 @@
 #include "capture/synth_capture.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "formats/sha256.h"
 #include "network/poem/loss_plot.h"
 #include "network/poem/poem_trainer.h"
 #include "pipeline/capture_training_data.h"
@@ -149,7 +150,8 @@ void ExportAverage(const TrainConfig& config, const TrainFlags& f) {
     // them (no augmentation), the domain the weights will label.
     std::string hand_source;
     const HandModel hand = LoadTrainingHandModel(config, &hand_source);
-    const CaptureTrainingData data = LoadCaptureTrainingData(f.capture, hand.num_vertices());
+    const CaptureTrainingData data =
+        LoadCaptureTrainingData(f.capture, hand.num_vertices());
     const CaptureTrainingSamples train(*data.source, data.train,
                                        CaptureSampleOptionsFor(config, true));
     ExportPoemCheckpointAverageAsHalf(f.average, f.export_path, &train, f.bn_samples,
@@ -250,31 +252,38 @@ TrainingSources MakeTrainingSources(const TrainConfig& config, const HandModel& 
   return s;
 }
 
+// "3 frames, 000000 to 000002, sha256 1f0c...": which frames, comparable in one value
+// however many there are.
+std::string FrameSetText(const std::vector<LabeledFrame>& frames) {
+  if (frames.empty()) return "none";
+  std::string ids;
+  for (const LabeledFrame& frame : frames) ids += frame.id + "\n";
+  return std::to_string(frames.size()) + " frames, " + frames.front().id + " to " +
+         frames.back().id + ", sha256 " + Sha256Hex(ids).substr(0, 16);
+}
+
 // What decides the run's samples (PoemTrainerOptions::data_settings): a resume with
-// other values is refused naming the setting.
-nlohmann::json TrainingDataSettings(const TrainConfig& config, const TrainFlags& f) {
-  // The crop size, masks and augmentation seed follow from the network and the synth
-  // seed (LoadTrainConfig); the checkpoint's own config guards the network.
+// other values is refused naming the setting. The crop size, masks and augmentation
+// seed follow from the network and the synth seed (LoadTrainConfig); the checkpoint's
+// own config guards the network. A capture's frames count as the frames chosen (the
+// same frames however --train-frames spells them).
+nlohmann::json TrainingDataSettings(const TrainConfig& config, const TrainFlags& f,
+                                    const TrainingSources& sources) {
   const TrainingSampleOptions& s = config.samples;
   nlohmann::json data = {{"samples",
                           {{"box_scale", s.box_scale},
                            {"min_box_px", s.min_box_px},
                            {"frame_reuse", s.frame_reuse}}}};
-  const CaptureTrainingInputs& c = f.capture;
-  if (c.capture_dir.empty() || f.real_share < 1) {
-    data["synth"] = SynthOptionsToJson(config.synth);
-  }
-  if (!c.capture_dir.empty()) {
-    const auto absolute = [](const std::string& path) {
-      return std::filesystem::absolute(path).lexically_normal().string();
-    };
-    data["capture"] = {{"dir", absolute(c.capture_dir)},
-                       {"labels", absolute(c.labels_dir)},
-                       {"train_frames", c.train_frames},
-                       {"val_frames", c.val_frames},
-                       {"label_min_views", c.selection.min_views},
-                       {"label_max_rms_px", c.selection.max_view_rms_px},
-                       {"real_share", f.real_share}};
+  if (sources.synth_train) data["synth"] = SynthOptionsToJson(config.synth);
+  if (!f.capture.capture_dir.empty()) {
+    data["capture"] = {
+        {"dir",
+         std::filesystem::absolute(f.capture.capture_dir).lexically_normal().string()},
+        {"labels",
+         std::filesystem::absolute(f.capture.labels_dir).lexically_normal().string()},
+        {"train_frames", FrameSetText(sources.capture.train)},
+        {"validation_frames", FrameSetText(sources.capture.validation)},
+        {"real_share", f.real_share}};
   }
   return data;
 }
@@ -284,8 +293,8 @@ void Train(const TrainConfig& config, const TrainFlags& f) {
   const HandModel hand = LoadTrainingHandModel(config, &hand_source);
   std::cerr << "handlabel train: hand model " << hand_source << "\n";
   PoemTrainerOptions trainer_options = config.trainer;
-  trainer_options.data_settings = TrainingDataSettings(config, f);
   const TrainingSources sources = MakeTrainingSources(config, hand, f, &trainer_options);
+  trainer_options.data_settings = TrainingDataSettings(config, f, sources);
   const std::string run = config.trainer.out_dir;
   PoemTrainerHooks hooks;
   hooks.progress = [](const std::string& line) { std::cout << line << std::endl; };

@@ -88,10 +88,6 @@ nlohmann::json FrameDetectionsJson(const std::string& frame,
   return out;
 }
 
-int CountCaptureFrames(const std::string& capture_dir) {
-  return CaptureReader(capture_dir).num_frames();
-}
-
 DetectCaptureSummary DetectCapture(const std::string& capture_dir,
                                    const DetectCaptureOptions& options,
                                    const std::function<void(int, int)>& on_frame) {

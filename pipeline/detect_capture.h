@@ -39,14 +39,13 @@ struct DetectCaptureSummary {
   double seconds = 0;
 };
 
-// Runs every frame; `on_frame(done, total)` after each. Throws InputError naming the
-// capture when it already has detections and `overwrite` is off.
+// Runs every frame; `on_frame(done, total)` after each. Holds the capture folder's
+// writer lock (core/file_lock.h) throughout: an import or another detect on the
+// capture meanwhile is refused, as this one is while they run. Throws InputError naming
+// the capture when it already has detections and `overwrite` is off.
 DetectCaptureSummary DetectCapture(
     const std::string& capture_dir, const DetectCaptureOptions& options,
     const std::function<void(int, int)>& on_frame = nullptr);
-
-// Frames of the capture (reads its manifest; InputError when it is not a capture).
-int CountCaptureFrames(const std::string& capture_dir);
 
 // The detections record of one frame (native format plus the detector's fields).
 nlohmann::json FrameDetectionsJson(const std::string& frame,

@@ -276,7 +276,7 @@ TEST(TrainCommand, TrainsOnACapturesLabelsAndValidatesBeforeTheFirstStep) {
   // Resumed: the start is not validated again.
   const auto resumed = RunHandlabelCommand(
       {"train", "--config", config, "--resume", "--steps", "3", "--capture", capture,
-       "--labels", dir + "/fit/labels", "--val-frames", "3:4"});
+       "--labels", dir + "/fit/labels", "--val-frames", "3:4", "--real-share", "0.5"});
   ASSERT_EQ(resumed.status, 0) << resumed.err;
   EXPECT_THAT(resumed.out, ::testing::Not(HasSubstr("validation at step 2")));
 
