@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string>
 
 #include "core/json_util.h"
 #include "pipeline/job_config.h"
@@ -124,7 +125,18 @@ TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
   EXPECT_GT(next.detector_every, 1);
   const auto new_job = RunHandlabelCommand({"label", "--job", out + "/new_recordings.yaml"});
   ASSERT_EQ(new_job.status, 0) << new_job.err;
-  EXPECT_THAT(new_job.err, HasSubstr("6 frames: 6 labelled"));
+  // Frames where the detector finds the hand in no view fail by name (issue 46: they
+  // were labelled from no 2D at all, about 20 cm off); every other frame is labelled.
+  std::istringstream lines(new_job.err);
+  int new_labelled = -1, failed = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("6 frames: ", 0) == 0) new_labelled = std::stoi(line.substr(10));
+    if (line.rfind("  failed ", 0) != 0) continue;
+    ++failed;
+    EXPECT_THAT(line, HasSubstr("depth is not determined")) << line;
+  }
+  EXPECT_GE(new_labelled, 4) << new_job.err;
+  EXPECT_EQ(new_labelled + failed, 6) << new_job.err;
   const std::string network = FileBytes(out + "/network.pt");
 
   // Run again: every stage was done, nothing is redone.
