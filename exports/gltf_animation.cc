@@ -250,9 +250,8 @@ void GltfAnimationOptions::Check(const std::string& source) const {
 std::string HandAnimationGlb(const LabelSeries& series, const HandModel& model,
                              const GltfAnimationOptions& options) {
   options.Check("--fps");
-  const std::string folder = series.labels_dir + "/";
   for (const LabelRecord& label : series.labels) {
-    const std::string file = folder + FrameFileStem(label.frame, "frame id") + ".json";
+    const std::string file = series.FileOf(label.frame);
     if (!label.params)
       throw InputError(file, "mano", "MANO parameters (a fitted label)", "null");
     if (label.mesh.vertices.rows() != model.num_vertices()) {
@@ -270,7 +269,7 @@ std::string HandAnimationGlb(const LabelSeries& series, const HandModel& model,
     poses.push_back(PoseJoints(model, *label.params));
     targets.push_back(
         glb.AddFloats(CorrectiveTarget(skin, poses.back(), bind.vertices, bind.joints,
-                                       label.mesh.vertices, folder + label.frame),
+                                       label.mesh.vertices, series.FileOf(label.frame)),
                       "VEC3", GlbBuilder::kArrayBuffer));
   }
   AddMesh(model, bind, skin, targets, series, &glb);

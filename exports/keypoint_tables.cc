@@ -27,10 +27,9 @@ NdArray StackPoints(const LabelSeries& series, Points points_of) {
   for (const LabelRecord& label : series.labels) {
     const Points3d& p = points_of(label);
     if (p.rows() != rows) {
-      throw InputError(
-          series.labels_dir + "/" + FrameFileStem(label.frame, "frame id") + ".json",
-          "points", std::to_string(rows) + " rows as the first label",
-          std::to_string(p.rows()));
+      throw InputError(series.FileOf(label.frame), "points",
+                       std::to_string(rows) + " rows as the first label",
+                       std::to_string(p.rows()));
     }
     for (int r = 0; r < rows; ++r)
       for (int c = 0; c < 3; ++c) values.push_back(p(r, c));

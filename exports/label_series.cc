@@ -11,7 +11,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// `dir` itself when it holds label files, else its labels/ folder.
+// The labels/ folder of `dir` when it has one, else `dir` itself.
 fs::path LabelFolder(const std::string& dir) {
   const fs::path labels = fs::path(dir) / "labels";
   if (fs::is_directory(labels)) return labels;
@@ -23,6 +23,10 @@ fs::path LabelFolder(const std::string& dir) {
 }
 
 }  // namespace
+
+std::string LabelSeries::FileOf(const std::string& frame) const {
+  return (fs::path(labels_dir) / (FrameFileStem(frame, "frame id") + ".json")).string();
+}
 
 LabelSeries ReadLabelSeries(const std::string& dir) {
   LabelSeries series;
@@ -46,8 +50,7 @@ LabelSeries ReadLabelSeries(const std::string& dir) {
   series.side = first.side;
   series.hand_model = first.provenance.hand_model;
   for (const LabelRecord& label : series.labels) {
-    const std::string file =
-        (folder / (FrameFileStem(label.frame, "frame id") + ".json")).string();
+    const std::string file = series.FileOf(label.frame);
     if (label.side != series.side) {
       throw InputError(file, "hand_side",
                        HandSideName(series.side) + " as frame " + first.frame + " (one " +

@@ -14,6 +14,9 @@ struct LabelSeries {
   std::vector<LabelRecord> labels;  // sorted by frame id (the capture's frame order)
   HandSide side = HandSide::kRight;
   std::string hand_model;  // provenance.hand_model, the same in every label
+
+  // The label file `frame` was read from, for messages.
+  std::string FileOf(const std::string& frame) const;
 };
 
 // Reads every labels/<frame>.json of a job's output folder (`dir` may be the output
