@@ -51,6 +51,10 @@ struct FrameInput {
   // position 0.
   std::vector<std::optional<Keypoints2d>> keypoints_2d;
   std::optional<FrameGroundTruth> ground_truth;
+  // Where the hand is expected in views without 2D keypoints to cut the network's crop
+  // around: 3D points (world frame) whose projection the crop frames, e.g. the previous
+  // frame's label keypoints in a job that tracks (evidence.detector_every). Empty: none.
+  Points3d crop_prior;
 };
 
 class FrameSource {

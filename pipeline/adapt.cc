@@ -241,6 +241,7 @@ AdaptSummary RunStages(const AdaptOptions& options, std::ostream* log) {
   summary.card = ModelCard(run);
   WriteFileAtomically(run.Path("model_card.json"), summary.card.dump(1) + "\n");
   WriteFileAtomically(run.Path("model_card.md"), ModelCardMarkdown(summary.card));
+  WriteFileAtomically(run.Path("new_recordings.yaml"), JobForNewRecordings(run));
   return summary;
 }
 

@@ -32,8 +32,8 @@ std::vector<JudgedAnswer> JudgeAnswers(const AdaptRun& run, const std::string& j
   for (const std::string& id : WithFitLabel(run, run.heldout)) {
     const LabelRecord answer = ReadLabelFile(LabelFilePath(job_dir, id));
     const LabelRecord fit = ReadLabelFile(LabelFilePath(run.Path("fit"), id));
-    answers.push_back(
-        {1000 * MeanPointError(answer.mesh.keypoints, fit.mesh.keypoints), answer.quality});
+    answers.push_back({1000 * MeanPointError(answer.mesh.keypoints, fit.mesh.keypoints),
+                       answer.quality});
     vertices += 1000 * MeanPointError(answer.mesh.vertices, fit.mesh.vertices);
   }
   *mpvpe_mm = vertices / std::max<size_t>(answers.size(), 1);
@@ -57,7 +57,8 @@ nlohmann::json AnswersJson(const std::vector<JudgedAnswer>& answers, double mpvp
 
 // The adapted network's thresholds, chosen on its held-out answers
 // (adapt_thresholds.h), for the label stage (heldout.json's thresholds).
-void ChooseAdaptedThresholds(const AdaptRun& run, const std::vector<JudgedAnswer>& answers,
+void ChooseAdaptedThresholds(const AdaptRun& run,
+                             const std::vector<JudgedAnswer>& answers,
                              const QualityThresholds& current, nlohmann::json* result) {
   ThresholdStudy study;
   const QualityThresholds chosen =
@@ -124,18 +125,19 @@ void HeldoutStage(const AdaptRun& run) {
     result[name]["weights"] = weights;
     if (name == "after") ChooseAdaptedThresholds(run, answers, job.quality, &result);
     result[name]["job_metrics"] = summary.ToJson().value("metrics", nlohmann::json());
-    run.Say("heldout: network " + name + ": " +
-            FormatNumber(std::round(10 * result[name]["mpjpe_mm_vs_fit_labels"]
-                                             .get<double>()) /
-                         10) +
-            " mm from the fit labels (" + dir + ")");
+    run.Say(
+        "heldout: network " + name + ": " +
+        FormatNumber(
+            std::round(10 * result[name]["mpjpe_mm_vs_fit_labels"].get<double>()) / 10) +
+        " mm from the fit labels (" + dir + ")");
   }
   WriteFileAtomically(run.Path("heldout/heldout.json"), result.dump(1) + "\n");
 }
 
 // What the network learned from, how long, and what it measures on held-out frames.
 nlohmann::json ModelCard(const AdaptRun& run) {
-  const nlohmann::json selection = ReadJsonFileStrict(run.Path("train/capture_labels.json"));
+  const nlohmann::json selection =
+      ReadJsonFileStrict(run.Path("train/capture_labels.json"));
   const nlohmann::json summary = ReadIfExists(run.Path("summary.json"));
   const nlohmann::json detection = ReadIfExists(run.Path("detect.json"));
   const bool detected = detection.is_object() && detection.value("ran", false);
@@ -151,14 +153,14 @@ nlohmann::json ModelCard(const AdaptRun& run) {
       {"training_frames_with_fit_label", selection["training_frames"]},
       {"training_labels_kept", selection["kept"]},
       {"selection_rule", selection["rule"]},
-      {"heldout_frames",
-       run.heldout.empty() ? nlohmann::json()
-                           : nlohmann::json{run.heldout.front(), run.heldout.back()}},
+      {"heldout_frames", run.heldout.empty()
+                             ? nlohmann::json()
+                             : nlohmann::json{run.heldout.front(), run.heldout.back()}},
       {"plan", ReadJsonFileStrict(run.Path("train/plan.json"))},
       {"export", ReadIfExists(run.Path("export.json"))},
       {"heldout", ReadIfExists(run.Path("heldout/heldout.json"))},
-      {"labels_by_path",
-       summary.is_object() ? summary.value("by_path", nlohmann::json()) : nlohmann::json()},
+      {"labels_by_path", summary.is_object() ? summary.value("by_path", nlohmann::json())
+                                             : nlohmann::json()},
       // The label stage reuses the detections: the detector's time is not in it.
       {"detection", detection},
       {"frames_per_second",
@@ -170,6 +172,37 @@ nlohmann::json ModelCard(const AdaptRun& run) {
       {"total_seconds", run.ElapsedSeconds()},
       {"version", GetBuildInfo().version}};
   return card;
+}
+
+std::string JobForNewRecordings(const AdaptRun& run) {
+  const nlohmann::json heldout = ReadIfExists(run.Path("heldout/heldout.json"));
+  const bool chosen = heldout.is_object() && heldout.contains("thresholds");
+  // JSON strings are YAML's double-quoted scalars: any path survives.
+  auto quoted = [](const std::string& text) { return nlohmann::json(text).dump(); };
+  std::ostringstream yaml;
+  yaml << "# A label job for new recordings of this rig with the adapted network, "
+          "written\n"
+          "# by handlabel adapt (docs/adapt.md \"Labelling new recordings\"). Set "
+          "input.path\n"
+          "# to the new capture and output.dir, then: handlabel label --job <this file>\n"
+       << "name: adapted\nseed: " << run.o.seed << "\n"
+       << "input: {format: native, path: " << quoted(run.o.capture_dir) << "}\n"
+       << "network: {weights: " << quoted(run.Path("network.pt"))
+       << ", threads: " << run.o.threads << "}\n"
+       << "refine: {mode: fallback";
+  if (chosen) {
+    const nlohmann::json& refine = heldout["thresholds"]["refine"];
+    for (const char* field :
+         {"max_reprojection_px", "max_view_disagreement_mm", "max_detector_rms_px"}) {
+      yaml << ", " << field << ": " << refine[field].dump();  // as chosen, unrounded
+    }
+  }
+  yaml << "}\n"
+       << "evidence: {keypoints_2d: detector, detector_every: "
+       << kNewRecordingsDetectorEvery << ", masks: none}\n"
+       << "output: {dir: " << quoted(run.Path("new_labels"))
+       << ", overlays: " << (run.o.overlays ? "true" : "false") << "}\n";
+  return yaml.str();
 }
 
 std::string ModelCardMarkdown(const nlohmann::json& card) {
@@ -195,12 +228,13 @@ std::string ModelCardMarkdown(const nlohmann::json& card) {
   if (card["heldout"].is_object() && card["heldout"].contains("thresholds")) {
     const nlohmann::json& t = card["heldout"]["thresholds"];
     md << "Quality-check thresholds chosen on the adapted answers (bad: farther than "
-       << Sig(t["accept_mm"]) << " mm from the fit label; " << t["bad_answers"]
-       << " of " << t["bad_answers"].get<int>() + t["good_answers"].get<int>()
+       << Sig(t["accept_mm"]) << " mm from the fit label; " << t["bad_answers"] << " of "
+       << t["bad_answers"].get<int>() + t["good_answers"].get<int>()
        << " are): the joint decision's Youden's J " << Sig(t["youden_current"]) << " -> "
        << Sig(t["youden_chosen"]) << ", answers kept " << t["kept_current"] << " ("
        << t["kept_bad_current"] << " bad) -> " << t["kept_chosen"] << " ("
-       << t["kept_bad_chosen"] << " bad).\n\n| check | current | chosen |\n|---|---|---|\n";
+       << t["kept_bad_chosen"]
+       << " bad).\n\n| check | current | chosen |\n|---|---|---|\n";
     for (const nlohmann::json& c : t["checks"]) {
       md << "| " << c["check"].get<std::string>() << " | " << Sig(c["current"]) << " | "
          << Sig(c["chosen"]) << " |\n";
@@ -221,8 +255,8 @@ std::string ModelCardMarkdown(const nlohmann::json& card) {
   for (const auto& [stage, seconds] : card["seconds"].items()) {
     md << " " << stage << " " << Sig(seconds);
   }
-  md << "; total " << Sig(card["total_seconds"]) << " (" << Sig(card["total_seconds"].get<double>() / 60)
-     << " min).\n";
+  md << "; total " << Sig(card["total_seconds"]) << " ("
+     << Sig(card["total_seconds"].get<double>() / 60) << " min).\n";
   return md.str();
 }
 

@@ -31,7 +31,9 @@ struct AdaptRun {
   void Say(const std::string& line) const {
     if (log) *log << "handlabel adapt: " << line << std::endl;
   }
-  std::string Path(const std::string& relative) const { return (out / relative).string(); }
+  std::string Path(const std::string& relative) const {
+    return (out / relative).string();
+  }
   double ElapsedSeconds() const {
     double s = 0;
     for (const auto& [stage, seconds] : progress.items()) s += seconds.get<double>();
@@ -39,12 +41,12 @@ struct AdaptRun {
   }
 };
 
-
 // The file's JSON, or null when there is none.
 nlohmann::json ReadIfExists(const std::string& path);
 
 // A job over the capture's detections without masks (their 2D is the evidence).
-JobConfig CaptureJob(const AdaptRun& run, const std::string& name, const std::string& out);
+JobConfig CaptureJob(const AdaptRun& run, const std::string& name,
+                     const std::string& out);
 // Runs (or continues) a job of the run.
 LabelSummary RunJob(const AdaptRun& run, const JobConfig& job);
 // The frames the fit labelled (it fails a frame whose detections do not pin the hand
@@ -57,6 +59,12 @@ std::vector<std::string> WithFitLabel(const AdaptRun& run,
 void TrainStage(AdaptRun* run);
 void ExportStage(const AdaptRun& run);
 void HeldoutStage(const AdaptRun& run);
+
+// The label job file for new recordings of the rig (new_recordings.yaml): the adapted
+// network with the chosen thresholds, the detector on 1 frame in
+// kNewRecordingsDetectorEvery and the network's crops tracked in between.
+constexpr int kNewRecordingsDetectorEvery = 10;
+std::string JobForNewRecordings(const AdaptRun& run);
 
 // The model card (model_card.json) and its Markdown (model_card.md).
 nlohmann::json ModelCard(const AdaptRun& run);

@@ -37,9 +37,11 @@ std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
 
 DetectorFrameSource::DetectorFrameSource(std::unique_ptr<FrameSource> inner,
                                          const DetectCaptureOptions& options,
-                                         std::shared_ptr<DetectionStore> store)
+                                         std::shared_ptr<DetectionStore> store,
+                                         bool detect_on_load)
     : Replaced2dFrameSource(std::move(inner)),
       options_(options),
+      detect_on_load_(detect_on_load),
       store_(std::move(store)) {
   options_.Check("evidence.keypoints_2d: detector");
   detector_ = std::make_unique<MediapipeHands>(options_.hands);
@@ -59,15 +61,22 @@ FrameInput DetectorFrameSource::Load(const std::string& id) const {
                        "none for camera " + frame.rig[c].name);
     }
   }
+  // The capture's own 2D (if any) is not this job's evidence.
+  frame.keypoints_2d.clear();
+  if (detect_on_load_) Detect(&frame);
+  return frame;
+}
+
+void DetectorFrameSource::Detect(FrameInput* frame) const {
   FrameHandResult result;
   {
     // One frame at a time: the models are shared, and they use the cores themselves.
     std::lock_guard<std::mutex> lock(detect_mutex_);
-    result = DetectHandMultiView(*detector_, frame.rig, frame.images, options_.multiview);
+    result =
+        DetectHandMultiView(*detector_, frame->rig, frame->images, options_.multiview);
   }
-  frame.keypoints_2d = KeypointsFromDetection(result);
-  if (store_) store_->Put(id, std::move(result));
-  return frame;
+  frame->keypoints_2d = KeypointsFromDetection(result);
+  if (store_) store_->Put(frame->id, std::move(result));
 }
 
 std::string DetectorFrameSource::KeypointsSource() const {

@@ -42,17 +42,22 @@ std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
 class DetectorFrameSource : public Replaced2dFrameSource {
  public:
   // Loads the models (InputError naming the file when one is missing). `store` may be
-  // null (nothing kept).
+  // null (nothing kept). With `detect_on_load` false, Load only reads and decodes: the
+  // caller detects the frames it needs with Detect (a job that tracks the hand,
+  // evidence.detector_every).
   DetectorFrameSource(std::unique_ptr<FrameSource> inner,
                       const DetectCaptureOptions& options,
-                      std::shared_ptr<DetectionStore> store);
+                      std::shared_ptr<DetectionStore> store, bool detect_on_load = true);
   // Reads the frame's images (InputError naming a file that cannot be read or does not
-  // fit its camera) and detects; frames are detected one at a time.
+  // fit its camera) and detects unless told not to; frames are detected one at a time.
   FrameInput Load(const std::string& id) const override;
+  // Detects the hand in a frame that Load read: sets frame->keypoints_2d.
+  void Detect(FrameInput* frame) const;
   std::string KeypointsSource() const override;
 
  private:
   DetectCaptureOptions options_;
+  bool detect_on_load_ = true;
   std::unique_ptr<MediapipeHands> detector_;
   std::shared_ptr<DetectionStore> store_;
   mutable std::mutex detect_mutex_;

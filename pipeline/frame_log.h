@@ -27,6 +27,9 @@ struct FrameRecord {
   int64_t label_bytes = -1;
   std::string label_sha256;
   std::string job_hash;  // the job the record belongs to ("" in older logs)
+  // Jobs that track the hand (evidence.detector_every): where the network's crops came
+  // from, "detector" or "previous_label"; "" otherwise.
+  std::string crops;
 };
 
 // Why the label file at `label_path` is not the one `record` (an ok record) wrote:

@@ -164,6 +164,7 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
   evidence.Read("ignore_views", &job->ignore_views);
   evidence.Read("detections", &job->detections);
   evidence.Read("detector_model", &job->detector_model);
+  evidence.Read("detector_every", &job->detector_every);
   if (job->detector_model != "full" && job->detector_model != "lite") {
     throw InputError(path, evidence.Name("detector_model"), "full | lite",
                      "'" + job->detector_model + "'");
@@ -224,6 +225,32 @@ std::string ToString(RefineMode mode) {
   return "?";
 }
 
+namespace {
+
+// evidence.detector_every.
+void CheckTracking(const JobConfig& job, const std::string& source) {
+  RequireAtLeast(source, "evidence.detector_every", job.detector_every, 1);
+  if (job.detector_every == 1) return;
+  const std::string why = " (evidence.detector_every " +
+                          std::to_string(job.detector_every) +
+                          " tracks the hand: the detector runs only where needed)";
+  if (!job.keypoints_from_detector) {
+    throw InputError(source, "evidence.keypoints_2d", "detector" + why,
+                     job.keypoints == KeypointSource::kNetwork ? "'network'"
+                     : job.keypoints == KeypointSource::kFiles ? "'files'"
+                                                               : "'both'");
+  }
+  if (job.network_weights.empty()) {
+    throw InputError(source, "network.weights", "a network to track with" + why);
+  }
+  if (job.refine_mode != RefineMode::kFallback) {
+    throw InputError(source, "refine.mode", "fallback" + why,
+                     "'" + ToString(job.refine_mode) + "'");
+  }
+}
+
+}  // namespace
+
 void JobConfig::Check(const std::string& source) const {
   const std::set<std::string> formats = {"native", "dexycb", "ho3d", "oakink"};
   if (!formats.count(input_format)) {
@@ -250,6 +277,7 @@ void JobConfig::Check(const std::string& source) const {
   if (network_weights.empty() && keypoints != KeypointSource::kFiles) {
     throw InputError(source, "evidence.keypoints_2d", "'files' when there is no network");
   }
+  CheckTracking(*this, source);
   RequireGreater(source, "refine.max_reprojection_px", quality.max_reprojection_px, 0);
   RequireGreater(source, "refine.max_view_disagreement_mm",
                  quality.max_view_disagreement_mm, 0);

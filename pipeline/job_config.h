@@ -137,6 +137,12 @@ struct JobConfig {
   bool keypoints_from_detector = false;
   // evidence.detector_model: full | lite (MediaPipe's two model sizes).
   std::string detector_model = "full";
+  // evidence.detector_every: N > 1 tracks the hand (with keypoints_2d: detector, a
+  // network and refine fallback; pipeline/label_job.h): the detector runs on every
+  // N-th frame of the job, on a shard's first frame, after a frame without a label and
+  // on frames whose network answer, cut around the previous frame's label, fails its
+  // checks; 1 = on every frame.
+  int detector_every = 1;
   // Camera names whose 2D keypoints and masks are not fitted to (a broken camera).
   std::vector<std::string> ignore_views;
   // Silhouette residual scale (pixels per unit) for the network's masks. In the file

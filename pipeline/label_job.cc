@@ -1,5 +1,6 @@
 #include "pipeline/label_job.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
@@ -15,7 +16,6 @@
 #include <fstream>
 #include <functional>
 #include <memory>
-#include <set>
 #include <sstream>
 
 #include "capture/frame_images.h"
@@ -29,6 +29,7 @@
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/output_lock.h"
+#include "pipeline/quality_checks.h"
 
 namespace handlabel {
 namespace {
@@ -46,7 +47,23 @@ struct Batch {
   // Non-empty: the network failed on this frame; in fallback mode the fitter takes over.
   std::vector<std::string> network_errors;
   std::vector<double> seconds;
+  // Jobs that track the hand: where the network's crops came from (FrameRecord::crops).
+  std::vector<std::string> crops;
 };
+
+std::shared_ptr<Batch> MakeBatch(size_t index, std::vector<std::string> ids) {
+  auto batch = std::make_shared<Batch>();
+  batch->index = index;
+  batch->ids = std::move(ids);
+  const size_t n = batch->ids.size();
+  batch->inputs.resize(n);
+  batch->predictions.resize(n);
+  batch->errors.resize(n);
+  batch->network_errors.resize(n);
+  batch->seconds.assign(n, 0.0);
+  batch->crops.resize(n);
+  return batch;
+}
 
 std::string Describe(const std::exception_ptr& error) {
   try {
@@ -109,140 +126,6 @@ void ClaimOutputFolder(const JobConfig& job, const std::string& job_hash, bool f
   WriteFileAtomically(stamp, j.dump(1) + "\n");
 }
 
-template <typename T>
-nlohmann::json Optional(const std::optional<T>& value) {
-  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
-}
-
-nlohmann::json FitSettingsJson(const FitSettings& f) {
-  nlohmann::json j = {f.init,
-                      Optional(f.keypoint_loss),
-                      Optional(f.keypoint_loss_scale),
-                      Optional(f.keypoint_sigma_px),
-                      Optional(f.silhouette_sigma_px),
-                      Optional(f.silhouette_rounds),
-                      Optional(f.pose_pca_comps),
-                      Optional(f.joint_limits),
-                      Optional(f.optimise_shape)};
-  // Added later: only when set, so the hash of older fit settings stays.
-  if (f.silhouette_check || f.unknown_occluders) {
-    j.push_back({Optional(f.silhouette_check), Optional(f.unknown_occluders)});
-  }
-  if (f.mask_margin_px) j.push_back({{"mask_margin_px", *f.mask_margin_px}});
-  return j;
-}
-
-}  // namespace
-
-std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
-  const QualityThresholds& q = job.quality;
-  nlohmann::json j = {
-      {"label_format", kLabelFormatVersion},
-      {"input", {job.input_format, job.input_path, job.frames}},
-      {"cameras", {job.cameras_source, job.cameras_file}},
-      {"hand_model", job.hand_model},
-      {"weights_sha256", weights_sha256},
-      {"refine",
-       {ToString(job.refine_mode), q.max_reprojection_px, q.max_view_disagreement_mm,
-        q.min_confidence, q.min_views, q.min_hand_span_m, q.max_hand_span_m}},
-      {"evidence", {static_cast<int>(job.keypoints), static_cast<int>(job.masks)}},
-      {"seed", job.seed}};
-  // Fields added later enter only when set, so older jobs keep their hash (and their
-  // output folders resume).
-  nlohmann::json extra = nlohmann::json::object();
-  if (job.max_frames > 0) extra["max_frames"] = job.max_frames;
-  if (job.keypoint_files != "auto" || job.mask_files != "auto" ||
-      !job.ignore_views.empty()) {
-    extra["evidence_files"] = {job.keypoint_files, job.mask_files, job.ignore_views};
-  }
-  if (!job.fit.IsDefault()) extra["fit"] = FitSettingsJson(job.fit);
-  if (!job.object_masks) extra["object_masks"] = "none";
-  if (!job.detections.empty()) extra["detections"] = job.detections;
-  if (job.keypoints_from_detector) extra["detector"] = job.detector_model;
-  // Labels made before the reading was chosen used the joints.
-  if (!weights_sha256.empty() && job.network_keypoints != AnswerKeypoints::kJoints) {
-    extra["network_keypoints"] = ToString(job.network_keypoints);
-  }
-  // Refinement against file 2D changed (issue 43): the network's answer is a loose start
-  // with a restart from the views, so jobs that refine it against files hash anew.
-  if (!weights_sha256.empty() && job.keypoints != KeypointSource::kNetwork &&
-      job.refine_mode != RefineMode::kOff) {
-    extra["refine_against_files"] = {job.refine_network_sigma_mm, job.refine_restart_px};
-  }
-  // The network's answer judged against the file 2D too (issue 43).
-  if (!weights_sha256.empty() && job.keypoints != KeypointSource::kNetwork) {
-    extra["detector_agreement"] = q.max_detector_rms_px;
-  }
-  if (!extra.empty()) j["added"] = extra;
-  return Sha256Hex(j.dump());
-}
-
-std::vector<std::string> SelectFrames(const std::vector<std::string>& all_frames,
-                                      const std::string& spec, const std::string& source,
-                                      const std::string& field) {
-  if (spec == "all" || spec.empty()) return all_frames;
-  const size_t colon = spec.find(':');
-  if (colon != std::string::npos) {
-    size_t begin = 0, end = all_frames.size();
-    try {
-      if (colon > 0) begin = std::stoul(spec.substr(0, colon));
-      if (colon + 1 < spec.size()) end = std::stoul(spec.substr(colon + 1));
-    } catch (const std::exception&) {
-      throw InputError(source, field, "'all', 'a:b' or 'id,id,...'", "'" + spec + "'");
-    }
-    if (begin > end || end > all_frames.size()) {
-      throw InputError(
-          source, field,
-          "a range within the capture's " + std::to_string(all_frames.size()) + " frames",
-          "'" + spec + "'");
-    }
-    return {all_frames.begin() + begin, all_frames.begin() + end};
-  }
-  const std::set<std::string> known(all_frames.begin(), all_frames.end());
-  std::set<std::string> chosen;
-  size_t start = 0;
-  while (start <= spec.size()) {
-    size_t comma = spec.find(',', start);
-    if (comma == std::string::npos) comma = spec.size();
-    std::string id = spec.substr(start, comma - start);
-    id.erase(0, id.find_first_not_of(' '));
-    id.erase(id.find_last_not_of(' ') + 1);
-    if (!id.empty()) {
-      if (!known.count(id)) {
-        throw InputError(source, field, "frame ids of the capture", "'" + id + "'");
-      }
-      if (!chosen.insert(id).second) {
-        throw InputError(source, field, "each frame id once",
-                         "'" + id + "' listed twice");
-      }
-    }
-    start = comma + 1;
-  }
-  std::vector<std::string> frames;
-  for (const std::string& f : all_frames) {
-    if (chosen.count(f)) frames.push_back(f);
-  }
-  return frames;
-}
-
-std::vector<std::string> JobFrames(const JobConfig& job, const FrameSource& source) {
-  const std::vector<std::string> all = source.FrameIds();
-  std::set<std::string> seen;
-  for (const std::string& id : all) {  // a frame listed twice would be labelled twice
-    if (!seen.insert(id).second) {
-      throw InputError(source.Describe(), "frames", "each frame id once",
-                       "'" + id + "' listed twice");
-    }
-  }
-  std::vector<std::string> frames = SelectFrames(all, job.frames, job.source_file);
-  if (job.max_frames > 0 && static_cast<int>(frames.size()) > job.max_frames) {
-    frames.resize(job.max_frames);
-  }
-  return frames;
-}
-
-namespace {
-
 // One run of one shard of a job: plan (frames, resume, folder), label every frame to
 // do through the stages, then summarise and, for a whole-job run, merge.
 class LabelJobRun {
@@ -269,7 +152,9 @@ class LabelJobRun {
     Progress progress(static_cast<int>(todo_.size()),
                       options_.log ? *options_.log : discard, options_.interactive);
     progress_ = &progress;
-    if (in_order_) {
+    if (stages_.find_keypoints_2d) {
+      LabelTracked();
+    } else if (in_order_) {
       LabelInOrder();
     } else {
       LabelPipelined();
@@ -286,6 +171,10 @@ class LabelJobRun {
     job_hash_ = JobHash(job_, weights_sha_);
     all_frames_ = JobFrames(job_, *stages_.source);
     mine_ = FramesOfShard(all_frames_, options_.shard);
+    shard_begin_ = mine_.empty()
+                       ? 0
+                       : std::find(all_frames_.begin(), all_frames_.end(), mine_[0]) -
+                             all_frames_.begin();
     for (const std::string& f : mine_) FrameFileStem(f, stages_.source->Describe());
     lock_ = OutputFolderLock::ForShard(out_, options_.shard, job_.source_file);
     ClaimOutputFolder(job_, job_hash_, options_.force, &lock_);
@@ -364,18 +253,10 @@ class LabelJobRun {
   // The next batch of frames to do (serial), or nullptr when all are handed out.
   std::shared_ptr<Batch> NextBatch(size_t size) {
     if (next_ >= todo_.size()) return nullptr;
-    auto batch = std::make_shared<Batch>();
     const size_t end = std::min(todo_.size(), next_ + size);
-    batch->index = batches_++;
-    batch->ids.assign(todo_.begin() + next_, todo_.begin() + end);
+    std::vector<std::string> ids(todo_.begin() + next_, todo_.begin() + end);
     next_ = end;
-    const size_t n = batch->ids.size();
-    batch->inputs.resize(n);
-    batch->predictions.resize(n);
-    batch->errors.resize(n);
-    batch->network_errors.resize(n);
-    batch->seconds.assign(n, 0.0);
-    return batch;
+    return MakeBatch(batches_++, std::move(ids));
   }
 
   // Reads one frame of the batch; a read error fails that frame only.
@@ -481,6 +362,7 @@ class LabelJobRun {
       record.label_sha256 = Sha256OfFile(label);
     }
     record.seconds = batch.seconds[i] + SecondsSince(frame_start);
+    record.crops = batch.crops[i];
     log_->Record(record);
     progress_->FrameDone(!error.empty());
     batch.inputs[i].reset();  // free the frame's memory early
@@ -565,12 +447,130 @@ class LabelJobRun {
     }
   }
 
+  // A job that tracks the hand (evidence.detector_every): runs of frames in order, each
+  // frame's crops from the previous frame's label; runs in parallel, one per network
+  // lane (in order with fit.init previous).
+  void LabelTracked() {
+    const std::vector<std::vector<size_t>> runs = TrackRuns();
+    auto label_run = [this](const std::vector<size_t>& run) {
+      for (const size_t i : run) LabelTrackedFrame(i);
+    };
+    if (in_order_) {
+      for (const auto& run : runs) label_run(run);
+      return;
+    }
+    tbb::task_arena arena(std::max(1, stages_.predictor->lanes));
+    arena.execute([&] {
+      tbb::parallel_for(
+          tbb::blocked_range<size_t>(0, runs.size(), 1),
+          [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t k = r.begin(); k != r.end(); ++k) label_run(runs[k]);
+          },
+          tbb::simple_partitioner());
+    });
+  }
+
+  // The shard's frames to do (positions in mine_) in runs that depend on nothing
+  // another run labels: a run starts at a frame the detector runs on anyway
+  // (TrackPrior) or after a gap (its prior then is a label of an earlier run).
+  std::vector<std::vector<size_t>> TrackRuns() const {
+    std::vector<std::vector<size_t>> runs;
+    size_t t = 0;
+    for (size_t i = 0; i < mine_.size() && t < todo_.size(); ++i) {
+      if (mine_[i] != todo_[t]) continue;
+      ++t;
+      if (runs.empty() || runs.back().back() != i - 1 || IsTrackAnchor(i)) {
+        runs.emplace_back();
+      }
+      runs.back().push_back(i);
+    }
+    return runs;
+  }
+
+  // The detector runs on every N-th frame of the job (positions in the job's frame
+  // order, so that shards and resumed runs choose the same frames) and on the shard's
+  // first frame.
+  bool IsTrackAnchor(size_t i) const {
+    return i == 0 || (shard_begin_ + i) % static_cast<size_t>(job_.detector_every) == 0;
+  }
+
+  // Where frame mine_[i] is expected: the previous frame's label keypoints moved on by
+  // their last step (the hand keeps its speed over one frame); labels are read from
+  // their files, written by this run or an earlier one, so a resumed job crops as an
+  // uninterrupted one. None at an anchor or when the previous frame has no label.
+  std::optional<Points3d> TrackPrior(size_t i) const {
+    if (IsTrackAnchor(i)) return std::nullopt;
+    const std::optional<Points3d> last = LabelKeypoints(mine_[i - 1]);
+    if (!last || IsTrackAnchor(i - 1)) return last;
+    const std::optional<Points3d> before = LabelKeypoints(mine_[i - 2]);
+    if (!before) return last;
+    return Points3d(2 * *last - *before);
+  }
+
+  std::optional<Points3d> LabelKeypoints(const std::string& frame) const {
+    const std::string path = LabelFilePath(out_, frame);
+    if (!fs::exists(path)) return std::nullopt;
+    try {
+      return ReadLabelFile(path).mesh.keypoints;
+    } catch (const std::exception&) {
+      return std::nullopt;  // an unreadable label: no prior from it
+    }
+  }
+
+  // One frame of a tracked job: the network on crops around the previous frame's
+  // label; if that answer fails its checks (or there is no prior), the frame is
+  // detected and labelled as a job that detects every frame labels it.
+  void LabelTrackedFrame(size_t i) {
+    std::shared_ptr<Batch> batch = MakeBatch(0, {mine_[i]});
+    Load(*batch, 0);
+    const std::optional<Points3d> prior = TrackPrior(i);
+    if (prior && batch->errors[0].empty()) {
+      batch->inputs[0]->crop_prior = *prior;
+      Predict(*batch);
+      if (TrackedAnswerPasses(*batch)) {
+        batch->crops[0] = "previous_label";
+        FinishFrame(*batch, 0);
+        return;
+      }
+      batch->inputs[0]->crop_prior = Points3d();
+      batch->predictions[0].reset();
+      batch->network_errors[0].clear();
+    }
+    FindKeypoints2d(*batch);
+    Predict(*batch);
+    batch->crops[0] = "detector";
+    FinishFrame(*batch, 0);
+  }
+
+  // The quality checks of a tracked frame's answer (no file 2D to judge it against).
+  bool TrackedAnswerPasses(const Batch& batch) const {
+    if (!batch.predictions[0]) return false;
+    return CheckPrediction(batch.inputs[0]->rig, *batch.predictions[0], job_.quality)
+        .Passed();
+  }
+
+  void FindKeypoints2d(Batch& batch) const {
+    if (!batch.errors[0].empty()) return;
+    const Clock::time_point t = Clock::now();
+    try {
+      stages_.find_keypoints_2d(&*batch.inputs[0]);
+    } catch (...) {
+      batch.errors[0] = "detect: " + Describe(std::current_exception());
+    }
+    batch.seconds[0] += SecondsSince(t);
+  }
+
   // What the job's 2D keypoints are: the capture's (or evidence.detections'), the
   // network's, or both (evidence.keypoints_2d).
   std::string KeypointsSourceText() const {
     const std::string files = stages_.source->KeypointsSource();
     const std::string own = stages_.predictor ? "the network's own 2D" : "";
     if (job_.keypoints == KeypointSource::kNetwork) return own;
+    if (job_.keypoints == KeypointSource::kFiles && stages_.find_keypoints_2d) {
+      return files + ", run on 1 frame in " + std::to_string(job_.detector_every) +
+             " and where the network's answer from crops around the previous frame's "
+             "label fails its checks";
+    }
     if (job_.keypoints == KeypointSource::kFiles) return files.empty() ? "none" : files;
     return files.empty() ? own : files + ", else " + own;
   }
@@ -607,6 +607,7 @@ class LabelJobRun {
   const std::string out_;
   std::string weights_sha_, job_hash_, log_path_;
   std::vector<std::string> all_frames_, mine_, todo_;
+  size_t shard_begin_ = 0;  // position of the shard's first frame in all_frames_
   int done_before_ = 0;
   int threads_ = 1;
   bool in_order_ = false;

@@ -6,6 +6,13 @@
 // one frame at a time in the job's frame order. `handlabel fit` is this runner on a
 // job without a network (fit_capture.h).
 //
+// Tracking (evidence.detector_every N > 1, LabelStageSet::find_keypoints_2d): the
+// detector costs more than the network, so it runs only on every N-th frame of the job
+// (and a shard's first frame); a frame in between gives the network crops cut around
+// the previous frame's label moved on by its last step (FrameInput::crop_prior), and
+// is detected and labelled as usual only when that answer fails its checks. Frames run
+// in order within runs that start at detected frames, the runs in parallel.
+//
 //  - Resume: a frame is finished once its files are renamed into place and its record
 //    appended to the shard log (frame_log.h). A re-run with resume skips finished
 //    frames, so `kill -9` at any moment loses no finished frame; leftovers of
@@ -18,6 +25,7 @@
 //    (output_lock.h) from planning to the end; a finished frame's record carries the
 //    label file's size and SHA-256, checked on resume (frame_log.h).
 
+#include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -48,6 +56,9 @@ struct LabelStageSet {
   std::string hand_model_name;              // recorded in provenance
   HandSide side = HandSide::kRight;
   Faces faces;  // for mesh files
+  // A job that tracks the hand (evidence.detector_every > 1): the source loads frames
+  // without their 2D and this finds it for the frames that need it; empty otherwise.
+  std::function<void(FrameInput*)> find_keypoints_2d;
 };
 
 struct LabelRunOptions {

@@ -57,6 +57,7 @@ LabelStageSet BuiltLabelStages::Set() const {
   set.hand_model_name = hand_model.name;
   set.side = hand_model.side;
   set.faces = hand_model.faces;
+  set.find_keypoints_2d = find_keypoints_2d;
   return set;
 }
 
@@ -83,8 +84,9 @@ std::unique_ptr<FrameSource> BuildCaptureSource(const JobConfig& job,
 
 }  // namespace
 
-std::unique_ptr<FrameSource> BuildFrameSource(
-    const JobConfig& job, std::shared_ptr<DetectionStore> detections) {
+std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job,
+                                              std::shared_ptr<DetectionStore> detections,
+                                              const DetectorFrameSource** detector) {
   std::optional<Rig> cameras;
   if (job.cameras_source == "file")
     cameras = ReadCamerasFile(job.cameras_file, job.source_file);
@@ -96,8 +98,12 @@ std::unique_ptr<FrameSource> BuildFrameSource(
   if (job.keypoints_from_detector) {
     DetectCaptureOptions detect;
     detect.hands.model = job.detector_model;
-    source = std::make_unique<DetectorFrameSource>(std::move(source), detect,
-                                                   std::move(detections));
+    // A job that tracks detects only the frames that need it (label_job.h).
+    const bool detect_on_load = job.detector_every == 1;
+    auto on_images = std::make_unique<DetectorFrameSource>(
+        std::move(source), detect, std::move(detections), detect_on_load);
+    if (detector) *detector = on_images.get();
+    source = std::move(on_images);
   }
   // A dataset without 2D keypoints gives the network nothing to crop on and the fit
   // nothing to fit: the job must name its 2D.
@@ -121,7 +127,11 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job,
   if (job.keypoints_from_detector && job.overlays) {
     detections = std::make_shared<DetectionStore>();
   }
-  built.source = BuildFrameSource(job, detections);
+  const DetectorFrameSource* detector = nullptr;
+  built.source = BuildFrameSource(job, detections, &detector);
+  if (detector && job.detector_every > 1) {
+    built.find_keypoints_2d = [detector](FrameInput* frame) { detector->Detect(frame); };
+  }
   const HandSide side = built.source->side().value_or(HandSide::kRight);
   ResolvedHandModel hand = ResolveHandModel(job.hand_model, side);
   built.hand_model = std::move(hand.model);

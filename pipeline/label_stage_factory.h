@@ -23,6 +23,8 @@ struct BuiltLabelStages {
   HandModel hand_model;
   // Why the hand model is not the one asked for (ResolveHandModel's note), "" if nothing.
   std::string hand_model_note;
+  // The detector on demand of a job that tracks (LabelStageSet::find_keypoints_2d).
+  std::function<void(FrameInput*)> find_keypoints_2d;
   // Views of the above for RunLabelJob.
   LabelStageSet Set() const;
 };
@@ -34,8 +36,9 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job,
 
 // Only the frame source (what `handlabel merge` needs to list the job's frames). With
 // evidence.keypoints_2d: detector, the detector's answers go into `detections` when
-// given.
+// given, and `detector` (when given) points at the detecting source.
 std::unique_ptr<FrameSource> BuildFrameSource(
-    const JobConfig& job, std::shared_ptr<DetectionStore> detections = nullptr);
+    const JobConfig& job, std::shared_ptr<DetectionStore> detections = nullptr,
+    const DetectorFrameSource** detector = nullptr);
 
 }  // namespace handlabel

@@ -29,7 +29,8 @@ struct MeshPrediction {
   std::vector<Keypoints2d> keypoints_2d;  // one per rig camera: the network's own 2D
   std::optional<HandParams> params;       // when the network regresses them
   // One per rig camera: the network's hand silhouette in the full image (255 = hand;
-  // a 0 x 0 mask where it found none); empty when the network has no mask head.
+  // a 0 x 0 mask where it found none); empty when the network has no mask head or
+  // the job does not fit to its masks.
   std::vector<MaskImage> masks;
 };
 

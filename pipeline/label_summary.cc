@@ -58,6 +58,7 @@ LabelSummary Summarize(const std::vector<std::string>& frames,
     if (r.status == "ok") {
       ++s.ok;
       ++s.by_path[r.path];
+      if (!r.crops.empty()) ++s.by_crops[r.crops];
     } else {
       ++s.failed;
       s.failures.emplace_back(frame, r.reason);
@@ -81,6 +82,7 @@ nlohmann::json LabelSummary::ToJson() const {
                       {"skipped", skipped},
                       {"by_path", by_path},
                       {"frame_seconds", frame_seconds}};
+  if (!by_crops.empty()) j["by_crops"] = by_crops;
   // A merge does not know a wall time (shards may run anywhere): no field then.
   if (wall_seconds > 0) j["wall_seconds"] = wall_seconds;
   nlohmann::json fails = nlohmann::json::array();
@@ -103,6 +105,10 @@ std::string LabelSummary::ToText() const {
   out << frames << " frames: " << ok << " labelled";
   for (const auto& [path, count] : by_path) out << " (" << path << " " << count << ")";
   out << ", " << failed << " failed";
+  if (!by_crops.empty()) {
+    out << "; network crops:";
+    for (const auto& [from, count] : by_crops) out << " " << from << " " << count;
+  }
   if (missing > 0) out << ", " << missing << " not yet run";
   if (skipped > 0) out << ", " << skipped << " skipped (done before)";
   out << "\n";
@@ -144,6 +150,12 @@ std::string LabelSummary::ToMarkdown() const {
     out << "| path | frames |\n|---|---|\n";
     for (const auto& [path, count] : by_path)
       out << "| " << path << " | " << count << " |\n";
+    out << "\n";
+  }
+  if (!by_crops.empty()) {
+    out << "| network crops from | frames |\n|---|---|\n";
+    for (const auto& [from, count] : by_crops)
+      out << "| " << from << " | " << count << " |\n";
     out << "\n";
   }
   if (!metrics.empty()) {

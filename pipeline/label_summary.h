@@ -33,6 +33,9 @@ struct LabelSummary {
   int failed = 0;                      // finished with an error
   int missing = 0;                     // never attempted (a shard that has not run yet)
   std::map<std::string, int> by_path;  // label path -> frames
+  // Jobs that track the hand: where the network's crops came from -> frames
+  // ("detector": the frame was detected, "previous_label": it was not).
+  std::map<std::string, int> by_crops;
   double frame_seconds = 0;            // summed per-frame time of the latest records
   double wall_seconds = 0;  // wall time of this run (0 for a merge: not written)
   int skipped = 0;          // done in an earlier run and skipped (run only)

@@ -54,6 +54,10 @@ HandMeshInput CropFrameForNetwork(const FrameInput& frame, int num_views,
     }
     HandEvidence evidence;
     if (!frame.keypoints_2d.empty()) evidence.keypoints = frame.keypoints_2d[v];
+    for (int p = 0; p < frame.crop_prior.rows(); ++p) {
+      evidence.prior_points_in_cam.push_back(rig[v].cam_from_world *
+                                             Eigen::Vector3d(frame.crop_prior.row(p)));
+    }
     ViewCrop view_crop = CropForView({image.width, image.height, image.data.data()},
                                      rig[v].camera, evidence, crop);
     HandMeshViewInput view;
@@ -68,7 +72,8 @@ HandMeshInput CropFrameForNetwork(const FrameInput& frame, int num_views,
 }
 
 MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& frame,
-                               const std::vector<ViewCrop>& crops, int crop_size) {
+                               const std::vector<ViewCrop>& crops, int crop_size,
+                               bool image_masks) {
   const Rig& rig = frame.rig;
   const Rigid3 world_from_master = rig[0].cam_from_world.Inverse();
   MeshPrediction p;
@@ -77,7 +82,7 @@ MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& 
   for (size_t v = 0; v < rig.size(); ++v) {
     p.keypoints_2d.push_back(
         CropKeypointsToImage(out.joints_2d[v], crops[v], rig[v].camera));
-    if (out.masks.empty()) continue;
+    if (out.masks.empty() || !image_masks) continue;
     const int cell = crop_size / static_cast<int>(out.masks[v].rows());
     MaskImage mask =
         CropMaskToImage(out.masks[v], cell, crops[v].intrinsics, rig[v].camera);
@@ -131,7 +136,7 @@ double PredictionMemo::saved_seconds() const {
 
 std::vector<MeshPrediction> PredictFramesInRig(
     HandMeshPredictor& network, const std::vector<const FrameInput*>& frames,
-    PredictionMemo* memo, const std::string& weights_sha256) {
+    PredictionMemo* memo, const std::string& weights_sha256, bool image_masks) {
   HandCropOptions crop;
   crop.crop_size = network.crop_size();
   std::vector<std::vector<ViewCrop>> crops(frames.size());
@@ -161,8 +166,8 @@ std::vector<MeshPrediction> PredictFramesInRig(
   }
   std::vector<MeshPrediction> predictions;
   for (size_t f = 0; f < frames.size(); ++f) {
-    predictions.push_back(
-        PredictionInRig(outputs[f], *frames[f], crops[f], network.crop_size()));
+    predictions.push_back(PredictionInRig(outputs[f], *frames[f], crops[f],
+                                          network.crop_size(), image_masks));
   }
   return predictions;
 }
@@ -193,9 +198,10 @@ NetworkStage LoadNetworkStage(const JobConfig& job,
   stage.num_parameters = network->num_parameters();
   stage.lanes = lanes;
   stage.threads_per_batch = options.num_threads;
-  stage.predict = [network, memo, sha = stage.weights_sha256](
-                      const std::vector<const FrameInput*>& frames) {
-    return PredictFramesInRig(*network, frames, memo.get(), sha);
+  const bool image_masks = job.masks == MaskSource::kNetwork;
+  stage.predict = [network, memo, sha = stage.weights_sha256,
+                   image_masks](const std::vector<const FrameInput*>& frames) {
+    return PredictFramesInRig(*network, frames, memo.get(), sha, image_masks);
   };
   return stage;
 }

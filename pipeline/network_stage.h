@@ -1,7 +1,8 @@
 #pragma once
 // The labeling job's network stage (label_stages.h NetworkStage) on the one network
 // interface, network/poem/hand_mesh_predictor.h: per view it reads the image and crops
-// around the hand (the capture's 2D keypoints locate it; network/poem/hand_crop.h), runs
+// around the hand (the frame's 2D keypoints locate it, else its crop prior;
+// network/poem/hand_crop.h), runs
 // the network in batches, and brings the answer back to the job's conventions: 3D points
 // from the master camera's frame to the rig's world frame, 2D keypoints from crop
 // pixels to full-image (distorted) pixels with the heatmap peaks as confidences, and
@@ -28,9 +29,11 @@ HandMeshInput CropFrameForNetwork(const FrameInput& frame, int num_views,
                                   std::vector<ViewCrop>* crops);
 
 // The network's answer for `frame` (made from `crops`) in the rig's world frame and
-// full-image pixels.
+// full-image pixels; the mask head's masks only with `image_masks` (a full-image
+// mask per view costs more than the rest of this together).
 MeshPrediction PredictionInRig(const HandMeshPrediction& out, const FrameInput& frame,
-                               const std::vector<ViewCrop>& crops, int crop_size);
+                               const std::vector<ViewCrop>& crops, int crop_size,
+                               bool image_masks = true);
 
 // The network's answers by input, shared by jobs that show the same weights the same
 // frames (the methods of a comparison): each distinct input is predicted once.
@@ -64,10 +67,12 @@ class PredictionMemo {
 // whose input it has not seen go to the network.
 std::vector<MeshPrediction> PredictFramesInRig(
     HandMeshPredictor& network, const std::vector<const FrameInput*>& frames,
-    PredictionMemo* memo = nullptr, const std::string& weights_sha256 = "");
+    PredictionMemo* memo = nullptr, const std::string& weights_sha256 = "",
+    bool image_masks = true);
 
 // The job's network stage from its `network` section (weights, batch_size, threads):
-// loads and validates the weights (InputError naming the file) and hashes them. This is
+// loads and validates the weights (InputError naming the file) and hashes them. Its
+// answers carry masks only when the job fits to them (evidence.masks: network). This is
 // where capture/'s frames meet network/'s predictor, so it lives in pipeline/. With a
 // memo, inputs seen before are answered from it.
 NetworkStage LoadNetworkStage(const JobConfig& job,

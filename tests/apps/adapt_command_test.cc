@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/json_util.h"
+#include "pipeline/job_config.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
 
@@ -111,6 +112,19 @@ TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
     }
   }
   EXPECT_EQ(compared, 3 * 6);  // every label carries the three, detector_agreement too
+  // The job for new recordings: the adapted network, the chosen thresholds, tracking;
+  // it runs as written (on the same capture here).
+  const JobConfig next = LoadJobConfig(out + "/new_recordings.yaml");
+  EXPECT_EQ(next.network_weights, out + "/network.pt");
+  EXPECT_EQ(next.quality.max_reprojection_px, chosen["max_reprojection_px"].get<double>());
+  EXPECT_EQ(next.quality.max_view_disagreement_mm,
+            chosen["max_view_disagreement_mm"].get<double>());
+  EXPECT_EQ(next.quality.max_detector_rms_px, chosen["max_detector_rms_px"].get<double>());
+  EXPECT_TRUE(next.keypoints_from_detector);
+  EXPECT_GT(next.detector_every, 1);
+  const auto new_job = RunHandlabelCommand({"label", "--job", out + "/new_recordings.yaml"});
+  ASSERT_EQ(new_job.status, 0) << new_job.err;
+  EXPECT_THAT(new_job.err, HasSubstr("6 frames: 6 labelled"));
   const std::string network = FileBytes(out + "/network.pt");
 
   // Run again: every stage was done, nothing is redone.

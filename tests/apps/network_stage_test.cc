@@ -82,7 +82,12 @@ TEST_F(NetworkStageTest, AnswersAreTheNetworksInTheRigsFrames) {
     EXPECT_LT((in_master - raw.joints.row(k).transpose()).norm(), 1e-9) << k;
   }
   ASSERT_EQ(p.keypoints_2d.size(), rig.size());
-  ASSERT_EQ(p.masks.size(), rig.size());
+  // Full-image masks (a warp per view) only for jobs that fit to them.
+  EXPECT_TRUE(p.masks.empty());
+  JobConfig fits_masks = Job();
+  fits_masks.masks = MaskSource::kNetwork;
+  EXPECT_EQ(LoadNetworkStage(fits_masks).predict({&frame_}).at(0).masks.size(),
+            rig.size());
   for (size_t v = 0; v < rig.size(); ++v) {
     for (int k = 0; k < kNumHandKeypoints; ++k) {
       // Image pixel -> ray (undistorted) -> crop pixel gives the network's 2D back.

@@ -126,6 +126,28 @@ TEST(JobConfig, KeypointsFromTheDetector) {
               "network | files | both | detector");
 }
 
+// evidence.detector_every: tracking needs the detector, a network and refine fallback.
+TEST(JobConfig, TrackingNeedsTheDetectorANetworkAndFallback) {
+  const std::string tracked =
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n"
+      "evidence: {keypoints_2d: detector, detector_every: 10}\n";
+  EXPECT_EQ(LoadJobConfig(WriteJob(tracked)).detector_every, 10);
+  EXPECT_EQ(LoadJobConfig(WriteJob(kValidJob)).detector_every, 1);
+  ExpectError(
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n"
+      "evidence: {keypoints_2d: detector, detector_every: 0}\n",
+      "evidence.detector_every", ">= 1");
+  ExpectError(
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n"
+      "evidence: {keypoints_2d: files, detector_every: 10}\n",
+      "evidence.keypoints_2d", "detector (evidence.detector_every 10 tracks");
+  ExpectError(
+      "input: {path: c}\noutput: {dir: o}\nrefine: {mode: always}\n"
+      "evidence: {keypoints_2d: detector, detector_every: 10}\n",
+      "network.weights", "a network to track with");
+  ExpectError(tracked + "refine: {mode: always}\n", "refine.mode", "fallback");
+}
+
 // The fields `handlabel fit` sets: unset fitter fields stay unset (the fitter's
 // defaults), set ones are read and checked naming the field.
 TEST(JobConfig, FitSectionAndFileEvidence) {

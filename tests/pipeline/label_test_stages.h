@@ -97,7 +97,8 @@ class TestCapture : public FrameSource {
     frame.ground_truth = truth;
     for (const RigCamera& camera : rig_.cameras()) {
       frame.image_paths.push_back("/nonexistent/" + camera.name + "/" + id + ".png");
-      frame.keypoints_2d.push_back(ProjectKeypoints(camera, mesh.keypoints));
+      if (!without_2d)
+        frame.keypoints_2d.push_back(ProjectKeypoints(camera, mesh.keypoints));
     }
     return frame;
   }
@@ -108,7 +109,8 @@ class TestCapture : public FrameSource {
 
   const HandModel& model() const { return model_; }
   std::set<std::string> unreadable;
-  std::string duplicate;  // a frame id FrameIds() lists a second time (bad captures)
+  std::string duplicate;    // a frame id FrameIds() lists a second time (bad captures)
+  bool without_2d = false;  // frames without 2D keypoints (a detector finds them later)
   mutable std::atomic<int> loads{0};
 
  private:
