@@ -16,16 +16,11 @@
 #include "core/errors.h"
 #include "hand/hand_lbs.h"
 #include "hand/hand_model_io.h"
+#include "hand/hand_skeleton.h"
 #include "openhand/builder.h"
 
 namespace handlabel {
 namespace {
-
-constexpr const char* kSnapNames[kNumHandKeypoints] = {
-    "wrist",      "thumb_cmc", "thumb_mcp", "thumb_ip",   "thumb_tip",  "index_mcp",
-    "index_pip",  "index_dip", "index_tip", "middle_mcp", "middle_pip", "middle_dip",
-    "middle_tip", "ring_mcp",  "ring_pip",  "ring_dip",   "ring_tip",   "pinky_mcp",
-    "pinky_pip",  "pinky_dip", "pinky_tip"};
 
 void PrintInfo(const std::string& path, const LoadedHandModel& loaded,
                std::ostream& out) {
@@ -65,8 +60,8 @@ void PrintInfo(const std::string& path, const LoadedHandModel& loaded,
       << "keypoints (SNAP/OpenPose order <- native joint, or tip vertex):\n";
   for (int k = 0; k < kNumHandKeypoints; ++k) {
     const int native = kSnapFromNative[k];
-    out << "  " << std::setw(2) << k << " " << std::left << std::setw(11) << kSnapNames[k]
-        << std::right << " <- ";
+    out << "  " << std::setw(2) << k << " " << std::left << std::setw(11)
+        << kSnapKeypointNames[k] << std::right << " <- ";
     if (native < kNumHandJoints) {
       out << "joint " << native << "\n";
     } else {

@@ -1,5 +1,6 @@
 #include "formats/nd_array.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -228,12 +229,27 @@ NdArray NdArray::FromInt64s(const std::vector<int64_t>& shape, const int64_t* va
 }
 
 NdArray NdArray::FromText(const std::string& utf8) {
-  const std::vector<uint32_t> cps = DecodeUtf8(utf8);
+  NdArray a = FromTexts({utf8});
+  a.shape.clear();  // 0-d
+  return a;
+}
+
+NdArray NdArray::FromTexts(const std::vector<std::string>& utf8) {
+  std::vector<std::vector<uint32_t>> cps;
+  size_t longest = 1;  // numpy's narrowest string dtype is 'U1'
+  for (const std::string& s : utf8) {
+    cps.push_back(DecodeUtf8(s));
+    longest = std::max(longest, cps.back().size());
+  }
   NdArray a;
   a.dtype = DType::kUnicode;
-  a.itemsize = std::max<int64_t>(4, 4 * static_cast<int64_t>(cps.size()));
-  a.data.assign(static_cast<size_t>(a.itemsize), 0);
-  if (!cps.empty()) std::memcpy(a.data.data(), cps.data(), 4 * cps.size());
+  a.itemsize = 4 * static_cast<int64_t>(longest);
+  a.shape = {static_cast<int64_t>(utf8.size())};
+  a.data.assign(static_cast<size_t>(a.itemsize) * utf8.size(), 0);
+  for (size_t i = 0; i < cps.size(); ++i) {
+    if (!cps[i].empty())
+      std::memcpy(a.data.data() + i * a.itemsize, cps[i].data(), 4 * cps[i].size());
+  }
   return a;
 }
 

@@ -58,6 +58,8 @@ struct NdArray {
   static NdArray FromInt64s(const std::vector<int64_t>& shape, const int64_t* values,
                             DType dtype = DType::kInt64);
   static NdArray FromText(const std::string& utf8);  // 0-d numpy 'U<n>' array
+  // 1-d numpy 'U<n>' array, n = the longest text's code points (at least 1).
+  static NdArray FromTexts(const std::vector<std::string>& utf8);
   // Row-major copy of any Eigen matrix of doubles, shape (rows, cols).
   static NdArray FromMatrix(const Eigen::MatrixXd& m);
 };

@@ -5,6 +5,7 @@
 
 #include "core/errors.h"
 #include "hand/mesh_keypoints.h"
+#include "hand/shaped_hand.h"
 
 // Reference implementation with plain Eigen matrix algebra, written for clarity and
 // kept independent of the templated HandEvaluator (hand_evaluator.h) so that each can
@@ -23,21 +24,11 @@ Eigen::Matrix3d Rodrigues(const Eigen::Vector3d& w) {
 
 HandMesh PoseHand(const HandModel& model, const HandParams& params) {
   const int num_vertices = model.num_vertices();
-  const int num_betas = model.num_betas();
-  if (params.betas.size() > num_betas) {
-    throw InputError("HandParams", "betas", "at most " + std::to_string(num_betas),
-                     std::to_string(params.betas.size()));
-  }
-  Eigen::VectorXd betas = Eigen::VectorXd::Zero(num_betas);
-  betas.head(params.betas.size()) = params.betas;
-
+  const ShapedHand shaped = ShapeHand(model, params.betas);
   // Row-major V x 3 storage flattens to index 3*v + c, the row order of the blend shapes.
   const Eigen::VectorXd v_shaped_flat =
-      Eigen::Map<const Eigen::VectorXd>(model.v_template.data(), 3 * num_vertices) +
-      model.shapedirs * betas;
-  const Points3d v_shaped =
-      Eigen::Map<const Points3d>(v_shaped_flat.data(), num_vertices, 3);
-  const Points3d rest_joints = model.joint_regressor * v_shaped;
+      Eigen::Map<const Eigen::VectorXd>(shaped.vertices.data(), 3 * num_vertices);
+  const Points3d& rest_joints = shaped.joints;
 
   std::array<Eigen::Matrix3d, kNumHandJoints> local;
   local[0] = Rodrigues(params.global_orient);

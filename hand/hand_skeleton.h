@@ -15,6 +15,13 @@ namespace handlabel {
 inline constexpr std::array<int, kNumHandKeypoints> kSnapParents = {
     -1, 0, 1, 2, 3, 0, 5, 6, 7, 0, 9, 10, 11, 0, 13, 14, 15, 0, 17, 18, 19};
 
+// Name of SNAP keypoint k, as `model info`, CSV columns and exports spell it.
+inline constexpr std::array<const char*, kNumHandKeypoints> kSnapKeypointNames = {
+    "wrist",      "thumb_cmc", "thumb_mcp", "thumb_ip",   "thumb_tip",  "index_mcp",
+    "index_pip",  "index_dip", "index_tip", "middle_mcp", "middle_pip", "middle_dip",
+    "middle_tip", "ring_mcp",  "ring_pip",  "ring_dip",   "ring_tip",   "pinky_mcp",
+    "pinky_pip",  "pinky_dip", "pinky_tip"};
+
 inline constexpr int kNumHandFingers = 5;
 
 // Finger of SNAP keypoint k, 0-based: 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky;

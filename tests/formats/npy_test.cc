@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -82,6 +83,24 @@ TEST(Npy, OurBytesEqualNumpysForTheSameArray) {
             testing::ReadFileBytes(Fixture("unicode.npy")));
   EXPECT_EQ(SerializeNpy(ReadNpyFile(Fixture("scalar.npy"))),
             testing::ReadFileBytes(Fixture("scalar.npy")));
+}
+
+TEST(Npy, TextArraysAreNumpysFixedWidthUnicode) {
+  // numpy's np.array(["f1", "frame_10", "\u00e9"]) is '<U8': 8 UCS-4 code points per
+  // element, NUL padded; the 0-d form is what FromText always wrote.
+  const NdArray a = NdArray::FromTexts({"f1", "frame_10", "\xc3\xa9"});
+  EXPECT_EQ(a.dtype, DType::kUnicode);
+  EXPECT_EQ(a.shape, (std::vector<int64_t>{3}));
+  EXPECT_EQ(a.itemsize, 32);
+  EXPECT_EQ(DTypeDescr(a), "<U8");
+  uint32_t third;
+  std::memcpy(&third, a.data.data() + 2 * 32, 4);
+  EXPECT_EQ(third, 0xE9u);
+  const NdArray none = NdArray::FromTexts({});
+  EXPECT_EQ(none.shape, (std::vector<int64_t>{0}));
+  EXPECT_EQ(DTypeDescr(none), "<U1");
+  EXPECT_EQ(SerializeNpy(NdArray::FromText("right")),
+            testing::ReadFileBytes(Fixture("unicode.npy")));
 }
 
 TEST(Npy, RoundTripsEveryDTypeThroughAFile) {

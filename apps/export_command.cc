@@ -1,0 +1,54 @@
+#include <iostream>
+
+#include "apps/cli_util.h"
+#include "apps/commands.h"
+#include "exports/export_labels.h"
+
+namespace handlabel {
+
+int RunExport(int argc, char** argv) {
+  CLI::App app(
+      "Write a labeling job's labels in another format (docs/exports.md): npz "
+      "(keypoints, "
+      "joints, vertices and MANO parameters per frame, in smplx's or manopth's "
+      "convention), csv (21 keypoints per frame) or coco (COCO-WholeBody-style 2D hand "
+      "keypoints and boxes per view, projected with the capture's cameras) or glb (a "
+      "skinned "
+      "hand in glTF 2.0 with one animation over the labels).\n"
+      "Example: handlabel export --labels /tmp/demo_out --format npz --out "
+      "/tmp/demo_out/keypoints.npz --mano-convention manopth",
+      "export");
+  ExportRequest request;
+  std::string format, convention = "smplx", flat;
+  app.add_option("--labels", request.labels_dir,
+                 "the labeling job's output folder (output.dir) or its labels/ folder")
+      ->required();
+  app.add_option("--format", format, ExportFormatChoices())->required();
+  app.add_option("--out", request.out, "the file to write")->required();
+  app.add_option(
+         "--mano-convention", convention,
+         "npz: MANO parameters for smplx.MANO or manopth.ManoLayer (default smplx)")
+      ->check(CLI::IsMember({"smplx", "manopth"}));
+  app.add_option(
+         "--flat-hand-mean", flat,
+         "npz: the layer's flat_hand_mean; false subtracts the model's hands_mean "
+         "from hand_pose (default: the layer's own, smplx false, manopth true)")
+      ->check(CLI::IsMember({"true", "false"}));
+  app.add_option("--hand-model", request.hand_model,
+                 "npz with --flat-hand-mean false, and glb: the labels' hand model file "
+                 "(default: the job's hand_model)");
+  app.add_option("--fps", request.fps, "glb: keyframes per second (default 30)");
+  app.add_option("--job", request.job_file,
+                 "the job that made the labels (default: the one output.dir/job.json "
+                 "names); coco reads its capture's cameras and image files");
+  if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
+  return RunReportingErrors("export", [&] {
+    request.format = ParseExportFormat(format, "--format");
+    request.convention = ParseManoConvention(convention, "--mano-convention");
+    if (!flat.empty()) request.flat_hand_mean = flat == "true";
+    std::cout << ExportLabels(request) << "\n";
+    return 0;
+  });
+}
+
+}  // namespace handlabel
