@@ -24,18 +24,7 @@ using testing::TestFitter;
 using testing::TestPredictor;
 
 JobConfig MakeJob(const std::string& out, RefineMode mode) {
-  JobConfig job;
-  job.source_file = "test.yaml";
-  job.name = "test";
-  job.seed = 5;
-  job.input_path = "memory";
-  job.output_dir = out;
-  job.refine_mode = mode;
-  job.threads = 2;
-  job.batch_size = 3;
-  job.network_weights = "weights.pt";
-  job.meshes = {"ply"};
-  return job;
+  return testing::MakeTestJob(out, mode);
 }
 
 struct Stages {

@@ -21,6 +21,22 @@
 
 namespace handlabel::testing {
 
+// A job over the test capture with a network (the test predictor) and `mode`.
+inline JobConfig MakeTestJob(const std::string& out, RefineMode mode) {
+  JobConfig job;
+  job.source_file = "test.yaml";
+  job.name = "test";
+  job.seed = 5;
+  job.input_path = "memory";
+  job.output_dir = out;
+  job.refine_mode = mode;
+  job.threads = 2;
+  job.batch_size = 3;
+  job.network_weights = "weights.pt";
+  job.meshes = {"ply"};
+  return job;
+}
+
 inline Rig MakeFourCameraRig() {
   Rig rig;
   for (int i = 0; i < 4; ++i) {

@@ -23,16 +23,7 @@ using testing::TestFitter;
 using testing::TestPredictor;
 
 JobConfig TrackedJob(const std::string& out, int every) {
-  JobConfig job;
-  job.source_file = "test.yaml";
-  job.name = "tracked";
-  job.seed = 5;
-  job.input_path = "memory";
-  job.output_dir = out;
-  job.refine_mode = RefineMode::kFallback;
-  job.threads = 2;
-  job.batch_size = 1;
-  job.network_weights = "weights.pt";
+  JobConfig job = testing::MakeTestJob(out, RefineMode::kFallback);
   job.keypoints = KeypointSource::kFiles;
   job.keypoints_from_detector = true;
   job.detector_every = every;
