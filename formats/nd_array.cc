@@ -186,6 +186,21 @@ NdArray NdArray::FromDoubles(const std::vector<int64_t>& shape, const double* va
   return a;
 }
 
+NdArray NdArray::FromDoublesAsFloat32(const std::vector<int64_t>& shape,
+                                      const double* values) {
+  NdArray a;
+  a.dtype = DType::kFloat32;
+  a.itemsize = 4;
+  a.shape = shape;
+  const int64_t n = a.size();
+  a.data.resize(static_cast<size_t>(n) * 4);
+  for (int64_t i = 0; i < n; ++i) {
+    const float f = static_cast<float>(values[i]);
+    std::memcpy(a.data.data() + 4 * i, &f, 4);
+  }
+  return a;
+}
+
 NdArray NdArray::FromInt64s(const std::vector<int64_t>& shape, const int64_t* values,
                             DType dtype) {
   NdArray a;

@@ -55,6 +55,9 @@ struct NdArray {
 
   // Builders (C order).
   static NdArray FromDoubles(const std::vector<int64_t>& shape, const double* values);
+  // float32, each value rounded to nearest (what datasets such as DexYCB store).
+  static NdArray FromDoublesAsFloat32(const std::vector<int64_t>& shape,
+                                      const double* values);
   static NdArray FromInt64s(const std::vector<int64_t>& shape, const int64_t* values,
                             DType dtype = DType::kInt64);
   static NdArray FromText(const std::string& utf8);  // 0-d numpy 'U<n>' array
