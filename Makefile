@@ -5,7 +5,7 @@ JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 DEMO_OUT ?= out/demo
 
-.PHONY: deps configure build test demo format bench clean sanitize
+.PHONY: deps configure build test demo format bench clean sanitize check-blender
 
 deps:
 	bash scripts/install-deps
@@ -27,6 +27,11 @@ demo: build
 
 bench: build
 	bash scripts/run-benchmarks $(BUILD_DIR)
+
+# Opt-in: a 20-frame glb export imported by Blender (skipped without `blender`; not in
+# `make test` or CI; docs/exports.md).
+check-blender: build
+	bash scripts/check-blender-glb $(BUILD_DIR)/apps/handlabel
 
 format:
 	git ls-files '*.h' '*.cc' | xargs clang-format -i
