@@ -1,12 +1,11 @@
-// `handlabel export` end to end: a real label job (fallback fits on a synthetic capture
-// of the open hand) whose hand model is a file in the official MANO pickle layout, then
-// its labels exported and read back by independent Python readers (Debian's
+// `handlabel export` end to end: the labels of tests/apps/export_fixture.h's label job
+// exported and read back by independent Python readers (Debian's
 // /usr/bin/python3 with numpy):
-//   - tests/apps/mano_layers.py re-implements smplx's and manopth's MANO layers in
-//     NumPy and feeds them the labels' parameters by the rule docs/exports.md states,
-//     and the npz exports' parameters as they are: both must reproduce the labels'
-//     vertices and keypoints to 1e-6 m in both conventions and both flat_hand_mean
-//     settings, and the wrong guesses must not;
+//   - tests/apps/mano_layers.py re-implements smplx's, manopth's and manotorch's MANO
+//     layers in NumPy and feeds them the labels' parameters by the rules
+//     docs/exports.md states, and the npz exports' parameters as they are: all must
+//     reproduce the labels' vertices and keypoints to 1e-6 m in every convention and
+//     both flat_hand_mean settings, and the wrong guesses must not;
 //   - tests/apps/export_readers.py reads the CSV with numpy and the COCO-WholeBody JSON
 //     as mmpose's hand dataset does, projecting the labels itself;
 //   - tests/apps/gltf_reader.py poses the .glb's skinned, morphed mesh at each keyframe
@@ -14,91 +13,20 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <nlohmann/json.hpp>
-#include <sstream>
 
-#include "capture/synth_capture.h"
 #include "hand/hand_model_io.h"
-#include "pipeline/hand_model_source.h"
-#include "tests/apps/run_command.h"
-#include "tests/hand/mano_sized_model.h"
-#include "tests/test_util.h"
+#include "tests/apps/export_fixture.h"
 
 namespace handlabel {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::kExportFrames;
 using testing::RunHandlabelCommand;
 
-constexpr int kFrames = 3;
-
-// One labelled capture shared by the tests (a label job takes a few seconds).
-class ExportCommand : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    // ScratchDir needs a running test: one folder of our own for the suite.
-    std::string pattern =
-        (fs::temp_directory_path() / "handlabel-export-XXXXXX").string();
-    dir_ = new std::string(mkdtemp(pattern.data()));
-    const std::string capture = *dir_ + "/capture";
-    const HandModel open_hand = ResolveHandModel("", HandSide::kRight).model;
-    SynthCaptureOptions o;
-    o.rig.preset = "dexycb";
-    o.rig.width = 160;
-    o.rig.height = 120;
-    o.num_frames = kFrames;
-    o.seed = 5;
-    o.num_threads = 1;
-    WriteSynthCapture(open_hand, o, capture, "open hand");
-    // The hand model as MANO ships it (chumpy objects, scipy sparse regressor, no
-    // fingertip ids, hands_mean): what a user's MANO_RIGHT.pkl looks like.
-    std::ofstream(ModelPath(), std::ios::binary) << testing::ManoStylePickle(open_hand);
-    std::ofstream(JobPath()) << "name: export\nseed: 1\nhand_model: " << ModelPath()
-                             << "\ninput: {format: native, path: " << capture << "}\n"
-                             << "network: {threads: 2}\nrefine: {mode: always}\n"
-                             << "evidence: {keypoints_2d: files, masks: none}\n"
-                             << "output: {dir: " << OutDir() << ", overlays: false}\n";
-    const auto r = RunHandlabelCommand({"label", "--job", JobPath(), "--quiet"});
-    ASSERT_EQ(r.status, 0) << r.err;
-  }
-  static void TearDownTestSuite() {
-    std::error_code ignored;
-    fs::remove_all(*dir_, ignored);
-    delete dir_;
-  }
-
-  static std::string ModelPath() { return *dir_ + "/MANO_RIGHT.pkl"; }
-  static std::string JobPath() { return *dir_ + "/job.yaml"; }
-  static std::string OutDir() { return *dir_ + "/out"; }
-  static std::string Script(const std::string& name) {
-    return std::string(HANDLABEL_SOURCE_DIR) + "/tests/apps/" + name;
-  }
-
-  // Runs a Python reader; its stdout is a JSON report.
-  static nlohmann::json RunPython(const std::string& script, const std::string& args) {
-    const std::string report = *dir_ + "/report.json", log = *dir_ + "/python.log";
-    const std::string cmd =
-        "/usr/bin/python3 " + Script(script) + " " + args + " > " + report + " 2> " + log;
-    if (std::system(cmd.c_str()) != 0) {
-      std::ifstream in(log);
-      std::stringstream ss;
-      ss << in.rdbuf();
-      ADD_FAILURE() << script << " failed (needs /usr/bin/python3 with numpy, Debian "
-                    << "python3-numpy):\n"
-                    << ss.str();
-      return nlohmann::json::object();
-    }
-    std::ifstream in(report);
-    return nlohmann::json::parse(in);
-  }
-
-  static std::string* dir_;
-};
-
-std::string* ExportCommand::dir_ = nullptr;
+using ExportCommand = testing::LabelledCaptureForExport;
 
 TEST_F(ExportCommand, SmplxAndManopthLayersReproduceTheLabels) {
   std::string npz_specs;
@@ -117,7 +45,8 @@ TEST_F(ExportCommand, SmplxAndManopthLayersReproduceTheLabels) {
       RunPython("mano_layers.py", "--model " + ModelPath() + " --labels " + OutDir() +
                                       "/labels" + npz_specs);
   ASSERT_TRUE(report.contains("cases")) << report.dump();
-  EXPECT_EQ(report["labels"], kFrames);  // every label has parameters (fitted)
+  RecordProperty("cases", report["cases"].dump());  // the measured numbers
+  EXPECT_EQ(report["labels"], kExportFrames);  // every label has parameters (fitted)
   int right = 0, wrong = 0;
   for (const auto& [name, errors] : report["cases"].items()) {
     if (name.rfind("WRONG", 0) == 0) {
@@ -131,10 +60,11 @@ TEST_F(ExportCommand, SmplxAndManopthLayersReproduceTheLabels) {
     }
     ++right;
   }
-  // 2 layers x 2 flat_hand_mean settings from the labels, and the same from the 4 npz
-  // files' parameters, plus their stored arrays.
-  EXPECT_EQ(right, 4 + 4 + 4);
-  EXPECT_EQ(wrong, 2);
+  // 2 layers x 2 flat_hand_mean settings from the labels, manotorch's 4 (both
+  // flat_hand_mean, center_idx=9, quaternions), and the 4 npz files' parameters, plus
+  // their stored arrays.
+  EXPECT_EQ(right, 4 + 4 + 4 + 4);
+  EXPECT_EQ(wrong, 3);
 }
 
 TEST_F(ExportCommand, CsvKeypointsReadBackWithNumpy) {
@@ -146,7 +76,7 @@ TEST_F(ExportCommand, CsvKeypointsReadBackWithNumpy) {
       RunPython("export_readers.py", "--labels " + OutDir() + "/labels --csv " + out);
   ASSERT_TRUE(report.contains("csv")) << report.dump();
   const nlohmann::json& csv = report["csv"];
-  EXPECT_EQ(csv["rows"], kFrames);
+  EXPECT_EQ(csv["rows"], kExportFrames);
   EXPECT_EQ(csv["columns"], 2 + 63);
   EXPECT_TRUE(csv["frames_in_order"].get<bool>());
   EXPECT_EQ(csv["first_columns"],
@@ -165,8 +95,8 @@ TEST_F(ExportCommand, CocoWholeBodyHandsAreTheLabelsProjected) {
                                          " --rig " + *dir_ + "/capture/rig.json");
   ASSERT_TRUE(report.contains("coco")) << report.dump();
   const nlohmann::json& coco = report["coco"];
-  EXPECT_EQ(coco["images"], kFrames * 8);               // the dexycb rig's 8 views
-  EXPECT_GE(coco["hands"].get<int>(), kFrames * 6);     // the hand is in most views
+  EXPECT_EQ(coco["images"], kExportFrames * 8);               // the dexycb rig's 8 views
+  EXPECT_GE(coco["hands"].get<int>(), kExportFrames * 6);     // the hand is in most views
   EXPECT_LT(coco["keypoints_2d"].get<double>(), 1e-6);  // pixels
   EXPECT_EQ(coco["keypoints_outside_box"], 0);
   EXPECT_TRUE(coco["image_files_exist"].get<bool>());
@@ -181,8 +111,9 @@ TEST_F(ExportCommand, GlbAnimationPosesTheLabelsAsAViewerWould) {
   const nlohmann::json report =
       RunPython("gltf_reader.py", "--glb " + out + " --labels " + OutDir() + "/labels");
   ASSERT_TRUE(report.contains("vertices")) << report.dump();
-  EXPECT_EQ(report["keyframes"], kFrames);
-  EXPECT_EQ(report["morph_targets"], kFrames);
+  RecordProperty("report", report.dump());  // the measured numbers
+  EXPECT_EQ(report["keyframes"], kExportFrames);
+  EXPECT_EQ(report["morph_targets"], kExportFrames);
   // Skinned mesh + the keyframe's morph target = the label (float32 storage).
   EXPECT_LT(report["vertices"].get<double>(), 1e-5);
   EXPECT_LT(report["joints_native"].get<double>(), 1e-5);  // joint nodes on the joints

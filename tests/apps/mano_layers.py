@@ -14,6 +14,12 @@ compute it, used to prove what a handlabel label's `mano` fields mean
            bases, middles, ends); joints + fingertip vertices (745, 317, 444, 556, 673;
            445 for the middle finger of a left hand) in SNAP order; trans added;
            millimetres.
+  manotorch  manotorch.manolayer.ManoLayer(rot_mode="axisang"|"quat", center_idx=None|j,
+           use_pca=False, flat_hand_mean=F)(pose_coeffs, betas): manopth's skinning and
+           joints (SNAP order, the same fingertips) in metres, no translation argument
+           (add transl to the output), hands_mean added in axisang mode unless F, full
+           rotations as (w, x, y, z) quaternions in quat mode, and with center_idx the
+           output relative to that joint (center_joint returned).
 
 Written from the layers' documented behaviour and public code; no code is copied.
 
@@ -74,6 +80,8 @@ def load_mano(path):
     model = {key: _dense(raw[key]) for key in
              ("v_template", "shapedirs", "posedirs", "J_regressor", "weights",
               "kintree_table", "hands_mean", "f")}
+    if "hands_components" in raw:
+        model["hands_components"] = _dense(raw["hands_components"])
     parents = model["kintree_table"][0].astype(np.int64)
     parents[0] = -1  # MANO stores the root's parent as 4294967295
     model["parents"] = parents
@@ -139,10 +147,10 @@ MANOPTH_SNAP_ORDER = [0, 13, 14, 15, 16, 1, 2, 3, 17, 4, 5, 6, 18, 10, 11, 12, 1
                       7, 8, 9, 20]
 
 
-def manopth_layer(model, pose_coeffs, betas, trans, flat_hand_mean, side="right"):
-    hands_mean = np.zeros(45) if flat_hand_mean else model["hands_mean"]
-    full_pose = np.concatenate([pose_coeffs[:3], hands_mean + pose_coeffs[3:48]])
-    rotations = rotation_matrices(full_pose.reshape(16, 3))
+def _level_chain(model, rotations, betas, side):
+    """manopth's and manotorch's skinning: transforms built level by level (root, then
+    the 5 finger bases, middles, ends); joints + fingertip vertices in SNAP order;
+    metres, no translation."""
     v_shaped, rest = _shaped(model, betas)
     pose_map = (rotations[1:] - np.eye(3)).reshape(-1)
     v_posed = v_shaped + model["posedirs"] @ pose_map
@@ -156,10 +164,57 @@ def manopth_layer(model, pose_coeffs, betas, trans, flat_hand_mean, side="right"
     vertices = _skin(model, world, rest, v_posed)
     tips = [745, 317, 444, 556, 673] if side == "right" else [745, 317, 445, 556, 673]
     joints = np.concatenate([world[:, :3, 3], vertices[tips]])[MANOPTH_SNAP_ORDER]
+    return vertices, joints
+
+
+def manopth_layer(model, pose_coeffs, betas, trans, flat_hand_mean, side="right"):
+    hands_mean = np.zeros(45) if flat_hand_mean else model["hands_mean"]
+    full_pose = np.concatenate([pose_coeffs[:3], hands_mean + pose_coeffs[3:48]])
+    vertices, joints = _level_chain(model, rotation_matrices(full_pose.reshape(16, 3)),
+                                    betas, side)
     if np.linalg.norm(trans) != 0:  # manopth adds trans only when it is not zero
         joints = joints + trans
         vertices = vertices + trans
     return 1000.0 * vertices, 1000.0 * joints
+
+
+def quaternion_matrices(quaternions):
+    """(N, 4) quaternions, real part first (w, x, y, z) -> (N, 3, 3)."""
+    out = np.empty((len(quaternions), 3, 3))
+    for n, (w, x, y, z) in enumerate(quaternions):
+        s = 2.0 / (w * w + x * x + y * y + z * z)
+        out[n] = [[1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w)],
+                  [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
+                  [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)]]
+    return out
+
+
+def manotorch_layer(model, pose_coeffs, betas, flat_hand_mean, center_idx=None,
+                    rot_mode="axisang", side="right"):
+    """manotorch.manolayer.ManoLayer(rot_mode, center_idx, use_pca=False,
+    flat_hand_mean)(pose_coeffs, betas): axisang adds hands_mean unless flat_hand_mean
+    (48 values); quat takes 16 (w, x, y, z) quaternions as full rotations. No
+    translation argument; metres; with center_idx, verts and joints minus that joint
+    (returned as center_joint), else unshifted."""
+    if rot_mode == "quat":
+        rotations = quaternion_matrices(np.asarray(pose_coeffs).reshape(16, 4))
+    else:
+        hands_mean = np.zeros(45) if flat_hand_mean else model["hands_mean"]
+        full_pose = np.concatenate([pose_coeffs[:3], hands_mean + pose_coeffs[3:48]])
+        rotations = rotation_matrices(full_pose.reshape(16, 3))
+    vertices, joints = _level_chain(model, rotations, betas, side)
+    center = joints[center_idx] if center_idx is not None else np.zeros(3)
+    return vertices - center, joints - center, center
+
+
+def quaternions_wxyz(axis_angles):
+    """(N, 3) axis-angle -> (N, 4) unit quaternions (w, x, y, z)."""
+    out = np.empty((len(axis_angles), 4))
+    for n, w in enumerate(axis_angles):
+        angle = np.linalg.norm(w)
+        axis = w / angle if angle > 0 else np.zeros(3)
+        out[n] = [np.cos(angle / 2), *(np.sin(angle / 2) * axis)]
+    return out
 
 
 SNAP_FROM_NATIVE = [0, 13, 14, 15, 16, 1, 2, 3, 17, 4, 5, 6, 18, 10, 11, 12, 19, 7,
@@ -188,7 +243,22 @@ def label_cases(model, label):
         cases[f"smplx flat_hand_mean={flat}"] = (v, keypoints_from_smplx(model, v, j), j)
         v, k = manopth_layer(model, np.concatenate([go, layer_pose]), betas, transl, flat)
         cases[f"manopth flat_hand_mean={flat}"] = (v / 1000, k / 1000, None)
-    # Wrong guesses: hands_mean added once more, or manopth's output taken as metres.
+    for flat in (True, False):  # manotorch: no transl argument, add it to the output
+        layer_pose = pose if flat else pose - mean
+        v, k, _ = manotorch_layer(model, np.concatenate([go, layer_pose]), betas, flat)
+        cases[f"manotorch flat_hand_mean={flat}"] = (v + transl, k + transl, None)
+    # center_idx=9 (the middle MCP, a common choice): the output is relative to that
+    # joint; center_joint + transl puts it back.
+    v, k, center = manotorch_layer(model, np.concatenate([go, pose]), betas, True, 9)
+    cases["manotorch center_idx=9"] = (v + center + transl, k + center + transl, None)
+    quats = quaternions_wxyz(np.concatenate([go, pose]).reshape(16, 3))
+    v, k, _ = manotorch_layer(model, quats.ravel(), betas, True, rot_mode="quat")
+    cases["manotorch rot_mode=quat"] = (v + transl, k + transl, None)
+    # Wrong guesses: hands_mean added once more, or manopth's output taken as metres,
+    # or manotorch's centred output moved by transl alone.
+    cases["WRONG manotorch center_idx=9 output + transl"] = (
+        cases["manotorch center_idx=9"][0] - center,
+        cases["manotorch center_idx=9"][1] - center, None)
     v, j = smplx_mano(model, betas, go, pose, transl, False)
     cases["WRONG smplx flat_hand_mean=False given the label's hand_pose"] = (
         v, keypoints_from_smplx(model, v, j), j)
