@@ -12,9 +12,10 @@ int RunExport(int argc, char** argv) {
       "(keypoints, "
       "joints, vertices and MANO parameters per frame, in smplx's or manopth's "
       "convention), csv (21 keypoints per frame) or coco (COCO-WholeBody-style 2D hand "
-      "keypoints and boxes per view, projected with the capture's cameras) or glb (a "
-      "skinned "
-      "hand in glTF 2.0 with one animation over the labels).\n"
+      "keypoints and boxes per view, projected with the capture's cameras), glb (a "
+      "skinned hand in glTF 2.0 with one animation over the labels), dexycb or ho3d "
+      "(per-frame annotations in DexYCB's or HO3D's layout, with the capture's "
+      "cameras and images, readable by their toolkits and our in-place readers).\n"
       "Example: handlabel export --labels /tmp/demo_out --format npz --out "
       "/tmp/demo_out/keypoints.npz --mano-convention manopth",
       "export");
@@ -24,7 +25,9 @@ int RunExport(int argc, char** argv) {
                  "the labeling job's output folder (output.dir) or its labels/ folder")
       ->required();
   app.add_option("--format", format, ExportFormatChoices())->required();
-  app.add_option("--out", request.out, "the file to write")->required();
+  app.add_option("--out", request.out,
+                 "the file to write (dexycb, ho3d: the dataset folder)")
+      ->required();
   app.add_option(
          "--mano-convention", convention,
          "npz: MANO parameters for smplx.MANO or manopth.ManoLayer (default smplx)")
@@ -35,17 +38,23 @@ int RunExport(int argc, char** argv) {
          "from hand_pose (default: the layer's own, smplx false, manopth true)")
       ->check(CLI::IsMember({"true", "false"}));
   app.add_option("--hand-model", request.hand_model,
-                 "npz with --flat-hand-mean false, and glb: the labels' hand model file "
-                 "(default: the job's hand_model)");
+                 "npz with --flat-hand-mean false, glb: the labels' hand model file, "
+                 "and dexycb (its pose PCA) (default: the job's hand_model)");
   app.add_option("--fps", request.fps, "glb: keyframes per second (default 30)");
   app.add_option("--job", request.job_file,
                  "the job that made the labels (default: the one output.dir/job.json "
-                 "names); coco reads its capture's cameras and image files");
+                 "names); coco, dexycb and ho3d read its capture's cameras and images");
+  std::string images = "link";
+  app.add_option("--images", images,
+                 "dexycb, ho3d: link (symbolic links, the default) or copy the "
+                 "capture's image files into the layout")
+      ->check(CLI::IsMember({"link", "copy"}));
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   return RunReportingErrors("export", [&] {
     request.format = ParseExportFormat(format, "--format");
     request.convention = ParseManoConvention(convention, "--mano-convention");
     if (!flat.empty()) request.flat_hand_mean = flat == "true";
+    request.images = ParseImagePlacement(images, "--images");
     std::cout << ExportLabels(request) << "\n";
     return 0;
   });

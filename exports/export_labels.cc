@@ -7,7 +7,9 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "exports/coco_wholebody.h"
+#include "exports/dexycb_layout.h"
 #include "exports/gltf_animation.h"
+#include "exports/ho3d_layout.h"
 #include "exports/keypoint_tables.h"
 #include "exports/label_series.h"
 #include "pipeline/hand_model_source.h"
@@ -21,8 +23,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr ExportFormat kAllFormats[] = {ExportFormat::kNpz, ExportFormat::kCsv,
-                                        ExportFormat::kCoco, ExportFormat::kGlb};
+constexpr ExportFormat kAllFormats[] = {ExportFormat::kNpz,  ExportFormat::kCsv,
+                                        ExportFormat::kCoco, ExportFormat::kGlb,
+                                        ExportFormat::kDexYcb, ExportFormat::kHo3d};
 
 // The job that made the labels: --job, else the job file <output.dir>/job.json names.
 JobConfig LabelsJob(const ExportRequest& request, const LabelSeries& series) {
@@ -89,16 +92,31 @@ std::string ExportNpz(const ExportRequest& request, const LabelSeries& series) {
          (setting.flat_hand_mean ? "true" : "false");
 }
 
-std::string ExportCoco(const ExportRequest& request, const LabelSeries& series) {
+// The job's capture, read as the job reads it, for its cameras and image files only:
+// without the detector's 2D.
+std::unique_ptr<FrameSource> LabelsCapture(const ExportRequest& request,
+                                           const LabelSeries& series) {
   JobConfig job = LabelsJob(request, series);
-  // Only the cameras and image files are needed: not the detector's 2D.
   job.keypoints_from_detector = false;
-  const std::unique_ptr<FrameSource> source = BuildFrameSource(job);
+  return BuildFrameSource(job);
+}
+
+std::string ExportCoco(const ExportRequest& request, const LabelSeries& series) {
+  const std::unique_ptr<FrameSource> source = LabelsCapture(request, series);
   const nlohmann::json coco = CocoWholeBodyHands(series, *source);
   WriteFileAtomically(request.out, coco.dump(1) + "\n");
   return std::to_string(coco["images"].size()) + " images, " +
          std::to_string(coco["annotations"].size()) + " hand annotations, cameras of " +
          source->Describe();
+}
+
+std::string ExportDataset(const ExportRequest& request, const LabelSeries& series) {
+  const DatasetLayoutOptions options{request.out, request.images};
+  const SeriesCapture capture = ReadSeriesCapture(series, *LabelsCapture(request, series));
+  if (request.format == ExportFormat::kHo3d) {
+    return WriteHo3dLayout(series, capture, options);
+  }
+  return WriteDexYcbLayout(series, LabelsHandModel(request, series), capture, options);
 }
 
 }  // namespace
@@ -113,6 +131,10 @@ std::string ToString(ExportFormat format) {
       return "coco";
     case ExportFormat::kGlb:
       return "glb";
+    case ExportFormat::kDexYcb:
+      return "dexycb";
+    case ExportFormat::kHo3d:
+      return "ho3d";
   }
   return "?";
 }
@@ -153,6 +175,10 @@ std::string ExportLabels(const ExportRequest& request) {
       what = "a skinned hand, " + std::to_string(series.labels.size()) + " keyframes";
       break;
     }
+    case ExportFormat::kDexYcb:
+    case ExportFormat::kHo3d:
+      what = ExportDataset(request, series);
+      break;
   }
   return "export: " + std::to_string(series.labels.size()) + " labels of " +
          series.labels_dir + " -> " + request.out + " (" + ToString(request.format) +
