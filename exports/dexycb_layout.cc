@@ -63,18 +63,19 @@ class PcaPose {
   Eigen::FullPivLU<Eigen::MatrixXd> lu_;
 };
 
-void WriteCalibration(const fs::path& root, const Rig& rig, const Eigen::VectorXd& betas) {
+void WriteCalibration(const fs::path& root, const Rig& rig,
+                      const Eigen::VectorXd& betas) {
   const fs::path calib = root / "calibration";
   std::string extrinsics = "extrinsics:\n";
   for (const RigCamera& camera : rig.cameras()) {
     const Eigen::Vector4d k = PinholeIntrinsics(camera, "DexYCB");
-    WriteFileAtomically(
-        (calib / "intrinsics" /
-         (camera.name + "_" + std::to_string(camera.camera.width()) + "x" +
-          std::to_string(camera.camera.height()) + ".yml"))
-            .string(),
-        "color:\n  fx: " + Number(k[0]) + "\n  fy: " + Number(k[1]) +
-            "\n  ppx: " + Number(k[2]) + "\n  ppy: " + Number(k[3]) + "\n");
+    WriteFileAtomically((calib / "intrinsics" /
+                         (camera.name + "_" + std::to_string(camera.camera.width()) +
+                          "x" + std::to_string(camera.camera.height()) + ".yml"))
+                            .string(),
+                        "color:\n  fx: " + Number(k[0]) + "\n  fy: " + Number(k[1]) +
+                            "\n  ppx: " + Number(k[2]) + "\n  ppy: " + Number(k[3]) +
+                            "\n");
     // Row-major 3x4 camera -> common (world).
     const Matrix3x4d m = camera.cam_from_world.Inverse().ToMatrix();
     double row_major[12];
@@ -95,7 +96,8 @@ void WriteCalibration(const fs::path& root, const Rig& rig, const Eigen::VectorX
 void WriteMeta(const fs::path& sequence, const LabelSeries& series, const Rig& rig) {
   std::ostringstream meta;
   meta << "serials:\n";
-  for (const RigCamera& camera : rig.cameras()) meta << "- " << Quoted(camera.name) << "\n";
+  for (const RigCamera& camera : rig.cameras())
+    meta << "- " << Quoted(camera.name) << "\n";
   meta << "num_frames: " << series.labels.size() << "\n"
        << "ycb_ids: []\nycb_grasp_ind: null\n"
        << "mano_sides:\n- " << HandSideName(series.side) << "\n"
@@ -103,7 +105,8 @@ void WriteMeta(const fs::path& sequence, const LabelSeries& series, const Rig& r
        << "extrinsics: " << kCalibrationId << "\n"
        << "handlabel_labels: " << Quoted(series.labels_dir) << "\n"
        << "handlabel_frames:\n";
-  for (const LabelRecord& label : series.labels) meta << "- " << Quoted(label.frame) << "\n";
+  for (const LabelRecord& label : series.labels)
+    meta << "- " << Quoted(label.frame) << "\n";
   WriteFileAtomically((sequence / "meta.yml").string(), meta.str());
 }
 
@@ -127,11 +130,12 @@ NamedArrays CameraLabels(const LabelRecord& label, const RigCamera& camera,
     if (!camera.camera.Project(p, &uv)) uv.setConstant(-1);
     Eigen::Map<Eigen::Vector2d>{joint_2d + 2 * k} = uv;
   }
-  return {{"pose_y", NdArray::FromDoublesAsFloat32({0, 3, 4}, nullptr)},
-          {"pose_m", NdArray::FromDoublesAsFloat32({1, 51}, pose_m)},
-          {"joint_3d", NdArray::FromDoublesAsFloat32({1, kNumHandKeypoints, 3}, joint_3d)},
-          {"joint_2d", NdArray::FromDoublesAsFloat32({1, kNumHandKeypoints, 2}, joint_2d)},
-          {"mano_betas", NdArray::FromDoublesAsFloat32({1, 10}, betas10.data())}};
+  return {
+      {"pose_y", NdArray::FromDoublesAsFloat32({0, 3, 4}, nullptr)},
+      {"pose_m", NdArray::FromDoublesAsFloat32({1, 51}, pose_m)},
+      {"joint_3d", NdArray::FromDoublesAsFloat32({1, kNumHandKeypoints, 3}, joint_3d)},
+      {"joint_2d", NdArray::FromDoublesAsFloat32({1, kNumHandKeypoints, 2}, joint_2d)},
+      {"mano_betas", NdArray::FromDoublesAsFloat32({1, 10}, betas10.data())}};
 }
 
 Eigen::VectorXd Betas10(const HandParams& params) {
@@ -174,8 +178,8 @@ std::string WriteDexYcbLayout(const LabelSeries& series, const HandModel& model,
   if (other_betas > 0) {
     what += "; " + std::to_string(other_betas) +
             (other_betas == 1 ? " label has" : " labels have") +
-            " other betas than mano.yml's (frame " +
-            series.labels.front().frame + "'s): their labels npz's mano_betas hold them";
+            " other betas than mano.yml's (frame " + series.labels.front().frame +
+            "'s): their labels npz's mano_betas hold them";
   }
   return what;
 }

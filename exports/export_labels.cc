@@ -23,8 +23,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr ExportFormat kAllFormats[] = {ExportFormat::kNpz,  ExportFormat::kCsv,
-                                        ExportFormat::kCoco, ExportFormat::kGlb,
+constexpr ExportFormat kAllFormats[] = {ExportFormat::kNpz,    ExportFormat::kCsv,
+                                        ExportFormat::kCoco,   ExportFormat::kGlb,
                                         ExportFormat::kDexYcb, ExportFormat::kHo3d};
 
 // The job that made the labels: --job, else the job file <output.dir>/job.json names.
@@ -112,7 +112,8 @@ std::string ExportCoco(const ExportRequest& request, const LabelSeries& series) 
 
 std::string ExportDataset(const ExportRequest& request, const LabelSeries& series) {
   const DatasetLayoutOptions options{request.out, request.images};
-  const SeriesCapture capture = ReadSeriesCapture(series, *LabelsCapture(request, series));
+  const SeriesCapture capture =
+      ReadSeriesCapture(series, *LabelsCapture(request, series));
   if (request.format == ExportFormat::kHo3d) {
     return WriteHo3dLayout(series, capture, options);
   }

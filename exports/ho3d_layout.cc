@@ -40,8 +40,8 @@ void WriteCalibration(const fs::path& dir, const Rig& rig) {
     const std::string index = std::to_string(i);
     orders += (i ? " " : "") + index;
     WriteFileAtomically((dir / ("cam_" + index + "_intrinsics.txt")).string(),
-                        "fx:" + Number(k[0]) + ", fy:" + Number(k[1]) + ", ppx:" +
-                            Number(k[2]) + ", ppy:" + Number(k[3]) + "\n");
+                        "fx:" + Number(k[0]) + ", fy:" + Number(k[1]) +
+                            ", ppx:" + Number(k[2]) + ", ppy:" + Number(k[3]) + "\n");
     const Matrix3x4d m = camera.cam_from_world.Inverse().ToMatrix();  // camera -> world
     std::string trans;
     for (int r = 0; r < 3; ++r) {
@@ -104,7 +104,8 @@ std::string WriteHo3dLayout(const LabelSeries& series, const SeriesCapture& capt
   nlohmann::json index = {{"labels", series.labels_dir},
                           {"frames", nlohmann::json::array()},
                           {"cameras", nlohmann::json::array()}};
-  for (const RigCamera& camera : capture.rig.cameras()) index["cameras"].push_back(camera.name);
+  for (const RigCamera& camera : capture.rig.cameras())
+    index["cameras"].push_back(camera.name);
   for (size_t f = 0; f < series.labels.size(); ++f) {
     const LabelRecord& label = series.labels[f];
     const std::string fid = ZeroPadded(static_cast<int64_t>(f), 4);
@@ -121,7 +122,8 @@ std::string WriteHo3dLayout(const LabelSeries& series, const SeriesCapture& capt
   WriteFileAtomically((calibration / "handlabel.json").string(), index.dump(1) + "\n");
   return "HO3D sequence " + (root / "train" / kSequence).string() + " (" +
          std::to_string(capture.rig.size()) + " camera folders " + kSequence +
-         "<i>), images " + (options.images == ImagePlacement::kLink ? "linked" : "copied");
+         "<i>), images " +
+         (options.images == ImagePlacement::kLink ? "linked" : "copied");
 }
 
 }  // namespace handlabel

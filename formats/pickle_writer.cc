@@ -9,10 +9,9 @@ namespace {
 
 // Pickle opcodes (Python's pickletools names).
 constexpr char kProto = '\x80', kStop = '.', kMark = '(', kEmptyDict = '}',
-               kSetItems = 'u', kGlobal = 'c', kReduce = 'R', kBuild = 'b',
-               kTuple = 't', kTuple1 = '\x85', kTuple2 = '\x86', kTuple3 = '\x87',
-               kNewTrue = '\x88', kNewFalse = '\x89', kNone = 'N', kBinInt = 'J',
-               kBinUnicode = 'X';
+               kSetItems = 'u', kGlobal = 'c', kReduce = 'R', kBuild = 'b', kTuple = 't',
+               kTuple1 = '\x85', kTuple2 = '\x86', kTuple3 = '\x87', kNewTrue = '\x88',
+               kNewFalse = '\x89', kNone = 'N', kBinInt = 'J', kBinUnicode = 'X';
 
 class Writer {
  public:

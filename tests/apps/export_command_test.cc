@@ -46,7 +46,7 @@ TEST_F(ExportCommand, SmplxAndManopthLayersReproduceTheLabels) {
                                       "/labels" + npz_specs);
   ASSERT_TRUE(report.contains("cases")) << report.dump();
   RecordProperty("cases", report["cases"].dump());  // the measured numbers
-  EXPECT_EQ(report["labels"], kExportFrames);  // every label has parameters (fitted)
+  EXPECT_EQ(report["labels"], kExportFrames);       // every label has parameters (fitted)
   int right = 0, wrong = 0;
   for (const auto& [name, errors] : report["cases"].items()) {
     if (name.rfind("WRONG", 0) == 0) {
@@ -95,9 +95,9 @@ TEST_F(ExportCommand, CocoWholeBodyHandsAreTheLabelsProjected) {
                                          " --rig " + *dir_ + "/capture/rig.json");
   ASSERT_TRUE(report.contains("coco")) << report.dump();
   const nlohmann::json& coco = report["coco"];
-  EXPECT_EQ(coco["images"], kExportFrames * 8);               // the dexycb rig's 8 views
-  EXPECT_GE(coco["hands"].get<int>(), kExportFrames * 6);     // the hand is in most views
-  EXPECT_LT(coco["keypoints_2d"].get<double>(), 1e-6);  // pixels
+  EXPECT_EQ(coco["images"], kExportFrames * 8);            // the dexycb rig's 8 views
+  EXPECT_GE(coco["hands"].get<int>(), kExportFrames * 6);  // the hand is in most views
+  EXPECT_LT(coco["keypoints_2d"].get<double>(), 1e-6);     // pixels
   EXPECT_EQ(coco["keypoints_outside_box"], 0);
   EXPECT_TRUE(coco["image_files_exist"].get<bool>());
   EXPECT_EQ(coco["hand_keypoint_names"], 21);

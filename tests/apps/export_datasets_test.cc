@@ -37,9 +37,10 @@ double GroundTruthError(const FrameSource& source, const LabelSeries& series,
     const FrameInput frame = source.Load(ids[f]);
     EXPECT_TRUE(frame.ground_truth.has_value()) << ids[f];
     if (!frame.ground_truth) continue;
-    worst = std::max(worst, (frame.ground_truth->keypoints - series.labels[f].mesh.keypoints)
-                                .cwiseAbs()
-                                .maxCoeff());
+    worst =
+        std::max(worst, (frame.ground_truth->keypoints - series.labels[f].mesh.keypoints)
+                            .cwiseAbs()
+                            .maxCoeff());
   }
   return worst;
 }
@@ -61,9 +62,9 @@ TEST_F(ExportDatasets, DexYcbLayoutReadsBackAsTheToolkitAndOurReaderRead) {
   const auto r = RunHandlabelCommand(
       {"export", "--labels", OutDir(), "--format", "dexycb", "--out", out});
   ASSERT_EQ(r.status, 0) << r.err;
-  const nlohmann::json report = RunPython(
-      "dataset_readers.py",
-      "--model " + ModelPath() + " --labels " + OutDir() + "/labels --dexycb " + out);
+  const nlohmann::json report =
+      RunPython("dataset_readers.py", "--model " + ModelPath() + " --labels " + OutDir() +
+                                          "/labels --dexycb " + out);
   ASSERT_TRUE(report.contains("dexycb")) << report.dump();
   const nlohmann::json& dex = report["dexycb"];
   RecordProperty("dexycb_report", dex.dump());  // the measured numbers, in the XML/JSON
@@ -123,9 +124,9 @@ TEST_F(ExportDatasets, Ho3dLayoutReadsBackAsItsScriptsAndOurReaderRead) {
   const auto r = RunHandlabelCommand({"export", "--labels", OutDir(), "--format", "ho3d",
                                       "--out", out, "--images", "copy"});
   ASSERT_EQ(r.status, 0) << r.err;
-  const nlohmann::json report = RunPython(
-      "dataset_readers.py",
-      "--model " + ModelPath() + " --labels " + OutDir() + "/labels --ho3d " + out);
+  const nlohmann::json report =
+      RunPython("dataset_readers.py", "--model " + ModelPath() + " --labels " + OutDir() +
+                                          "/labels --ho3d " + out);
   ASSERT_TRUE(report.contains("ho3d")) << report.dump();
   const nlohmann::json& ho3d = report["ho3d"];
   RecordProperty("ho3d_report", ho3d.dump());

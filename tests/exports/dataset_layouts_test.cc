@@ -72,14 +72,12 @@ TEST(DatasetLayouts, WhatALayoutCannotHoldIsNamed) {
       [&] { WriteHo3dLayout(series, OneCamera(640, 480, true), options); });
   EXPECT_NE(message.find("camera cam0"), std::string::npos) << message;
   EXPECT_NE(message.find("distortion"), std::string::npos) << message;
-  message = testing::InputErrorOf([&] {
-    WriteDexYcbLayout(series, model, OneCamera(640, 480, true), options);
-  });
+  message = testing::InputErrorOf(
+      [&] { WriteDexYcbLayout(series, model, OneCamera(640, 480, true), options); });
   EXPECT_NE(message.find("distortion"), std::string::npos) << message;
   series.labels[0].params.reset();  // a network-path label
-  message = testing::InputErrorOf([&] {
-    WriteDexYcbLayout(series, model, OneCamera(640, 480, false), options);
-  });
+  message = testing::InputErrorOf(
+      [&] { WriteDexYcbLayout(series, model, OneCamera(640, 480, false), options); });
   EXPECT_NE(message.find("000000.json"), std::string::npos) << message;
   EXPECT_NE(message.find("field 'mano'"), std::string::npos) << message;
 }
