@@ -22,10 +22,12 @@
 #include <Eigen/Core>
 #include <array>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "geometry/rig.h"
 #include "geometry/rigid3.h"
 #include "hand/hand_lbs.h"
 #include "hand/hand_model.h"
@@ -87,6 +89,19 @@ nlohmann::json ViewKeypointsToJson(const std::string& frame,
                                    bool ground_truth);
 std::vector<ViewKeypoints> ViewKeypointsFromJson(const nlohmann::json& json,
                                                  const std::string& source);
+
+// One frame's keypoint or detection file as a reader of frame `frame` of `rig` takes
+// it: ViewKeypointsFromJson, then what needs the frame and the cameras, each an
+// InputError naming `source` and the field: the file's "frame" (optional) must be
+// `frame` (a file copied under another frame's name is not used); each view's camera
+// must be a camera of `rig`, once; each position given (not null) must be finite and
+// within its camera's image widened by the image's size on every side (so 1e308, or a
+// position in another image's pixels, is refused), except ground-truth keypoints marked
+// out of frame (visibility 0: a projection near the camera plane may be anywhere).
+// Returns the views in `rig` order; nullopt: no view for that camera.
+std::vector<std::optional<ViewKeypoints>> FrameKeypointsFromJson(
+    const nlohmann::json& json, const std::string& source, const std::string& frame,
+    const Rig& rig);
 
 struct ObjectGroundTruth {
   std::string kind;  // sphere, box, cylinder

@@ -14,6 +14,7 @@
 #include "cameras/rig_json.h"
 #include "capture/capture_reader.h"
 #include "core/errors.h"
+#include "tests/capture/capture_import_fixture.h"
 #include "tests/capture/video_fixture.h"
 #include "tests/test_util.h"
 
@@ -23,22 +24,11 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using testing::InputErrorOf;
+using testing::InitSmallCapture;
+using testing::SmallRig;
+using testing::kHeight;
+using testing::kWidth;
 using testing::ScratchDir;
-
-constexpr int kWidth = 32;
-constexpr int kHeight = 24;
-
-Rig SmallRig(int cameras) {
-  Rig rig;
-  for (int c = 0; c < cameras; ++c) {
-    RigCamera cam;
-    cam.name = "cam" + std::to_string(c);
-    cam.camera = Camera::Pinhole(40 + c, 41 + c, 15.5, 11.5, kWidth, kHeight);
-    cam.cam_from_world.translation = Eigen::Vector3d(0.1 * c, 0, 0);
-    rig.Add(cam);
-  }
-  return rig;
-}
 
 ImageU8 RandomImage(int width = kWidth, int height = kHeight) {
   ImageU8 image(width, height, 3);
@@ -74,14 +64,6 @@ void WriteVideos(const std::string& dir, const Recording& recording) {
   for (size_t c = 0; c < recording.size(); ++c) {
     testing::WriteLosslessVideo(dir + "/cam" + std::to_string(c) + ".mkv", recording[c]);
   }
-}
-
-std::string InitSmallCapture(const std::string& dir, int cameras = 3) {
-  const std::string capture = dir + "/capture";
-  CaptureInitOptions init;
-  init.rig_source = "test rig";
-  InitCapture(SmallRig(cameras), {}, capture, init);
-  return capture;
 }
 
 ::testing::AssertionResult SameImage(const ImageU8& a, const ImageU8& b) {
