@@ -22,8 +22,8 @@
 #include <Eigen/Core>
 #include <array>
 #include <map>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,9 +65,16 @@ nlohmann::json ManifestToJson(const CaptureManifest& manifest);
 // Throws InputError naming `source` and the field.
 CaptureManifest ManifestFromJson(const nlohmann::json& json, const std::string& source);
 
-// Replaces {camera} and {frame} in `pattern`.
+// Replaces {camera} and {frame} in `pattern` (in one pass: values are not expanded).
 std::string ExpandPattern(const std::string& pattern, const std::string& camera,
                           const std::string& frame);
+// A capture's camera names are folder names, values in file patterns and tokens of
+// COLMAP's whitespace-separated text model, none of which can escape anything: a name
+// with a space or control character, '/', '\\', '{' or '}', or "." / ".." is refused
+// (InputError naming `source` and `field`). Renaming a camera (the rig file, or
+// `capture import --map`) is cheap; escaped names would differ from file to file.
+void CheckCameraName(const std::string& name, const std::string& source,
+                     const std::string& field);
 // "000042" for 42.
 std::string FrameId(int index);
 
