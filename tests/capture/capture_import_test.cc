@@ -23,12 +23,12 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-using testing::InputErrorOf;
 using testing::InitSmallCapture;
-using testing::SmallRig;
+using testing::InputErrorOf;
 using testing::kHeight;
 using testing::kWidth;
 using testing::ScratchDir;
+using testing::SmallRig;
 
 ImageU8 RandomImage(int width = kWidth, int height = kHeight) {
   ImageU8 image(width, height, 3);
@@ -251,6 +251,14 @@ TEST(CaptureImport, ARigCameraWithoutASourceIsAnError) {
   o.source_to_camera = {{"cam0", "cam9"}};
   EXPECT_THAT(InputErrorOf([&] { ImportCapture(capture, o); }),
               HasSubstr("a camera of the rig (cam0, cam1, cam2)"));
+  // --map cam1=cam0 leaves cam1 without a source: the message says where cam1.mkv went
+  // (it said "got only cam0.mkv, cam1.mkv", as if cam1.mkv were not there).
+  o.source_to_camera = {{"cam1", "cam0"}};
+  EXPECT_THAT(
+      InputErrorOf([&] { ImportCapture(capture, o); }),
+      HasSubstr("field 'camera cam1': expected a video cam1.<mp4|mkv|avi|...> (or "
+                "--map SOURCE=cam1), got cam0.mkv (unused), cam1.mkv (--map "
+                "cam1=cam0)"));
 }
 
 TEST(CaptureImport, AnImageOfAnotherSizeNamesFileCameraAndSizesAndKeepsEarlierFrames) {
