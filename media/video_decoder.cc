@@ -69,9 +69,8 @@ struct VideoDecoder::State {
   AVFrame* frame = nullptr;
   SwsContext* scale = nullptr;
   int stream = -1;
-  int rotation = 0;     // clockwise degrees, as OpenCV's CAP_PROP_ORIENTATION_META
-  bool flushing = false;
-  std::string damage;   // since the last clean key frame: "frame N: message"
+  int rotation = 0;    // clockwise degrees, as OpenCV's CAP_PROP_ORIENTATION_META
+  std::string damage;  // since the last clean key frame: "frame N: message"
 
   ~State() {
     sws_freeContext(scale);
@@ -109,8 +108,10 @@ VideoDecoder::VideoDecoder(const std::string& path, const std::string& camera)
   HL_CHECK(s.packet && s.frame, "FFmpeg allocation");
   if (const uint8_t* matrix =
           av_stream_get_side_data(stream, AV_PKT_DATA_DISPLAYMATRIX, nullptr)) {
-    const double degrees = av_display_rotation_get(reinterpret_cast<const int32_t*>(matrix));
-    if (std::isfinite(degrees)) s.rotation = ((-static_cast<int>(std::lround(degrees))) % 360 + 360) % 360;
+    const double degrees =
+        av_display_rotation_get(reinterpret_cast<const int32_t*>(matrix));
+    if (std::isfinite(degrees))
+      s.rotation = ((-static_cast<int>(std::lround(degrees))) % 360 + 360) % 360;
   }
 }
 
@@ -122,7 +123,8 @@ int VideoDecoder::DeclaredCount() const {
   double seconds = state_->format->duration > 0
                        ? static_cast<double>(state_->format->duration) / AV_TIME_BASE
                        : 0.0;
-  if (seconds <= 0 && stream->duration > 0) seconds = stream->duration * av_q2d(stream->time_base);
+  if (seconds <= 0 && stream->duration > 0)
+    seconds = stream->duration * av_q2d(stream->time_base);
   const double count = std::floor(seconds * Fps() + 0.5);
   return count >= 1 ? static_cast<int>(count) : -1;
 }
@@ -163,7 +165,6 @@ bool VideoDecoder::Decode() {
     if (r < 0) {
       if (r != AVERROR_EOF) note("reading the file failed: " + AvError(r));
       avcodec_send_packet(s.codec, nullptr);  // drain the frames the decoder holds
-      s.flushing = true;
       continue;
     }
     if (s.packet->stream_index == s.stream) {
@@ -172,7 +173,8 @@ bool VideoDecoder::Decode() {
     }
     av_packet_unref(s.packet);
   }
-  if (got && (s.frame->decode_error_flags != 0 || (s.frame->flags & AV_FRAME_FLAG_CORRUPT)))
+  if (got &&
+      (s.frame->decode_error_flags != 0 || (s.frame->flags & AV_FRAME_FLAG_CORRUPT)))
     note("the decoder marked the frame corrupt or concealed");
   if (!errors.empty() && s.damage.empty())
     s.damage = "frame " + std::to_string(next_) + ": " + errors;
@@ -198,9 +200,9 @@ bool VideoDecoder::Read(ImageU8* rgb) {
   if (!got) return false;
   ++next_;
   const int w = s.frame->width, h = s.frame->height;
-  s.scale = sws_getCachedContext(s.scale, w, h, static_cast<AVPixelFormat>(s.frame->format),
-                                 w, h, AV_PIX_FMT_RGB24, SWS_BICUBIC, nullptr, nullptr,
-                                 nullptr);
+  s.scale =
+      sws_getCachedContext(s.scale, w, h, static_cast<AVPixelFormat>(s.frame->format), w,
+                           h, AV_PIX_FMT_RGB24, SWS_BICUBIC, nullptr, nullptr, nullptr);
   HL_CHECK(s.scale != nullptr, "FFmpeg colour conversion");
   cv::Mat decoded(h, w, CV_8UC3);
   uint8_t* rows[4] = {decoded.data, nullptr, nullptr, nullptr};
