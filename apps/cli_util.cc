@@ -1,11 +1,23 @@
 #include "apps/cli_util.h"
 
+#include <malloc.h>
+
 #include <exception>
 #include <iostream>
 #include <new>
 #include <sstream>
 
 namespace handlabel {
+
+void UseOneMallocArena() {
+  // Each further thread would get an arena of its own, made of mmap'd heaps that glibc
+  // unmaps as they empty: the frames a second thread detected and fitted page-faulted
+  // their memory afresh, and with another process on one of two cores a detector label
+  // job was slower on 2 threads than on 1 (docs/speed.md, "Threads under load"). One
+  // arena measured the same on free cores. Not for the network: its two lanes allocate
+  // at once, and waiting for the one arena's lock cost 4-7 %.
+  mallopt(M_ARENA_MAX, 1);
+}
 
 int ParseCommandLine(CLI::App& app, int argc, char** argv) {
   try {

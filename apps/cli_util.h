@@ -15,6 +15,11 @@ int ParseCommandLine(CLI::App& app, int argc, char** argv);
 // Runs `body`, turning exceptions into a one-line message on stderr and status 1.
 int RunReportingErrors(const char* command, const std::function<int()>& body);
 
+// One malloc arena for every thread of the process, for commands whose threads each
+// run the detector and the fit on their own frames (detect, label jobs without a
+// network). Call before the threads start.
+void UseOneMallocArena();
+
 // "a,b,,c" -> {"a", "b", "c"}: the comma lists of flags such as --frames, --ignore-views.
 std::vector<std::string> SplitCommas(const std::string& text);
 

@@ -60,7 +60,12 @@ int RunDetect(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--min-presence", o.min_presence, "hand presence threshold")
       ->capture_default_str();
-  app.add_option("--threads", o.num_threads, "LibTorch threads, 0 = default")
+  app.add_option("--threads", dc.threads,
+                 "frames (or images) detected at once, 0 = one per core")
+      ->capture_default_str();
+  app.add_option("--model-threads", o.num_threads,
+                 "LibTorch threads of each model call (latency of one image); 1 = "
+                 "parallel over frames only, best for throughput and under load")
       ->capture_default_str();
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;
   if (images.empty() == capture_dir.empty()) {
@@ -71,6 +76,7 @@ int RunDetect(int argc, char** argv) {
     std::cerr << "detect: --images needs --out\n";
     return 2;
   }
+  UseOneMallocArena();
   if (!capture_dir.empty()) {
     return RunReportingErrors("detect", [&] {
       // Made at the first frame: the capture is read under DetectCapture's writer
@@ -95,11 +101,11 @@ int RunDetect(int argc, char** argv) {
     });
   }
   return RunReportingErrors("detect", [&] {
-    o.Check("detect");
+    dc.Check("detect");
     const MediapipeHands detector(o);
     Progress progress(static_cast<int>(images.size()), std::cerr,
                       Progress::IsTerminal(STDERR_FILENO), "detect");
-    const int removed = DetectImages(detector, images, out_dir,
+    const int removed = DetectImages(detector, images, out_dir, dc.threads,
                                      [&](int done, int) { progress.Update(done); });
     progress.Finish();
     if (removed > 0) {

@@ -40,6 +40,7 @@ int RunLabel(int argc, char** argv) {
   }
   return RunReportingErrors("label", [&] {
     const JobConfig job = LoadJobConfig(job_file);
+    if (job.network_weights.empty()) UseOneMallocArena();
     LabelRunOptions options;
     if (!shard_text.empty()) {
       options.shard = ParseShard(shard_text);

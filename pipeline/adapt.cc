@@ -167,7 +167,7 @@ void DetectStage(const AdaptRun& run) {
     return;
   }
   DetectCaptureOptions detect;
-  detect.hands.num_threads = run.o.threads;
+  detect.threads = run.o.threads;
   const DetectCaptureSummary s =
       DetectCapture(run.o.capture_dir, detect, [&run](int done, int total) {
         if (done % 10 == 0 || done == total) {

@@ -3,6 +3,11 @@
 #include <chrono>
 #include <filesystem>
 #include <limits>
+#include <mutex>
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "capture/capture_format.h"
 #include "capture/capture_manifest_file.h"
@@ -11,6 +16,7 @@
 #include "core/errors.h"
 #include "core/file_lock.h"
 #include "core/json_util.h"
+#include "core/option_checks.h"
 #include "core/stopwatch.h"
 #include "image/image_file.h"
 #include "network/detector/detector_overlay.h"
@@ -46,6 +52,15 @@ void WriteDetectionOverlays(const std::string& dir, const std::string& frame,
 void DetectCaptureOptions::Check(const std::string& source) const {
   hands.Check(source);
   multiview.Check(source);
+  RequireAtLeast(source, "threads", threads, 0, ">= 0 (0 = one frame per core)");
+}
+
+void DetectCaptureSummary::Add(const DetectCaptureSummary& other) {
+  frames += other.frames;
+  views += other.views;
+  views_detected += other.views_detected;
+  views_from_palm += other.views_from_palm;
+  frames_with_hand += other.frames_with_hand;
 }
 
 nlohmann::json FrameDetectionsJson(const std::string& frame,
@@ -88,6 +103,35 @@ nlohmann::json FrameDetectionsJson(const std::string& frame,
   return out;
 }
 
+namespace {
+
+// Detects one frame and writes its detections (and overlays); adds it to `summary`.
+void DetectFrame(const CaptureReader& capture, int f, const MediapipeHands& detector,
+                 const DetectCaptureOptions& options, DetectCaptureSummary* summary) {
+  const int n = capture.num_cameras();
+  std::vector<ImageU8> images;
+  for (int c = 0; c < n; ++c) images.push_back(capture.ReadImage(f, c));
+  const FrameHandResult result =
+      DetectHandMultiView(detector, capture.rig(), images, options.multiview);
+  const std::string id = capture.frame_id(f);
+  if (!options.overlays_dir.empty()) {
+    WriteDetectionOverlays(options.overlays_dir, id, capture.manifest().cameras, result,
+                           std::move(images));
+  }
+  WriteFileAtomically(
+      capture.dir() + "/" + ExpandPattern(kDetectionsPattern, "", id),
+      FrameDetectionsJson(id, capture.manifest().cameras, result).dump(1) + "\n");
+  summary->frames += 1;
+  summary->views += n;
+  summary->frames_with_hand += result.found ? 1 : 0;
+  for (const ViewHandResult& r : result.views) {
+    summary->views_detected += r.detected ? 1 : 0;
+    summary->views_from_palm += (r.detected && r.source == "palm") ? 1 : 0;
+  }
+}
+
+}  // namespace
+
 DetectCaptureSummary DetectCapture(const std::string& capture_dir,
                                    const DetectCaptureOptions& options,
                                    const std::function<void(int, int)>& on_frame) {
@@ -107,31 +151,23 @@ DetectCaptureSummary DetectCapture(const std::string& capture_dir,
   }
   const auto t0 = std::chrono::steady_clock::now();
   const MediapipeHands detector(options.hands);
-  DetectCaptureSummary summary;
-  const int n = capture.num_cameras();
   std::filesystem::create_directories(capture_dir + "/detections");
-  for (int f = 0; f < capture.num_frames(); ++f) {
-    std::vector<ImageU8> images;
-    for (int c = 0; c < n; ++c) images.push_back(capture.ReadImage(f, c));
-    const FrameHandResult result =
-        DetectHandMultiView(detector, capture.rig(), images, options.multiview);
-    const std::string id = capture.frame_id(f);
-    if (!options.overlays_dir.empty()) {
-      WriteDetectionOverlays(options.overlays_dir, id, capture.manifest().cameras, result,
-                             std::move(images));
-    }
-    WriteFileAtomically(
-        capture_dir + "/" + ExpandPattern(kDetectionsPattern, "", id),
-        FrameDetectionsJson(id, capture.manifest().cameras, result).dump(1) + "\n");
-    ++summary.frames;
-    summary.views += n;
-    summary.frames_with_hand += result.found ? 1 : 0;
-    for (const ViewHandResult& r : result.views) {
-      summary.views_detected += r.detected ? 1 : 0;
-      summary.views_from_palm += (r.detected && r.source == "palm") ? 1 : 0;
-    }
-    if (on_frame) on_frame(f + 1, capture.num_frames());
-  }
+  // Frames in parallel, each on one thread (options.hands.num_threads): a frame's
+  // result does not depend on the others, so the files are the same at any count.
+  DetectCaptureSummary summary;
+  std::mutex mutex;  // summary and on_frame
+  const int total = capture.num_frames();
+  tbb::task_arena arena(options.threads > 0 ? options.threads
+                                            : tbb::info::default_concurrency());
+  arena.execute([&] {
+    tbb::parallel_for(0, total, [&](int f) {
+      DetectCaptureSummary frame;
+      DetectFrame(capture, f, detector, options, &frame);
+      const std::lock_guard<std::mutex> lock(mutex);
+      summary.Add(frame);
+      if (on_frame) on_frame(summary.frames, total);
+    });
+  });
   ListDetections(capture);
   summary.seconds = SecondsSince(t0);
   return summary;

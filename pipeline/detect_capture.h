@@ -26,6 +26,9 @@ struct DetectCaptureOptions {
   // When set, also a picture per view of what was found
   // (network/detector/detector_overlay.h): <overlays_dir>/<frame>/<camera>.png.
   std::string overlays_dir;
+  // Frames detected at once; 0 = one per core. Each runs its models on
+  // hands.num_threads LibTorch threads (1 by default).
+  int threads = 0;
   // Throws InputError naming `source` when a field is out of range.
   void Check(const std::string& source) const;
 };
@@ -37,9 +40,12 @@ struct DetectCaptureSummary {
   int views_from_palm = 0;   // ... whose ROI came from their own palm
   int frames_with_hand = 0;  // frames where a 3D hand was established
   double seconds = 0;
+  // Adds another part's counts (not its seconds).
+  void Add(const DetectCaptureSummary& other);
 };
 
-// Runs every frame; `on_frame(done, total)` after each. Holds the capture folder's
+// Runs every frame (options.threads at once); `on_frame(done, total)` after each,
+// one call at a time. Holds the capture folder's
 // writer lock (core/file_lock.h) throughout: an import or another detect on the
 // capture meanwhile is refused, as this one is while they run. Throws InputError naming
 // the capture when it already has detections and `overwrite` is off.

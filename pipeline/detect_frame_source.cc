@@ -68,13 +68,10 @@ FrameInput DetectorFrameSource::Load(const std::string& id) const {
 }
 
 void DetectorFrameSource::Detect(FrameInput* frame) const {
-  FrameHandResult result;
-  {
-    // One frame at a time: the models are shared, and they use the cores themselves.
-    std::lock_guard<std::mutex> lock(detect_mutex_);
-    result =
-        DetectHandMultiView(*detector_, frame->rig, frame->images, options_.multiview);
-  }
+  // Frames may be detected in parallel: the models keep no state between calls and
+  // each call runs on options_.hands.num_threads threads (1 by default).
+  FrameHandResult result =
+      DetectHandMultiView(*detector_, frame->rig, frame->images, options_.multiview);
   frame->keypoints_2d = KeypointsFromDetection(result);
   if (store_) store_->Put(frame->id, std::move(result));
 }

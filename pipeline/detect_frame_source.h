@@ -49,7 +49,7 @@ class DetectorFrameSource : public Replaced2dFrameSource {
                       const DetectCaptureOptions& options,
                       std::shared_ptr<DetectionStore> store, bool detect_on_load = true);
   // Reads the frame's images (InputError naming a file that cannot be read or does not
-  // fit its camera) and detects unless told not to; frames are detected one at a time.
+  // fit its camera) and detects unless told not to. Several frames may load at once.
   FrameInput Load(const std::string& id) const override;
   // Detects the hand in a frame that Load read: sets frame->keypoints_2d.
   void Detect(FrameInput* frame) const;
@@ -60,7 +60,6 @@ class DetectorFrameSource : public Replaced2dFrameSource {
   bool detect_on_load_ = true;
   std::unique_ptr<MediapipeHands> detector_;
   std::shared_ptr<DetectionStore> store_;
-  mutable std::mutex detect_mutex_;
 };
 
 }  // namespace handlabel

@@ -44,8 +44,12 @@ struct MediapipeHandsOptions {
   double min_presence = 0.5;
   // At most this many palms (the best) go on to landmarks (MediaPipe's maxNumHands).
   int max_hands = 2;
-  // LibTorch threads for the models; 0 = the process default.
-  int num_threads = 0;
+  // LibTorch threads of each model call (set for the calling thread only); 0 = the
+  // calling thread's setting. 1 by default: callers run frames or views in parallel
+  // instead. The models are small, so most of a call split over threads is spent
+  // waiting at OpenMP's barriers, and with another process on a core that waiting takes
+  // over (docs/speed.md, "Threads under load").
+  int num_threads = 1;
   // Throws InputError naming `source` when a field is out of range.
   void Check(const std::string& source) const;
 };

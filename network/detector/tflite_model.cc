@@ -5,6 +5,7 @@
 // declares, so semantic mismatches and malformed graphs fail at load, naming the
 // operator.
 
+#include <omp.h>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -27,9 +28,33 @@ using tflite::ToInt64;
 using tflite::Value;
 using torch::Tensor;
 
+// LibTorch's intra-op thread count for the calling thread only, for one call. The count
+// (OpenMP's nthreads setting) is kept per thread, so callers that detect frames or views
+// in parallel each get theirs, and no process-wide at::set_num_threads races between
+// them or changes what the POEM network's threads use.
+class CallingThreadIntraOpThreads {
+ public:
+  explicit CallingThreadIntraOpThreads(int threads) {
+    if (threads <= 0) return;
+    // Also runs ATen's first-use set-up of this thread's count, which would otherwise
+    // replace ours at the first operator.
+    previous_ = at::get_num_threads();
+    if (previous_ != threads) omp_set_num_threads(threads);
+  }
+  ~CallingThreadIntraOpThreads() {
+    if (previous_ > 0) omp_set_num_threads(previous_);
+  }
+  CallingThreadIntraOpThreads(const CallingThreadIntraOpThreads&) = delete;
+  CallingThreadIntraOpThreads& operator=(const CallingThreadIntraOpThreads&) = delete;
+
+ private:
+  int previous_ = 0;
+};
+
 class Interpreter : public TfliteModel {
  public:
-  Interpreter(std::unique_ptr<TfliteGraph> graph, const std::string& source);
+  Interpreter(std::unique_ptr<TfliteGraph> graph, const std::string& source,
+              int num_threads);
   const std::vector<TfliteTensorInfo>& inputs() const override { return inputs_; }
   const std::vector<TfliteTensorInfo>& outputs() const override { return outputs_; }
   std::vector<std::string> op_names() const override { return op_names_; }
@@ -43,6 +68,7 @@ class Interpreter : public TfliteModel {
 
   std::unique_ptr<TfliteGraph> graph_;
   std::string source_;
+  int num_threads_ = 0;  // TfliteModelOptions::num_threads
   std::vector<TfliteTensorInfo> inputs_, outputs_;
   std::vector<std::string> op_names_;
   tflite::Program program_;
@@ -80,8 +106,9 @@ std::vector<TfliteTensorInfo> TensorInfos(const TfliteGraph& g,
   return infos;
 }
 
-Interpreter::Interpreter(std::unique_ptr<TfliteGraph> graph, const std::string& source)
-    : graph_(std::move(graph)), source_(source) {
+Interpreter::Interpreter(std::unique_ptr<TfliteGraph> graph, const std::string& source,
+                         int num_threads)
+    : graph_(std::move(graph)), source_(source), num_threads_(num_threads) {
   const TfliteGraph& g = *graph_;
   for (const TfliteOp& op : g.ops) {
     if (std::find(op_names_.begin(), op_names_.end(), op.name) == op_names_.end()) {
@@ -149,6 +176,7 @@ std::vector<Value> Interpreter::Execute(const std::vector<std::vector<float>>& i
                                         bool check_shapes) const {
   CheckInputs(inputs);
   torch::InferenceMode guard;
+  const CallingThreadIntraOpThreads threads(num_threads_);
   const TfliteGraph& g = *graph_;
   std::vector<Value> values(g.tensors.size());
   for (size_t i = 0; i < program_.constants.size(); ++i) {
@@ -211,15 +239,15 @@ int64_t TfliteTensorInfo::num_elements() const {
 
 void TfliteModelOptions::Check(const std::string& source) const {
   RequireAtLeast(source, "num_threads", num_threads, 0,
-                 ">= 0 (0 = keep the current setting)");
+                 ">= 0 (0 = the calling thread's setting)");
 }
 
 std::unique_ptr<TfliteModel> TfliteModel::FromBytes(const std::string& bytes,
                                                     const std::string& source,
                                                     const TfliteModelOptions& options) {
   options.Check(source);
-  if (options.num_threads > 0) at::set_num_threads(options.num_threads);
-  return std::make_unique<Interpreter>(ParseTflite(bytes, source), source);
+  return std::make_unique<Interpreter>(ParseTflite(bytes, source), source,
+                                       options.num_threads);
 }
 
 std::unique_ptr<TfliteModel> TfliteModel::Load(const std::string& path,

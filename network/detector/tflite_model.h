@@ -23,8 +23,9 @@ struct TfliteTensorInfo {
 };
 
 struct TfliteModelOptions {
-  // LibTorch intra-op threads set when the model is loaded; 0 = keep the current
-  // setting (the process-wide default: the machine's hardware threads).
+  // LibTorch intra-op threads each Run uses, set for the calling thread during the
+  // call only (other threads and the process-wide setting are left alone); 0 = the
+  // calling thread's setting (by default the machine's hardware threads).
   int num_threads = 0;
   // Throws InputError naming `source` when a field is out of range.
   void Check(const std::string& source) const;

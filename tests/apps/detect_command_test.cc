@@ -210,5 +210,49 @@ TEST(DetectCommand, LabelJobWithDetectorGivesTheSame2dAsDetectThenFiles) {
   EXPECT_EQ(plain_roi_pixels, 0);
 }
 
+// Frames detected at once (`detect --threads 2`, and a detector job's frames on two
+// threads) give what one at a time gives, bit for bit: each frame's detection depends
+// on its own images only, whichever thread runs it.
+TEST(DetectCommand, FramesInParallelGiveTheSameDetectionsAndLabels) {
+  if (!ModelsPresent()) {
+    GTEST_SKIP() << "MediaPipe models absent: run scripts/fetch-mediapipe-models";
+  }
+  namespace fs = std::filesystem;
+  const std::string dir = testing::ScratchDir();
+  ASSERT_EQ(RunHandlabelCommand({"synth", "--preset", "dexycb", "--frames", "3", "--seed",
+                                 "5", "--no-detections", "--out", dir + "/cap"})
+                .status,
+            0);
+  for (const std::string threads : {"1", "2"}) {
+    const std::string capture = dir + "/cap" + threads;
+    fs::copy(dir + "/cap", capture, fs::copy_options::recursive);
+    const testing::CommandResult r =
+        RunHandlabelCommand({"detect", "--capture", capture, "--threads", threads});
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::ofstream(dir + "/job" + threads + ".yaml")
+        << "name: t\nseed: 3\ninput: {format: native, path: " << dir
+        << "/cap}\nnetwork: {weights: \"\", threads: " << threads
+        << "}\nrefine: {mode: always}\nevidence: {keypoints_2d: detector, masks: none}\n"
+        << "output: {dir: " << dir << "/labels" << threads << ", meshes: [], overlays: false}\n";
+    const testing::CommandResult job =
+        RunHandlabelCommand({"label", "--job", dir + "/job" + threads + ".yaml"});
+    ASSERT_EQ(job.status, 0) << job.err;
+  }
+  int frames = 0;
+  for (const auto& entry : fs::directory_iterator(dir + "/cap1/detections")) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(testing::ReadFileBytes(entry.path().string()),
+              testing::ReadFileBytes(dir + "/cap2/detections/" + name))
+        << name;
+    const std::string stem = entry.path().stem().string();
+    const nlohmann::json one = ReadJson(dir + "/labels1/labels/" + stem + ".json");
+    const nlohmann::json two = ReadJson(dir + "/labels2/labels/" + stem + ".json");
+    EXPECT_EQ(one["keypoints_3d"].dump(), two["keypoints_3d"].dump()) << stem;
+    EXPECT_EQ(one["mano"].dump(), two["mano"].dump()) << stem;
+    ++frames;
+  }
+  EXPECT_EQ(frames, 3);
+}
+
 }  // namespace
 }  // namespace handlabel

@@ -2,6 +2,7 @@
 // from JSON, fuzz/make_tflite_corpus.py), and every kind of bad input: malformed or
 // truncated files, out-of-range indices and sizes, unsupported operators, wrong inputs.
 
+#include <ATen/Parallel.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -100,6 +101,35 @@ TEST(TfliteModel, InfoAndInputChecks) {
   options.num_threads = -1;
   EXPECT_THROW(TfliteModel::FromBytes(SmallModel(), "x", options), InputError);
   EXPECT_THROW(TfliteModel::Load("/nonexistent/model.tflite"), InputError);
+}
+
+// A model's thread count holds for its own calls only: loading and running it leave
+// the caller's count, and the count new threads start with, as they were (the label
+// job's network lanes run on the process-wide count while frames are detected on one
+// thread each), and calls from several threads at once give the same answer.
+TEST(TfliteModel, RunsOnItsThreadCountWithoutChangingAnyoneElses) {
+  const int before = at::get_num_threads();
+  at::set_num_threads(2);
+  TfliteModelOptions options;
+  options.num_threads = 1;
+  auto model = TfliteModel::FromBytes(SmallModel(), "small.tflite", options);
+  const std::vector<float> input(32, 0.5f);
+  const std::vector<float> alone = model->Run({input})[0];
+  EXPECT_EQ(at::get_num_threads(), 2);
+  int new_thread_count = 0;
+  std::thread([&] { new_thread_count = at::get_num_threads(); }).join();
+  EXPECT_EQ(new_thread_count, 2);
+  std::vector<std::vector<float>> answers(4);
+  std::vector<std::thread> callers;
+  for (auto& answer : answers) {
+    callers.emplace_back([&] {
+      answer = model->Run({input})[0];
+      EXPECT_EQ(at::get_num_threads(), 2);  // this thread's own count, given back
+    });
+  }
+  for (std::thread& caller : callers) caller.join();
+  for (const auto& answer : answers) EXPECT_EQ(answer, alone);
+  at::set_num_threads(before);
 }
 
 TEST(TfliteModel, NamesUnsupportedOperators) {
