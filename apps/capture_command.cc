@@ -9,6 +9,7 @@
 #include "capture/capture_import.h"
 #include "core/errors.h"
 #include "core/progress.h"
+#include "core/size_checks.h"
 
 namespace handlabel {
 namespace {
@@ -29,16 +30,8 @@ std::map<std::string, int> ParseOffsets(const std::vector<std::string>& items) {
   for (const std::string& item : items) {
     const auto [camera, number] =
         SplitAssignment(item, "--offset", "CAMERA=N with an integer N");
-    size_t used = 0;
-    int value = 0;
-    try {
-      value = std::stoi(number, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != number.size()) {
-      throw InputError("--offset", camera, "an integer frame offset", number);
-    }
+    const int value = static_cast<int>(ParseIntegerInRange(
+        number, "--offset", camera, "an integer frame offset", -1000000000, 1000000000));
     if (!offsets.emplace(camera, value).second) {
       throw InputError("--offset", camera, "one offset per camera", "two");
     }
@@ -101,7 +94,7 @@ int RunCaptureImport(int argc, char** argv) {
       "camera\n"
       "(--images DIR: DIR/<camera>/<frame>.png|jpg|...) or one video per camera "
       "(--videos DIR:\n"
-      "DIR/<camera>.mp4|mkv|avi|...; decoded with OpenCV/FFmpeg). Sources are matched to "
+      "DIR/<camera>.mp4|mkv|avi|...; decoded with FFmpeg). Sources are matched to "
       "rig\n"
       "cameras by name; --map SOURCE=CAMERA for others. Image frames are matched by file "
       "name\n"
@@ -141,6 +134,9 @@ int RunCaptureImport(int argc, char** argv) {
   app.add_option("--stride", o.stride, "import every N-th frame")->capture_default_str();
   app.add_option("--max-frames", o.max_frames, "import at most N frames (0 = all)")
       ->capture_default_str();
+  app.add_flag("--allow-mixed-fps", o.allow_mixed_fps,
+               "pair videos of different frame rates by index all the same (refused "
+               "without it)");
   app.add_flag("--resume", o.resume,
                "continue an interrupted import with the same sources and options");
   app.add_flag("--overwrite", o.overwrite,

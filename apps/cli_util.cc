@@ -4,6 +4,7 @@
 
 #include <exception>
 #include <iostream>
+#include <new>
 #include <sstream>
 
 namespace handlabel {
@@ -32,11 +33,28 @@ int ParseCommandLine(CLI::App& app, int argc, char** argv) {
   return -1;
 }
 
+namespace {
+
+// One line: a library's message up to its first line break (LibTorch appends a
+// backtrace of 40 lines that tells a user nothing).
+std::string FirstLine(const char* text) {
+  std::string line(text);
+  const size_t end = line.find('\n');
+  return end == std::string::npos ? line : line.substr(0, end);
+}
+
+}  // namespace
+
 int RunReportingErrors(const char* command, const std::function<int()>& body) {
   try {
     return body();
+  } catch (const std::bad_alloc&) {
+    std::cerr << "handlabel " << command
+              << ": error: out of memory (std::bad_alloc): a count, size or batch given "
+                 "in a flag or file needs more memory than this machine has\n";
+    return 1;
   } catch (const std::exception& e) {
-    std::cerr << "handlabel " << command << ": error: " << e.what() << "\n";
+    std::cerr << "handlabel " << command << ": error: " << FirstLine(e.what()) << "\n";
     return 1;
   }
 }

@@ -4,10 +4,10 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
-#include "core/errors.h"
 #include "comparison/compare_qa.h"
 #include "comparison/compare_report.h"
 #include "comparison/compare_run.h"
+#include "core/errors.h"
 #include "pipeline/job_config.h"
 
 namespace handlabel {
@@ -24,15 +24,9 @@ struct CompareFlags {
   CompareOptions options;
 };
 
-// "all" = every count from 2 to the rig's views - 1 (RunComparison skips counts >= the
-// rig's), "none", or a list.
+// "none" or a list ("all" is CompareOptions::ablation_all_counts).
 std::vector<int> AblationViews(const std::string& text) {
   if (text == "none") return {};
-  if (text == "all") {
-    std::vector<int> all;
-    for (int v = 2; v < 64; ++v) all.push_back(v);
-    return all;
-  }
   std::vector<int> views;
   for (const std::string& item : SplitCommas(text)) {
     try {
@@ -71,7 +65,8 @@ CompareOptions Options(const CompareFlags& f, const JobConfig& base) {
     for (const std::string& name : SplitCommas(f.methods))
       o.methods.push_back(ParseCompareMethod(name, "command line", "--methods"));
   }
-  o.ablation_views = AblationViews(f.ablation);
+  o.ablation_all_counts = f.ablation == "all";
+  if (!o.ablation_all_counts) o.ablation_views = AblationViews(f.ablation);
   if (!f.qa_selection.empty()) o.qa_selection = SplitCommas(f.qa_selection);
   o.Check("command line");
   return o;

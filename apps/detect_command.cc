@@ -105,9 +105,14 @@ int RunDetect(int argc, char** argv) {
     const MediapipeHands detector(o);
     Progress progress(static_cast<int>(images.size()), std::cerr,
                       Progress::IsTerminal(STDERR_FILENO), "detect");
-    DetectImages(detector, images, out_dir, dc.threads,
-                 [&](int done, int) { progress.Update(done); });
+    const int removed = DetectImages(detector, images, out_dir, dc.threads,
+                                     [&](int done, int) { progress.Update(done); });
     progress.Finish();
+    if (removed > 0) {
+      std::cerr << "handlabel detect: note: removed " << removed
+                << " records of an earlier run with more images (<n>.json, n >= "
+                << images.size() << ")\n";
+    }
     std::cout << "detections: " << out_dir << "\n";
     return 0;
   });

@@ -11,12 +11,13 @@
 
 #include "apps/cli_util.h"
 #include "apps/commands.h"
+#include "comparison/compare_report.h"
+#include "comparison/network_evaluation.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/progress.h"
+#include "core/size_checks.h"
 #include "hand/hand_model_io.h"
-#include "comparison/compare_report.h"
-#include "comparison/network_evaluation.h"
 #include "pipeline/train_config.h"
 
 namespace handlabel {
@@ -35,18 +36,9 @@ struct EvalNetworkFlags {
 };
 
 int ParseFrameCount(const std::string& text) {
-  size_t used = 0;
-  int count = 0;
-  try {
-    count = std::stoi(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || count < 1) {
-    throw InputError("command line", "--frames",
-                     "a frame count >= 1 (frame lists need --capture)", text);
-  }
-  return count;
+  return static_cast<int>(
+      ParseIntegerInRange(text, "command line", "--frames",
+                          "a frame count (frame lists need --capture)", 1, 1000000000));
 }
 
 int RunOnSynth(EvalNetworkFlags& f) {

@@ -261,12 +261,20 @@ Rig ReadHo3d(const fs::path& folder, RigFileInfo* info) {
   const fs::path abs = fs::absolute(folder).lexically_normal();
   const fs::path dir = abs.filename().empty() ? abs.parent_path() : abs;
   const std::string seq = dir.parent_path().filename().string();
+  int transforms = 0;  // trans_0.txt, trans_1.txt, ...: one per camera
+  while (fs::exists(dir / ("trans_" + std::to_string(transforms) + ".txt"))) ++transforms;
   std::vector<int> order;
   if (fs::exists(dir / "cam_orders.txt")) {
     order = Ho3dCameraOrder(dir / "cam_orders.txt");
+    // A list shorter than the cameras made a smaller rig without a word.
+    if (static_cast<int>(order.size()) != transforms) {
+      throw InputError((dir / "cam_orders.txt").string(), "(camera order)",
+                       "one camera index per trans_<i>.txt beside it (" +
+                           std::to_string(transforms) + ")",
+                       std::to_string(order.size()) + " indices");
+    }
   } else {
-    for (int i = 0; fs::exists(dir / ("trans_" + std::to_string(i) + ".txt")); ++i)
-      order.push_back(i);
+    for (int i = 0; i < transforms; ++i) order.push_back(i);
   }
   if (order.empty()) {
     throw InputError(dir.string(), "cam_orders.txt / trans_<i>.txt", "HO3D camera files",

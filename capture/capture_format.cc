@@ -1,9 +1,11 @@
 #include "capture/capture_format.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/errors.h"
 #include "core/json_util.h"
+#include "core/text.h"
 #include "hand/hand_params_json.h"
 
 namespace handlabel {
@@ -64,6 +66,9 @@ CaptureManifest ManifestFromJson(const json& j, const std::string& source) {
   m.rig_file = JsonString(j, "rig", source);
   if (j.contains("colmap")) m.colmap_dir = JsonString(j, "colmap", source);
   m.cameras = StringList(j, "cameras", source);
+  for (size_t c = 0; c < m.cameras.size(); ++c) {
+    CheckCameraName(m.cameras[c], source, "cameras[" + std::to_string(c) + "]");
+  }
   m.frames = StringList(j, "frames", source);
   const json& files = JsonMember(j, "files", source);
   if (!files.is_object())
@@ -89,15 +94,38 @@ CaptureManifest ManifestFromJson(const json& j, const std::string& source) {
 
 std::string ExpandPattern(const std::string& pattern, const std::string& camera,
                           const std::string& frame) {
-  std::string out = pattern;
-  for (const auto& [key, value] :
-       {std::pair<std::string, std::string>{"{camera}", camera}, {"{frame}", frame}}) {
-    for (size_t at = out.find(key); at != std::string::npos; at = out.find(key, at)) {
-      out.replace(at, key.size(), value);
-      at += value.size();
+  // One pass over the pattern: a value is never expanded again (a camera named
+  // "{frame}" made two cameras share one path before names were checked).
+  std::string out;
+  for (size_t at = 0; at < pattern.size();) {
+    if (pattern.compare(at, 8, "{camera}") == 0) {
+      out += camera;
+      at += 8;
+    } else if (pattern.compare(at, 7, "{frame}") == 0) {
+      out += frame;
+      at += 7;
+    } else {
+      out += pattern[at++];
     }
   }
   return out;
+}
+
+void CheckCameraName(const std::string& name, const std::string& source,
+                     const std::string& field) {
+  const bool usable =
+      !name.empty() && name != "." && name != ".." &&
+      std::none_of(name.begin(), name.end(), [](char c) {
+        const auto u = static_cast<unsigned char>(c);
+        return u <= 0x20 || u == 0x7f || c == '/' || c == '\\' || c == '{' || c == '}';
+      });
+  if (!usable) {
+    throw InputError(source, field,
+                     "a camera name usable as a folder name, in file patterns and in "
+                     "COLMAP's text model: no spaces, control characters, '/', '\\', "
+                     "'{' or '}', not '.' or '..'",
+                     json(name).dump());
+  }
 }
 
 std::string FrameId(int index) {
@@ -198,6 +226,59 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
     out.push_back(v);
   }
   return out;
+}
+
+namespace {
+
+// A position given in a view must lie within the camera's image widened by its size on
+// every side: detectors place a hand's keypoints a little outside the image at most.
+void CheckPositionsNearImage(const ViewKeypoints& view, const RigCamera& camera,
+                             const std::string& source, const std::string& where) {
+  const double w = camera.camera.width(), h = camera.camera.height();
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    const double u = view.keypoints.uv_px(k, 0), v = view.keypoints.uv_px(k, 1);
+    if ((std::isnan(u) && std::isnan(v)) || view.visibility[k] == 0) continue;
+    if (u >= -w && u <= 2 * w && v >= -h && v <= 2 * h) continue;  // NaN fails too
+    char got[80];
+    std::snprintf(got, sizeof(got), "[%g, %g]", u, v);
+    throw InputError(
+        source, where + "keypoints[" + std::to_string(k) + "]",
+        "a pixel position near the " + std::to_string(camera.camera.width()) + "x" +
+            std::to_string(camera.camera.height()) + " image of camera " + camera.name +
+            " (x in [" + FormatNumber(-w) + ", " + FormatNumber(2 * w) + "], y in [" +
+            FormatNumber(-h) + ", " + FormatNumber(2 * h) + "]) or [null, null]",
+        got);
+  }
+}
+
+}  // namespace
+
+std::vector<std::optional<ViewKeypoints>> FrameKeypointsFromJson(
+    const json& j, const std::string& source, const std::string& frame, const Rig& rig) {
+  const std::vector<ViewKeypoints> views = ViewKeypointsFromJson(j, source);
+  if (j.contains("frame") && !(j["frame"].is_string() && j["frame"] == frame)) {
+    throw InputError(source, "frame",
+                     "'" + frame +
+                         "' (the frame this file is read for; a file of another "
+                         "frame is not used)",
+                     j["frame"].dump());
+  }
+  std::vector<std::optional<ViewKeypoints>> ordered(rig.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    const ViewKeypoints& view = views[i];
+    const std::string where = "views[" + std::to_string(i) + "].";
+    const int c = rig.IndexOf(view.camera);
+    if (c < 0) {
+      throw InputError(source, where + "camera", "a camera of the rig",
+                       "'" + view.camera + "'");
+    }
+    if (ordered[c])
+      throw InputError(source, where + "camera", "each camera once",
+                       "'" + view.camera + "' again");
+    CheckPositionsNearImage(view, rig[c], source, where);
+    ordered[c] = view;
+  }
+  return ordered;
 }
 
 json GroundTruthToJson(const std::string& frame, const HandGroundTruth& gt) {

@@ -23,9 +23,11 @@
 #include <array>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "geometry/rig.h"
 #include "geometry/rigid3.h"
 #include "hand/hand_lbs.h"
 #include "hand/hand_model.h"
@@ -63,9 +65,16 @@ nlohmann::json ManifestToJson(const CaptureManifest& manifest);
 // Throws InputError naming `source` and the field.
 CaptureManifest ManifestFromJson(const nlohmann::json& json, const std::string& source);
 
-// Replaces {camera} and {frame} in `pattern`.
+// Replaces {camera} and {frame} in `pattern` (in one pass: values are not expanded).
 std::string ExpandPattern(const std::string& pattern, const std::string& camera,
                           const std::string& frame);
+// A capture's camera names are folder names, values in file patterns and tokens of
+// COLMAP's whitespace-separated text model, none of which can escape anything: a name
+// with a space or control character, '/', '\\', '{' or '}', or "." / ".." is refused
+// (InputError naming `source` and `field`). Renaming a camera (the rig file, or
+// `capture import --map`) is cheap; escaped names would differ from file to file.
+void CheckCameraName(const std::string& name, const std::string& source,
+                     const std::string& field);
 // "000042" for 42.
 std::string FrameId(int index);
 
@@ -87,6 +96,19 @@ nlohmann::json ViewKeypointsToJson(const std::string& frame,
                                    bool ground_truth);
 std::vector<ViewKeypoints> ViewKeypointsFromJson(const nlohmann::json& json,
                                                  const std::string& source);
+
+// One frame's keypoint or detection file as a reader of frame `frame` of `rig` takes
+// it: ViewKeypointsFromJson, then what needs the frame and the cameras, each an
+// InputError naming `source` and the field: the file's "frame" (optional) must be
+// `frame` (a file copied under another frame's name is not used); each view's camera
+// must be a camera of `rig`, once; each position given (not null) must be finite and
+// within its camera's image widened by the image's size on every side (so 1e308, or a
+// position in another image's pixels, is refused), except ground-truth keypoints marked
+// out of frame (visibility 0: a projection near the camera plane may be anywhere).
+// Returns the views in `rig` order; nullopt: no view for that camera.
+std::vector<std::optional<ViewKeypoints>> FrameKeypointsFromJson(
+    const nlohmann::json& json, const std::string& source, const std::string& frame,
+    const Rig& rig);
 
 struct ObjectGroundTruth {
   std::string kind;  // sphere, box, cylinder

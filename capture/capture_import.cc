@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -174,6 +175,30 @@ struct OpenedSources {
   std::vector<int> counts;
 };
 
+// Index matching pairs frame t of every video: that is one moment only when the videos
+// run at one rate. Rates are compared with the first camera's (0.1 %: 29.97 vs 30 is
+// a difference, container rounding such as 30 vs 30.0003 is not).
+void CheckFrameRates(const VideoReader& video, const std::vector<CameraSource>& cameras,
+                     bool allow_mixed, std::vector<std::string>* notes) {
+  const double first = video.DeclaredFps(0);
+  for (size_t c = 1; c < cameras.size(); ++c) {
+    const double fps = video.DeclaredFps(c);
+    if (first <= 0 || fps <= 0 || std::abs(fps - first) <= 1e-3 * first) continue;
+    const std::string both = cameras[c].path.filename().string() + " (camera " +
+                             cameras[c].camera + ") runs at " + FormatNumber(fps) +
+                             " fps, " + cameras[0].path.filename().string() +
+                             " (camera " + cameras[0].camera + ") at " +
+                             FormatNumber(first) + " fps";
+    if (!allow_mixed) {
+      throw InputError("--videos", "frame rate",
+                       "videos of one frame rate (frames are paired by index; "
+                       "--allow-mixed-fps pairs them all the same)",
+                       both);
+    }
+    notes->push_back(both + ": paired by index all the same (--allow-mixed-fps)");
+  }
+}
+
 OpenedSources OpenSources(const Rig& rig, const CaptureImportOptions& o,
                           std::vector<std::string>* notes) {
   const bool videos = !o.videos_dir.empty();
@@ -202,6 +227,7 @@ OpenedSources OpenSources(const Rig& rig, const CaptureImportOptions& o,
     }
     s.counts.push_back(count);
   }
+  CheckFrameRates(*video, s.cameras, o.allow_mixed_fps, notes);
   s.reader = std::move(video);
   return s;
 }

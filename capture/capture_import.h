@@ -73,6 +73,10 @@ struct CaptureImportOptions {
   int end = -1;
   int stride = 1;
   int max_frames = 0;
+  // Videos whose declared frame rates differ (by more than 0.1 %) are paired by index
+  // all the same, with a note naming them; without it they are refused: frame t of a
+  // 15 fps and of a 30 fps video are not one moment.
+  bool allow_mixed_fps = false;
   // Continue an interrupted import with the same sources and settings: frames already
   // in capture.json are kept and not read again.
   bool resume = false;
@@ -112,7 +116,8 @@ struct CaptureImportCallbacks {
 // writer lock (core/file_lock.h) throughout: another import, `capture init
 // --overwrite` or `detect --capture` on the folder meanwhile is refused naming this
 // one, and this one is refused while they run. Throws InputError for a
-// rig camera without a source, an image whose size differs from its camera's (naming
+// rig camera without a source, videos of different frame rates (unless
+// allow_mixed_fps), a damaged video frame or image file (naming the file and frame), an image whose size differs from its camera's (naming
 // the file, the camera and both sizes), an unreadable image or video, a capture that
 // already has frames (without resume / overwrite), or resume with other settings.
 // Whatever frames were completely written before an error stay in capture.json.

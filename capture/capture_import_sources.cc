@@ -105,8 +105,19 @@ std::vector<CameraSource> MatchSources(const std::map<std::string, fs::path>& so
       ignored.push_back(path.filename().string());
     }
   }
+  // What each source went to: a camera without one is named with where its namesake
+  // went (`--map cam01=cam00` leaves cam01 without a source while cam01/ is there).
+  std::map<std::string, std::string> source_to_camera;
+  for (const auto& [camera, source] : camera_to_source) source_to_camera[source] = camera;
   std::vector<std::string> found;
-  for (const auto& [source, path] : sources) found.push_back(path.filename().string());
+  for (const auto& [source, path] : sources) {
+    const auto to = source_to_camera.find(source);
+    found.push_back(path.filename().string() +
+                    (to == source_to_camera.end() ? " (unused)"
+                     : o.source_to_camera.count(source)
+                         ? " (--map " + source + "=" + to->second + ")"
+                         : " (camera " + to->second + ")"));
+  }
   std::vector<CameraSource> out;
   for (const std::string& camera : camera_names) {
     if (!camera_to_source.count(camera)) {
@@ -114,7 +125,7 @@ std::vector<CameraSource> MatchSources(const std::map<std::string, fs::path>& so
                        std::string(videos ? "a video " + camera + ".<mp4|mkv|avi|...>"
                                           : "a folder " + camera + "/ of images") +
                            " (or --map SOURCE=" + camera + ")",
-                       found.empty() ? "nothing there" : "only " + Join(found, ", "));
+                       found.empty() ? "nothing there" : Join(found, ", "));
     }
     out.push_back({camera, sources.at(camera_to_source[camera]), {}});
   }

@@ -17,15 +17,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Camera names become folder names.
+// Camera names become folder names, pattern values and COLMAP tokens.
 void CheckCameraNames(const Rig& rig, const std::string& source) {
-  for (const RigCamera& cam : rig.cameras()) {
-    if (cam.name.empty() || cam.name == "." || cam.name == ".." ||
-        cam.name.find_first_of("/\\") != std::string::npos) {
-      throw InputError(source, "camera name",
-                       "a name usable as a folder name (no '/', not '.' or '..')",
-                       "\"" + cam.name + "\"");
-    }
+  for (size_t c = 0; c < rig.size(); ++c) {
+    CheckCameraName(rig[c].name, source, "cameras[" + std::to_string(c) + "] name");
   }
 }
 

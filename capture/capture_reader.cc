@@ -153,21 +153,14 @@ ImageF CaptureReader::ReadDepth(int frame, int camera) const {
 std::vector<ViewKeypoints> CaptureReader::ReadViews(const std::string& kind,
                                                     int frame) const {
   const std::string path = Path(kind, frame);
-  const std::vector<ViewKeypoints> views =
-      ViewKeypointsFromJson(ReadJsonFile(path), path);
   // Rig order, matched by camera name; every camera must be present once.
-  std::vector<ViewKeypoints> ordered(rig_.size());
-  std::vector<bool> seen(rig_.size(), false);
-  for (const ViewKeypoints& v : views) {
-    const int c = rig_.IndexOf(v.camera);
-    if (c < 0) throw InputError(path, "views.camera", "a camera of the rig", v.camera);
-    if (seen[c]) throw InputError(path, "views.camera", "each camera once", v.camera);
-    seen[c] = true;
-    ordered[c] = v;
-  }
+  const std::vector<std::optional<ViewKeypoints>> views =
+      FrameKeypointsFromJson(ReadJsonFile(path), path, frame_id(frame), rig_);
+  std::vector<ViewKeypoints> ordered;
   for (size_t c = 0; c < rig_.size(); ++c) {
-    if (!seen[c])
+    if (!views[c])
       throw InputError(path, "views", "a view for camera " + rig_[c].name, "missing");
+    ordered.push_back(*views[c]);
   }
   return ordered;
 }

@@ -2,43 +2,33 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <nlohmann/json.hpp>
 
 #include "capture/capture_format.h"
 #include "core/errors.h"
+#include "core/json_util.h"
 
 namespace handlabel {
 
 namespace fs = std::filesystem;
 
 std::vector<std::optional<Keypoints2d>> ReadDetectionsFile(const std::string& path,
+                                                           const std::string& frame,
                                                            const Rig& rig) {
-  std::ifstream in(path);
-  if (!in) {
+  if (!fs::exists(path)) {
     throw InputError(path, "(file)",
                      "the frame's 2D detections (native detections/{frame}.json format)",
                      "missing");
   }
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path, "content", "valid JSON", e.what());
-  }
   std::vector<std::optional<Keypoints2d>> out(rig.size());
-  for (const ViewKeypoints& view : ViewKeypointsFromJson(json, path)) {
-    const int c = rig.IndexOf(view.camera);
-    if (c < 0) {
-      throw InputError(path, "views.camera", "a camera of the capture's rig",
-                       "'" + view.camera + "'");
-    }
-    if (out[c]) throw InputError(path, "views.camera", "each camera once", view.camera);
+  const std::vector<std::optional<ViewKeypoints>> views =
+      FrameKeypointsFromJson(ReadJsonFileStrict(path), path, frame, rig);
+  for (size_t c = 0; c < rig.size(); ++c) {
+    if (!views[c]) continue;
     Keypoints2d keypoints;
     for (int k = 0; k < kNumHandKeypoints; ++k) {
-      const double confidence = view.keypoints.confidence(k);
-      if (!view.keypoints.uv_px.row(k).allFinite() || !(confidence > 0)) continue;
-      keypoints.uv_px.row(k) = view.keypoints.uv_px.row(k);
+      const double confidence = views[c]->keypoints.confidence(k);
+      if (!views[c]->keypoints.uv_px.row(k).allFinite() || !(confidence > 0)) continue;
+      keypoints.uv_px.row(k) = views[c]->keypoints.uv_px.row(k);
       keypoints.confidence(k) = confidence;
     }
     out[c] = keypoints;
@@ -60,7 +50,7 @@ DetectionsFrameSource::DetectionsFrameSource(std::unique_ptr<FrameSource> inner,
 FrameInput DetectionsFrameSource::Load(const std::string& id) const {
   FrameInput frame = inner_->Load(id);
   frame.keypoints_2d =
-      ReadDetectionsFile((fs::path(folder_) / (id + ".json")).string(), frame.rig);
+      ReadDetectionsFile((fs::path(folder_) / (id + ".json")).string(), id, frame.rig);
   return frame;
 }
 

@@ -30,8 +30,10 @@ class DetectionsFrameSource : public Replaced2dFrameSource {
   std::string folder_;
 };
 
-// One frame's detections file in rig order (nullopt: no view for that camera).
+// The detections file of frame `frame` in rig order (nullopt: no view for that
+// camera); its checks are FrameKeypointsFromJson's (capture_format.h).
 std::vector<std::optional<Keypoints2d>> ReadDetectionsFile(const std::string& path,
+                                                           const std::string& frame,
                                                            const Rig& rig);
 
 }  // namespace handlabel

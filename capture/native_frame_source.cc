@@ -38,8 +38,11 @@ NativeFrameSource::NativeFrameSource(const std::string& capture_dir,
   } else if (reader_.Has(kFileMask)) {
     mask_kind_ = kFileMask;
   }
-  if (keypoint_files != "auto")
+  if (keypoint_files == "none") {
+    keypoint_kind_.clear();
+  } else if (keypoint_files != "auto") {
     keypoint_kind_ = keypoint_files == "detections" ? kFileDetections : kFileKeypoints;
+  }
   if (mask_files != "auto")
     mask_kind_ = mask_files == "detections" ? kFileDetectionMask : kFileMask;
   for (const std::string& kind : {keypoint_kind_, mask_kind_}) {

@@ -22,7 +22,9 @@ class NativeFrameSource : public FrameSource {
  public:
   // Throws InputError naming the capture's files, or `cameras_file` when its cameras
   // do not cover the capture's. keypoint_files ("detections" | "keypoints") and
-  // mask_files ("detections" | "truth") override the choice above ("auto" keeps it).
+  // mask_files ("detections" | "truth") override the choice above ("auto" keeps it);
+  // keypoint_files "none" reads no keypoint file (a job whose 2D comes from elsewhere
+  // must not fail a frame on a file it does not use).
   explicit NativeFrameSource(const std::string& capture_dir,
                              const std::optional<Rig>& cameras = std::nullopt,
                              const std::string& keypoint_files = "auto",

@@ -406,13 +406,28 @@ class ComparisonRun {
     const int n = std::min<int>(options_.ablation_frames, result_.frames.size());
     const std::vector<std::string> frames(result_.frames.begin(),
                                           result_.frames.begin() + n);
+    std::vector<int> counts = options_.ablation_views;
+    if (options_.ablation_all_counts) {
+      for (int k = 2; k < all_views; ++k) counts.push_back(k);
+    }
+    for (int k : counts) {  // asked for by number: said, not dropped silently
+      if (k >= all_views && log_) {
+        *log_ << "compare: note: --ablation-views " << k << " left out: the input has "
+              << all_views << " cameras (an ablation keeps fewer; all " << all_views
+              << " are the main run)\n";
+      }
+    }
     for (const MethodRun& main : result_.methods) {
       if (!main.why_not.empty()) continue;
-      for (int k : options_.ablation_views) {
-        if (k >= all_views) continue;
+      for (int k : counts) {
         AblationCell cell;
         cell.method = main.method;
         cell.views = k;
+        if (k >= all_views) {
+          cell.why_not = "the input has " + std::to_string(all_views) + " cameras";
+          result_.ablation.push_back(cell);
+          continue;
+        }
         if (main.method == CompareMethod::kNetwork ||
             main.method == CompareMethod::kNetworkRefine) {
           cell.why_not =
@@ -431,7 +446,7 @@ class ComparisonRun {
         result_.ablation.push_back(AblationCellOf(run, k));
       }
       // All views: the main run on the same frames.
-      if (options_.ablation_views.empty()) continue;
+      if (counts.empty()) continue;
       MethodRun subset = main;
       subset.scores = ScoreLabels(main, frames, truths_, pck_);
       result_.ablation.push_back(AblationCellOf(subset, all_views));

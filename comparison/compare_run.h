@@ -56,8 +56,12 @@ struct CompareOptions {
   int auc_steps = 20;  // thresholds of the PCK curve (POEM's configs: 20)
   // View-count ablation: view counts to run the fitting methods with (the first k
   // cameras of the rig keep their evidence, the others are ignored:
-  // evidence.ignore_views); empty = no ablation. Counts >= the rig's are skipped.
+  // evidence.ignore_views); empty = no ablation. A count >= the input's cameras is
+  // not run: a note says so and its cells say why.
   std::vector<int> ablation_views;
+  // Every count from 2 to the input's cameras - 1 (`--ablation-views all`), besides
+  // ablation_views.
+  bool ablation_all_counts = false;
   int ablation_frames = 10;  // the first N compared frames enter the ablation (>= 1)
   int worst_frames = 3;      // frames shown with every method's overlay (>= 0)
   // Quality-check study: a network answer is "bad" when its MPJPE exceeds this (mm).

@@ -5,6 +5,7 @@
 
 #include "core/errors.h"
 #include "core/option_checks.h"
+#include "core/size_checks.h"
 #include "core/stopwatch.h"
 #include "hand/mesh_keypoints.h"
 #include "image/line_plot.h"
@@ -76,6 +77,12 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
                      std::to_string(source.num_views()) + " (the rig's views)",
                      std::to_string(predictor->num_views()));
   }
+  // Every frame's errors are kept for the PCK curves: checked before allocating (10
+  // million frames ended in a bare std::bad_alloc).
+  RequireFitsInMemory("command line", "--frames", o.frames,
+                      sizeof(double) * (21.0 + hand.num_vertices()),
+                      "frames (each keeps its 21 keypoint and " +
+                          std::to_string(hand.num_vertices()) + " vertex errors)");
   NetworkEvalResult r;
   MaskIouCounts mask_iou;
   Eigen::MatrixXd joint_errors(o.frames, 21), vertex_errors;

@@ -1,8 +1,6 @@
 #include "exports/keypoint_tables.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <filesystem>
 #include <limits>
 #include <sstream>
 
@@ -107,15 +105,7 @@ void WriteKeypointsNpz(const LabelSeries& series, const ManoLayerSetting& settin
   arrays.emplace_back("hand_model", NdArray::FromText(series.hand_model));
   arrays.emplace_back("keypoints_order", NdArray::FromText("snap21"));
   arrays.emplace_back("units", NdArray::FromText("m"));
-  // A temporary name in the target's folder, then rename: never a half-written file.
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent);
-  const std::string temporary = path + ".tmp";
-  WriteNpzFile(temporary, arrays, ZipMethod::kDeflate);
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    throw InputError(path, "--out", "a writable location", "rename failed");
-  }
+  WriteNpzFile(path, arrays, ZipMethod::kDeflate);  // atomic: never a half-written file
 }
 
 void WriteKeypointsCsv(const LabelSeries& series, const std::string& path) {

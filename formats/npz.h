@@ -14,6 +14,8 @@ namespace handlabel {
 using NamedArrays = std::vector<std::pair<std::string, NdArray>>;
 
 // Writes the arrays in the given order; names get the ".npy" suffix numpy expects.
+// Atomic: a temporary in the same folder is renamed over `path` when complete and
+// removed when a write fails (InputError naming the file); creates missing folders.
 void WriteNpzFile(const std::string& path, const NamedArrays& arrays,
                   ZipMethod method = ZipMethod::kStored);
 // Reads every array of an .npz (names without ".npy"), in archive order.

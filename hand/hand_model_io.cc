@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -464,12 +463,7 @@ void SaveHandModel(const HandModel& model, const std::string& path) {
       "handlabel_keypoint_map",
       IntArray({kNumHandKeypoints},
                std::vector<int64_t>(kSnapFromNative.begin(), kSnapFromNative.end())));
-  const std::string tmp = path + ".tmp";
-  WriteNpzFile(tmp, arrays, ZipMethod::kDeflate);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(path, "", "a writable location", "rename failed");
-  }
+  WriteNpzFile(path, arrays, ZipMethod::kDeflate);  // atomic
 }
 
 }  // namespace handlabel

@@ -1,12 +1,13 @@
 #include "media/frame_readers.h"
 
 #include <algorithm>
+#include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "core/errors.h"
+#include "image/image_file.h"
 
 namespace handlabel {
 namespace {
@@ -23,12 +24,24 @@ ImageU8 RgbFromBgr(const cv::Mat& bgr) {
   return out;
 }
 
+bool IsJpegFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[3] = {0, 0, 0};
+  in.read(reinterpret_cast<char*>(head), 3);
+  return in.gcount() == 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF;
+}
+
 class ImageFolderReader : public FrameReader {
  public:
   explicit ImageFolderReader(const std::vector<CameraSource>& cameras)
       : cameras_(cameras) {}
   ImageU8 Read(int camera, int index) override {
     const std::string path = Where(camera, index);
+    // OpenCV decodes a truncated or corrupt JPEG with a warning on stderr and a grey
+    // rest: such a file must fail its frame by name, not become a complete capture of
+    // damaged images. The strict reader the label jobs use checks it first (OpenCV
+    // still decodes it: it applies the EXIF orientation, which ReadJpeg does not).
+    if (IsJpegFile(path)) ReadJpeg(path);
     // 8-bit BGR whatever the file holds (gray is replicated, 16 bits are scaled down).
     const cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
     if (bgr.empty()) {
@@ -53,62 +66,40 @@ std::unique_ptr<FrameReader> MakeImageFolderReader(
   return std::make_unique<ImageFolderReader>(cameras);
 }
 
-struct VideoReader::Stream {
-  cv::VideoCapture capture;
-  int next = 0;  // index of the frame the next read() returns
-};
-
 VideoReader::VideoReader(const std::vector<CameraSource>& cameras) : cameras_(cameras) {
   for (const CameraSource& source : cameras) {
-    auto stream = std::make_unique<Stream>();
-    const std::string path = source.path.string();
-    if (!stream->capture.open(path, cv::CAP_FFMPEG)) {
-      throw InputError(
-          path, "video",
-          "a video OpenCV's FFmpeg backend can open (camera " + source.camera + ")",
-          "cannot open it");
-    }
-    streams_.push_back(std::move(stream));
+    streams_.push_back(std::make_unique<VideoDecoder>(source.path.string(), source.camera));
   }
 }
 
 VideoReader::~VideoReader() = default;
 
 int VideoReader::DeclaredCount(int camera) const {
-  const double n = streams_[camera]->capture.get(cv::CAP_PROP_FRAME_COUNT);
-  return n >= 1 ? static_cast<int>(n) : -1;
+  return streams_[camera]->DeclaredCount();
 }
 
 std::pair<int, int> VideoReader::DeclaredSize(int camera) const {
-  const cv::VideoCapture& c = streams_[camera]->capture;
-  return {static_cast<int>(c.get(cv::CAP_PROP_FRAME_WIDTH)),
-          static_cast<int>(c.get(cv::CAP_PROP_FRAME_HEIGHT))};
+  return streams_[camera]->Size();
 }
 
+double VideoReader::DeclaredFps(int camera) const { return streams_[camera]->Fps(); }
+
 int VideoReader::CountByDecoding(int camera) const {
-  cv::VideoCapture counter(cameras_[camera].path.string(), cv::CAP_FFMPEG);
-  int n = 0;
-  while (counter.grab()) ++n;
-  return n;
+  VideoDecoder counter(cameras_[camera].path.string(), cameras_[camera].camera);
+  while (counter.Skip()) {
+  }
+  return counter.next_index();
 }
 
 ImageU8 VideoReader::Read(int camera, int index) {
-  Stream& s = *streams_[camera];
-  HL_CHECK(index >= s.next, "video frames are read in increasing order");
-  while (s.next < index) {
-    if (!s.capture.grab()) throw VideoEnded{camera, s.next};
-    ++s.next;
+  VideoDecoder& video = *streams_[camera];
+  HL_CHECK(index >= video.next_index(), "video frames are read in increasing order");
+  while (video.next_index() < index) {
+    if (!video.Skip()) throw VideoEnded{camera, video.next_index()};
   }
-  cv::Mat frame;
-  if (!s.capture.read(frame) || frame.empty()) throw VideoEnded{camera, s.next};
-  ++s.next;
-  if (frame.type() == CV_8UC1) cv::cvtColor(frame, frame, cv::COLOR_GRAY2BGR);
-  if (frame.type() == CV_8UC4) cv::cvtColor(frame, frame, cv::COLOR_BGRA2BGR);
-  if (frame.type() != CV_8UC3) {
-    throw InputError(Where(camera, index), "pixels", "8-bit colour or gray frames",
-                     "OpenCV type " + std::to_string(frame.type()));
-  }
-  return RgbFromBgr(frame);
+  ImageU8 rgb;
+  if (!video.Read(&rgb)) throw VideoEnded{camera, video.next_index()};
+  return rgb;
 }
 
 std::string VideoReader::Where(int camera, int index) const {

@@ -1,7 +1,8 @@
 #pragma once
 // Reading a frame of a camera's recording as RGB, from an image folder (any format
-// OpenCV decodes) or a video (OpenCV's FFmpeg backend), for capture import. OpenCV stays
-// inside media/'s .cc files: capture/ links media/, not OpenCV.
+// OpenCV decodes; JPEGs checked by image/'s strict reader first) or a video (FFmpeg's
+// libraries, media/video_decoder.h), for capture import. OpenCV and FFmpeg stay inside
+// media/'s .cc files: capture/ links media/, not them.
 
 #include <exception>
 #include <memory>
@@ -12,6 +13,7 @@
 #include <filesystem>
 
 #include "image/image.h"
+#include "media/video_decoder.h"
 
 namespace handlabel {
 
@@ -43,26 +45,27 @@ class FrameReader {
 std::unique_ptr<FrameReader> MakeImageFolderReader(
     const std::vector<CameraSource>& cameras);
 
-// Decodes each video forward only (grab() up to the wanted frame): exact for every
-// codec, unlike seeking. Throws InputError for a video OpenCV's FFmpeg backend cannot
-// open.
+// Decodes each video forward only (media/video_decoder.h: exact for every codec,
+// unlike seeking; a damaged frame throws InputError naming the file and the frame).
+// Throws InputError for a video FFmpeg cannot open.
 class VideoReader : public FrameReader {
  public:
   explicit VideoReader(const std::vector<CameraSource>& cameras);
   ~VideoReader() override;
   // Frame count the container declares; -1 if it declares none.
   int DeclaredCount(int camera) const;
-  // Size the stream declares (width, height).
+  // Size the stream declares (width, height), after its rotation metadata.
   std::pair<int, int> DeclaredSize(int camera) const;
+  // Frames per second the stream declares; 0 if unknown.
+  double DeclaredFps(int camera) const;
   // Counts by decoding on a second handle (for containers that declare no count).
   int CountByDecoding(int camera) const;
   ImageU8 Read(int camera, int index) override;
   std::string Where(int camera, int index) const override;
 
  private:
-  struct Stream;
   std::vector<CameraSource> cameras_;  // a copy: the reader may outlive the caller's list
-  std::vector<std::unique_ptr<Stream>> streams_;
+  std::vector<std::unique_ptr<VideoDecoder>> streams_;
 };
 
 }  // namespace handlabel

@@ -63,6 +63,35 @@ nlohmann::json HandJson(const HandDetection& d) {
             {"side", HandSideName(h.side())}}}};
 }
 
+// Whether `path` is a record DetectionRecordJson wrote (an object with its keys).
+bool IsDetectionRecord(const std::filesystem::path& path) {
+  try {
+    const nlohmann::json j = ReadJsonFileStrict(path.string());
+    return j.is_object() && j.contains("image") && j.contains("palms") &&
+           j.contains("hands") && j.contains("time_ms");
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// Removes <out_dir>/<n>.json for n >= `count` that an earlier run wrote (a detection
+// record by its content): the folder then holds this run's results only. Any other
+// file, a user's own included, stays.
+int RemoveEarlierRecords(const std::string& out_dir, size_t count) {
+  int removed = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(out_dir)) {
+    const std::string stem = entry.path().stem().string();
+    if (entry.path().extension() != ".json" || stem.empty() || stem.size() > 9 ||
+        stem.find_first_not_of("0123456789") != std::string::npos ||
+        std::stoul(stem) < count || !IsDetectionRecord(entry.path())) {
+      continue;
+    }
+    std::filesystem::remove(entry.path());
+    ++removed;
+  }
+  return removed;
+}
+
 }  // namespace
 
 ImageU8 ToRgb(const ImageU8& image) {
@@ -95,9 +124,9 @@ nlohmann::json DetectionRecordJson(const std::string& image_path, const ImageU8&
        {{"read", read_ms}, {"palm", trace.palm_ms}, {"landmarks", trace.landmarks_ms}}}};
 }
 
-void DetectImages(const MediapipeHands& detector, const std::vector<std::string>& images,
-                  const std::string& out_dir, int threads,
-                  const std::function<void(int, int)>& on_image) {
+int DetectImages(const MediapipeHands& detector, const std::vector<std::string>& images,
+                 const std::string& out_dir, int threads,
+                 const std::function<void(int, int)>& on_image) {
   std::filesystem::create_directories(out_dir);
   nlohmann::json summary = {{"detector", "handlabel MediapipeHands"},
                             {"model", detector.options().model},
@@ -137,7 +166,9 @@ void DetectImages(const MediapipeHands& detector, const std::vector<std::string>
   summary["images"] = per_image;
   summary["mean_palm_ms"] = palm_sum / n;
   summary["mean_landmarks_ms"] = landmark_sum / n;
+  const int removed = RemoveEarlierRecords(out_dir, images.size());
   WriteFileAtomically(out_dir + "/summary.json", summary.dump(1) + "\n");
+  return removed;
 }
 
 }  // namespace handlabel

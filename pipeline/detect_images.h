@@ -27,9 +27,12 @@ nlohmann::json DetectionRecordJson(const std::string& image_path, const ImageU8&
 // `images`) and <out_dir>/summary.json (per-image times and hand counts, means).
 // `threads` images at once (0 = one per core); `on_image(done, total)` after each
 // image, one call at a time. Throws InputError naming an unreadable image.
-void DetectImages(const MediapipeHands& detector, const std::vector<std::string>& images,
-                  const std::string& out_dir, int threads = 0,
-                  const std::function<void(int, int)>& on_image = nullptr);
+// Records <n>.json of an earlier run with more images (n >= images.size()) are removed
+// at the end, so the folder describes this run only; files that are not such records
+// (by name and content) are never touched. Returns how many were removed.
+int DetectImages(const MediapipeHands& detector, const std::vector<std::string>& images,
+                 const std::string& out_dir, int threads = 0,
+                 const std::function<void(int, int)>& on_image = nullptr);
 
 // An image as 3-channel RGB (gray is repeated, alpha dropped).
 ImageU8 ToRgb(const ImageU8& image);

@@ -66,8 +66,11 @@ namespace {
 std::unique_ptr<FrameSource> BuildCaptureSource(const JobConfig& job,
                                                 const std::optional<Rig>& cameras) {
   if (job.input_format == "native") {
-    return std::make_unique<NativeFrameSource>(job.input_path, cameras,
-                                               job.keypoint_files, job.mask_files);
+    // 2D from the detector or an evidence.detections folder replaces the capture's:
+    // its files are not read (a damaged one failed frames that did not use it).
+    const bool other_2d = job.keypoints_from_detector || !job.detections.empty();
+    return std::make_unique<NativeFrameSource>(
+        job.input_path, cameras, other_2d ? "none" : job.keypoint_files, job.mask_files);
   }
   if (job.input_format == "dexycb") {
     return std::make_unique<DexYcbFrameSource>(job.input_path, cameras);

@@ -27,7 +27,7 @@ ShardSpec ParseShard(const std::string& text, const std::string& source) {
       !ParseNonNegative(text.substr(0, slash), &shard.index) ||
       !ParseNonNegative(text.substr(slash + 1), &shard.count) || shard.count < 1 ||
       shard.index >= shard.count) {
-    throw InputError(source, "shard", "'i/N' with 0 <= i < N, e.g. 3/16",
+    throw InputError(source, "shard", "'i/N' with 0 <= i < N <= 999999999, e.g. 3/16",
                      "'" + text + "'");
   }
   return shard;

@@ -1,13 +1,12 @@
 #include "pipeline/train_config.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
+#include "core/size_checks.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/train_config_yaml.h"
 
@@ -37,12 +36,6 @@ void ResolveNetwork(const std::string& overrides_json, const std::string& path,
   }
 }
 
-// This machine's physical memory in bytes (0 if unknown).
-double PhysicalMemoryBytes() {
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && page > 0 ? static_cast<double>(pages) * page : 0.0;
-}
-
 // train.batch_size, checked before anything is allocated: >= 1, and the batches in
 // flight (the one trained and prefetch_batches made ahead) of input crops alone (float
 // RGB per view; the network's activations take several times more) fit in memory. A
@@ -59,11 +52,12 @@ void CheckBatchSize(const std::string& path, const TrainConfig& c) {
   const double largest = memory > 0 ? std::floor(memory / (sample_bytes * in_flight)) : 0;
   if (memory > 0 && batch > largest) {
     char detail[200];
-    std::snprintf(detail, sizeof(detail),
-                  "a batch whose input crops fit in memory: at most %.0f samples (%d views "
-                  "of %d px take %.1f MB each, %d batch(es) in flight, %.1f GB of memory)",
-                  largest, c.network.num_views, c.network.crop_size, sample_bytes / 1e6,
-                  in_flight, memory / 1e9);
+    std::snprintf(
+        detail, sizeof(detail),
+        "a batch whose input crops fit in memory: at most %.0f samples (%d views "
+        "of %d px take %.1f MB each, %d batch(es) in flight, %.1f GB of memory)",
+        largest, c.network.num_views, c.network.crop_size, sample_bytes / 1e6, in_flight,
+        memory / 1e9);
     throw InputError(path, "train.batch_size", detail, std::to_string(batch));
   }
 }

@@ -5,7 +5,9 @@
 
 #include "core/data_dir.h"
 #include "core/errors.h"
+#include "core/file_bytes.h"
 #include "core/option_checks.h"
+#include "formats/sha256.h"
 #include "network/detector/tflite_model.h"
 
 namespace handlabel {
@@ -25,10 +27,51 @@ void CheckShape(const TfliteTensorInfo& info, const std::vector<int>& want,
   throw InputError(path, what + " '" + info.name + "'", "shape " + expected, got);
 }
 
-std::unique_ptr<TfliteModel> LoadModel(const std::string& path, int num_threads) {
+// The four files of @mediapipe/hands 0.4.1675469240 (models/NOTICE.mediapipe).
+struct ShippedModel {
+  const char* name;
+  const char* sha256;
+};
+constexpr ShippedModel kShippedModels[] = {
+    {"hand_landmark_full.tflite",
+     "8c026882c9ec059ce0f8e75266bee5a9a23c341a40e0000df755374d3d1b9b68"},
+    {"hand_landmark_lite.tflite",
+     "d7fde8ac11f8ce03f8663775bfc323f4fc9f2a38062b4f4efa142874ef5b2a48"},
+    {"palm_detection_full.tflite",
+     "2f25e740121983f68ffc05f99991d524dc0ea812134f6316a26125816941ee85"},
+    {"palm_detection_lite.tflite",
+     "e9a4aaddf90dda56a87235303cf00e4c2d3fb28725f68fd88772997dac905c18"},
+};
+
+// The full and lite models have the same inputs and outputs, so a lite model copied
+// under the full model's name would run without a word and give worse keypoints: a
+// file holding the bytes of another shipped model than its name says is refused.
+// Files of other bytes (a user's own model) are taken as named.
+void RefuseAnotherShippedModel(const std::string& bytes, const std::string& path,
+                               const std::string& name) {
+  const std::string sha = Sha256Hex(bytes);
+  for (const ShippedModel& shipped : kShippedModels) {
+    if (sha != shipped.sha256 || name == shipped.name) continue;
+    std::string expected = "the bytes of " + name;
+    for (const ShippedModel& own : kShippedModels) {
+      if (name == own.name) expected += " (sha256 " + std::string(own.sha256) + ")";
+    }
+    throw InputError(
+        path, "content",
+        expected +
+            " or a model of your own (scripts/fetch-mediapipe-models "
+            "fetches the shipped files)",
+        "the bytes of " + std::string(shipped.name) + " (sha256 " + sha + ")");
+  }
+}
+
+std::unique_ptr<TfliteModel> LoadModel(const std::string& path, const std::string& name,
+                                       int num_threads) {
+  const std::string bytes = ReadFileBytes(path, ".tflite file");
+  RefuseAnotherShippedModel(bytes, path, name);
   TfliteModelOptions model_options;
   model_options.num_threads = num_threads;
-  return TfliteModel::Load(path, model_options);
+  return TfliteModel::FromBytes(bytes, path, model_options);
 }
 
 void CheckRgb(const ImageU8& rgb) {
@@ -51,9 +94,16 @@ void MediapipeHandsOptions::Check(const std::string& source) const {
   RequireAtLeast(source, "num_threads", num_threads, 0);
 }
 
+namespace {
+std::string MediapipeModelName(const MediapipeHandsOptions& options,
+                               const std::string& kind) {
+  return kind + "_" + options.model + ".tflite";
+}
+}  // namespace
+
 std::string MediapipeModelPath(const MediapipeHandsOptions& options,
                                const std::string& kind) {
-  const std::string name = kind + "_" + options.model + ".tflite";
+  const std::string name = MediapipeModelName(options, kind);
   if (!options.model_dir.empty()) return options.model_dir + "/" + name;
   return ShippedModelPath("mediapipe/" + name);
 }
@@ -75,8 +125,10 @@ MediapipeHands::MediapipeHands(const MediapipeHandsOptions& options) : options_(
   options_.Check("MediapipeHandsOptions");
   const std::string palm_path = MediapipeModelPath(options_, "palm_detection");
   const std::string landmark_path = MediapipeModelPath(options_, "hand_landmark");
-  palm_model_ = LoadModel(palm_path, options_.num_threads);
-  landmark_model_ = LoadModel(landmark_path, options_.num_threads);
+  palm_model_ = LoadModel(palm_path, MediapipeModelName(options_, "palm_detection"),
+                          options_.num_threads);
+  landmark_model_ = LoadModel(
+      landmark_path, MediapipeModelName(options_, "hand_landmark"), options_.num_threads);
   anchors_ = MakeSsdAnchors();
   const int n = static_cast<int>(anchors_.size());
 

@@ -84,6 +84,21 @@ Tensor LoadConstant(const TfliteGraph& g, const TfliteTensor& t) {
   return out;
 }
 
+// A weight that is NaN or infinite makes every answer NaN: a palm model with NaN
+// weights found "no hand" in every image and replaced good detections.
+void RequireFiniteWeights(const Tensor& weights, size_t index, const TfliteTensor& t,
+                          const std::string& source) {
+  const Tensor bad = torch::logical_not(torch::isfinite(weights)).flatten();
+  const int64_t count = bad.sum().item<int64_t>();
+  if (count == 0) return;
+  const int64_t first = bad.nonzero()[0][0].item<int64_t>();
+  throw InputError(
+      source, "tensor " + std::to_string(index) + " (" + t.name + ")", "finite weights",
+      std::to_string(count) + " of " + std::to_string(weights.numel()) +
+          " values NaN or infinite, the first at element " + std::to_string(first) +
+          " (" + std::to_string(weights.flatten()[first].item<float>()) + ")");
+}
+
 std::vector<TfliteTensorInfo> TensorInfos(const TfliteGraph& g,
                                           const std::vector<int>& ids) {
   std::vector<TfliteTensorInfo> infos;
@@ -111,6 +126,8 @@ Interpreter::Interpreter(std::unique_ptr<TfliteGraph> graph, const std::string& 
                        TfliteTypeName(t.type));
     }
     if (t.has_data) program_.constants[i] = LoadConstant(g, t);
+    if (t.has_data && t.type != 2)
+      RequireFiniteWeights(*program_.constants[i], i, t, source_);
   }
   for (int id : g.inputs) {
     if (program_.constants[id]) {

@@ -68,6 +68,61 @@ TEST(BadInputsCommand, FramesWithoutEvidenceOrWithBrokenFilesFailByName) {
   EXPECT_EQ(testing::ReadFileBytes(LabelFilePath(out, "000003")), kept);
 }
 
+// Detections damaged on the way (issue 46): a keypoint at 1e308 (was labelled 165-229 mm
+// off with "0 failed") and a file whose `frame` names another frame (was used as this
+// frame's 2D). Each fails its frame naming the file, the field and the range; the
+// frames with good files are labelled.
+TEST(BadInputsCommand, DetectionsOutOfRangeOrOfAnotherFrameFailTheirFrameByName) {
+  const std::string dir = testing::ScratchDir();
+  testing::WriteTestCapture(dir + "/capture", 4, 9);
+  const std::string det = dir + "/capture/detections/";
+  EditJson(det + "000000.json", [](nlohmann::json& j) {
+    j["views"][1]["keypoints"][5] = {1e308, 40.0};
+  });
+  fs::copy_file(det + "000002.json", det + "000001.json",
+                fs::copy_options::overwrite_existing);
+  const std::string job = testing::WriteTestJob(dir, "job", "capture", "out");
+  const auto r = RunHandlabelCommand({"label", "--job", job});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out + r.err, HasSubstr("2 failed"));
+  const std::string out = dir + "/out";
+  const std::string huge = ManifestEntry(out, "000000")["reason"];
+  EXPECT_THAT(huge, HasSubstr("detections/000000.json"));
+  EXPECT_THAT(huge, HasSubstr("views[1].keypoints[5]"));
+  EXPECT_THAT(huge, HasSubstr("x in [-160, 320], y in [-120, 240]"));
+  EXPECT_THAT(huge, HasSubstr("1e+308"));
+  const std::string other = ManifestEntry(out, "000001")["reason"];
+  EXPECT_THAT(other, HasSubstr("detections/000001.json: field 'frame'"));
+  EXPECT_THAT(other, HasSubstr("'000001'"));
+  EXPECT_THAT(other, HasSubstr("\"000002\""));
+  for (const char* id : {"000002", "000003"}) {
+    EXPECT_EQ(ManifestEntry(out, id)["status"], "ok") << id;
+  }
+}
+
+// A job whose 2D comes from elsewhere (an evidence.detections folder here; a detector
+// job alike) does not read the capture's own detections: a damaged one there no longer
+// fails its frame (issue 46: a detector job failed frames on detections/*.json it did
+// not use).
+TEST(BadInputsCommand, AJobWithOther2dDoesNotReadTheCapturesOwnDetections) {
+  const std::string dir = testing::ScratchDir();
+  testing::WriteTestCapture(dir + "/capture", 2, 9);
+  fs::copy(dir + "/capture/detections", dir + "/det");
+  EditJson(dir + "/capture/detections/000000.json",
+           [](nlohmann::json& j) { j["views"][2]["confidence"][4] = 7.5; });
+  const std::string job = testing::WriteTestJob(dir, "job", "capture", "out");
+  std::string text = testing::ReadFileBytes(job);
+  text.replace(text.find("masks: none}"), 12,
+               "masks: none, detections: " + dir + "/det}");
+  std::ofstream(job, std::ios::trunc) << text;
+  const auto r = RunHandlabelCommand({"label", "--job", job});
+  EXPECT_EQ(r.status, 0) << r.err;
+  for (const char* id : {"000000", "000001"}) {
+    EXPECT_EQ(ManifestEntry(dir + "/out", id)["status"], "ok")
+        << id << ": " << ManifestEntry(dir + "/out", id).dump();
+  }
+}
+
 // A label cut short after it was logged: merge reports the frame (exit 1) and
 // --resume labels it again; merge with another job's file leaves the manifest alone.
 TEST(BadInputsCommand, MergeReportsDamagedLabelsAndRefusesAnotherJob) {

@@ -206,5 +206,35 @@ grep -q "error: run_corrupt/latest.json: field" <<< "$LAST_OUT"; report "  ... a
 expect_fail "board 100000x100000" "100000x100000|2 to 1000" \
   $H calib render-board --board charuco:100000x100000:0.03:0.022 --out board_out --frames 1 --near-frames 0
 
+# --- issue 46: damaged input, names, messages --------------------------------------
+cp -r cap cap46
+json_edit cap46/detections/000000.json "j['views'][1]['keypoints'][5]=[1e308, 40]"
+cp cap46/detections/000002.json cap46/detections/000001.json
+job j46 cap46 out46
+$H label --job j46.yaml > j46.log 2>&1
+r0=$(manifest_reason out46 000000); r1=$(manifest_reason out46 000001)
+contains_all "$r0" "failed|views[1].keypoints[5]|x in [-160, 320]"; report "detection keypoint at 1e308 fails its frame naming the range" $((1-$?)) "$r0"
+contains_all "$r1" "failed|field 'frame'|'000001'"; report "detections file of another frame fails its frame" $((1-$?)) "$r1"
+mkdir -p rec46/cam00 rec46/cam01
+for i in 0 1 2; do for c in cam00 cam01; do
+  ffmpeg -loglevel error -y -f lavfi -i "testsrc=size=160x120:rate=1" -frames:v 1 rec46/$c/f$i.jpg; done; done
+head -c 1500 rec46/cam01/f1.jpg > cut.jpg && mv cut.jpg rec46/cam01/f1.jpg
+$PY -c "
+import json
+j=json.load(open('cap/rig.json')); j['cameras']=j['cameras'][:2]
+for c, n in zip(j['cameras'], ['cam00', 'cam01']): c['name']=n
+json.dump(j, open('rig46.json', 'w'))"
+$H capture init --rig json:rig46.json --out session46 > init46.log 2>&1
+expect_fail "capture import of a truncated JPEG" "rec46/cam01/f1.jpg|expected a valid JPEG"   $H capture import --capture session46 --images rec46
+sed 's/"cam01"/"cam 01"/' rig46.json > rig46_space.json
+expect_fail "camera name with a space" "cameras[1] name|COLMAP|\"cam 01\"" \
+  $H capture init --rig json:rig46_space.json --out session46_space
+expect_fail "huge --offset says the range" "--offset|[-1000000000, 1000000000]" \
+  $H capture import --capture session46 --videos rec46 --offset cam01=99999999999
+expect_fail "huge --shard says the range" "N <= 999999999" $H label --job j46.yaml --shard 1/99999999999
+head -c 3000 $SRC/models/poem_small_dexycb.pt > cut.pt
+out=$($H eval-network --weights cut.pt --frames 1 2>&1); rc=$?
+[ $rc = 1 ] && [ "$(wc -l <<< "$out")" = 1 ] && grep -qF cut.pt <<< "$out"; report "damaged --weights: one line naming the file" $((1-$?)) "rc=$rc $out"
+
 echo "---- $pass passed, $fail failed"
 [ $fail = 0 ]

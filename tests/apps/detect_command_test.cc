@@ -61,6 +61,42 @@ TEST(DetectCommand, KeepsExistingDetectionsUnlessOverwriteIsGiven) {
 // The multi-view detector on a rendered DexYCB-like frame (seed 7: MediaPipe's palm
 // detector fires in 2 of its 8 views): the views agree on the hand, the others are found
 // from it, detections lie near the true keypoints, views without one say why.
+// `detect --images` into a folder of an earlier run with more images (issue 46: its
+// <n>.json beyond this run stayed beside the new ones): they are removed, with a note;
+// a file of the user's, even one named like a record, stays.
+TEST(DetectCommand, ImagesIntoAFolderOfEarlierResultsKeepsOnlyThisRunsRecords) {
+  if (!ModelsPresent()) {
+    GTEST_SKIP() << "MediaPipe models absent: run scripts/fetch-mediapipe-models";
+  }
+  const std::string dir = testing::ScratchDir();
+  std::vector<std::string> images;
+  for (int i = 0; i < 3; ++i) {
+    ImageU8 image(64, 48, 3, static_cast<uint8_t>(40 * i));
+    images.push_back(dir + "/" + std::to_string(i) + ".png");
+    WritePng(images.back(), image);
+  }
+  const std::string out = dir + "/det";
+  std::vector<std::string> args = {"detect", "--images"};
+  args.insert(args.end(), images.begin(), images.end());
+  args.insert(args.end(), {"--out", out});
+  ASSERT_EQ(RunHandlabelCommand(args).status, 0);
+  std::filesystem::create_directories(out);
+  std::ofstream(out + "/7.json") << "{\"mine\": true}\n";
+  std::ofstream(out + "/notes.txt") << "kept\n";
+  const testing::CommandResult again =
+      RunHandlabelCommand({"detect", "--images", images[0], "--out", out});
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_NE(again.err.find("removed 2 records of an earlier run with more images"),
+            std::string::npos)
+      << again.err;
+  EXPECT_TRUE(std::filesystem::exists(out + "/0.json"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/1.json"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/2.json"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/7.json"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/notes.txt"));
+  EXPECT_EQ(ReadJson(out + "/summary.json")["images"].size(), 1u);
+}
+
 TEST(DetectCommand, CaptureViewsGetDetectionsOrReasons) {
   if (!ModelsPresent()) {
     GTEST_SKIP() << "MediaPipe models absent: run scripts/fetch-mediapipe-models";

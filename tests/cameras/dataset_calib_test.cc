@@ -87,7 +87,12 @@ TEST(DatasetCalib, Ho3dCamOrdersAsNumpyReadsThem) {
               ::testing::AllOf(::testing::HasSubstr("cam_orders.txt"),
                                ::testing::HasSubstr("np.loadtxt")));
   EXPECT_THAT(error_of("1 3 1 4 0\n"), ::testing::HasSubstr("1 twice"));
-  EXPECT_THAT(error_of("1 3 2 4 0 5\n"), ::testing::HasSubstr("trans_5.txt"));
+  // As many indices as cameras (trans_<i>.txt): 4 of 5 made a 4-camera rig silently.
+  EXPECT_THAT(error_of("1 3 2 4\n"),
+              ::testing::HasSubstr("cam_orders.txt: field '(camera order)': expected one "
+                                   "camera index per trans_<i>.txt beside it (5), got 4 "
+                                   "indices"));
+  EXPECT_THAT(error_of("1 3 2 4 0 5\n"), ::testing::HasSubstr("got 6 indices"));
 }
 
 // DexYCB: the extrinsics file alone lists the apriltag entry (not a camera), and a

@@ -14,6 +14,7 @@
 #include "cameras/rig_json.h"
 #include "capture/capture_reader.h"
 #include "core/errors.h"
+#include "tests/capture/capture_import_fixture.h"
 #include "tests/capture/video_fixture.h"
 #include "tests/test_util.h"
 
@@ -22,23 +23,12 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using testing::InitSmallCapture;
 using testing::InputErrorOf;
+using testing::kHeight;
+using testing::kWidth;
 using testing::ScratchDir;
-
-constexpr int kWidth = 32;
-constexpr int kHeight = 24;
-
-Rig SmallRig(int cameras) {
-  Rig rig;
-  for (int c = 0; c < cameras; ++c) {
-    RigCamera cam;
-    cam.name = "cam" + std::to_string(c);
-    cam.camera = Camera::Pinhole(40 + c, 41 + c, 15.5, 11.5, kWidth, kHeight);
-    cam.cam_from_world.translation = Eigen::Vector3d(0.1 * c, 0, 0);
-    rig.Add(cam);
-  }
-  return rig;
-}
+using testing::SmallRig;
 
 ImageU8 RandomImage(int width = kWidth, int height = kHeight) {
   ImageU8 image(width, height, 3);
@@ -74,14 +64,6 @@ void WriteVideos(const std::string& dir, const Recording& recording) {
   for (size_t c = 0; c < recording.size(); ++c) {
     testing::WriteLosslessVideo(dir + "/cam" + std::to_string(c) + ".mkv", recording[c]);
   }
-}
-
-std::string InitSmallCapture(const std::string& dir, int cameras = 3) {
-  const std::string capture = dir + "/capture";
-  CaptureInitOptions init;
-  init.rig_source = "test rig";
-  InitCapture(SmallRig(cameras), {}, capture, init);
-  return capture;
 }
 
 ::testing::AssertionResult SameImage(const ImageU8& a, const ImageU8& b) {
@@ -269,6 +251,14 @@ TEST(CaptureImport, ARigCameraWithoutASourceIsAnError) {
   o.source_to_camera = {{"cam0", "cam9"}};
   EXPECT_THAT(InputErrorOf([&] { ImportCapture(capture, o); }),
               HasSubstr("a camera of the rig (cam0, cam1, cam2)"));
+  // --map cam1=cam0 leaves cam1 without a source: the message says where cam1.mkv went
+  // (it said "got only cam0.mkv, cam1.mkv", as if cam1.mkv were not there).
+  o.source_to_camera = {{"cam1", "cam0"}};
+  EXPECT_THAT(
+      InputErrorOf([&] { ImportCapture(capture, o); }),
+      HasSubstr("field 'camera cam1': expected a video cam1.<mp4|mkv|avi|...> (or "
+                "--map SOURCE=cam1), got cam0.mkv (unused), cam1.mkv (--map "
+                "cam1=cam0)"));
 }
 
 TEST(CaptureImport, AnImageOfAnotherSizeNamesFileCameraAndSizesAndKeepsEarlierFrames) {

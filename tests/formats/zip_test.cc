@@ -1,4 +1,7 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+
+#include <csignal>
 
 #include <filesystem>
 #include <fstream>
@@ -130,6 +133,41 @@ TEST(Npz, WriteReadRoundTrip) {
   EXPECT_EQ(back[0].first, "v");
   EXPECT_EQ(back[0].second.ToDoubles(), v);
   EXPECT_EQ(back[1].second.ToText(), "left");
+}
+
+// A disk that fills up while an .npz is written (a file size limit here: the write fails
+// with EFBIG): an InputError naming the file, the earlier file intact and no temporary
+// left (issue 46: `model convert` and `export --format npz` left "<file>.tmp" behind).
+TEST(Npz, AFailedWriteKeepsTheOldFileAndLeavesNoTemporary) {
+  const std::string dir = testing::ScratchDir();
+  const std::string path = dir + "/m.npz";
+  const double one = 1.0;
+  WriteNpzFile(path, {{"v", NdArray::FromDoubles({1}, &one)}});
+  const std::string before = testing::ReadFileBytes(path);
+  std::vector<double> big(100000);
+  for (auto& x : big) x = testing::Gaussian(1);
+  rlimit old{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+  const auto previous_handler = signal(SIGXFSZ, SIG_IGN);
+  const rlimit limit{64 * 1024, old.rlim_max};
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  std::string error;
+  try {
+    WriteNpzFile(path, {{"big", NdArray::FromDoubles({100000}, big.data())}});
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  setrlimit(RLIMIT_FSIZE, &old);
+  signal(SIGXFSZ, previous_handler);
+  EXPECT_EQ(error.rfind(path + ": ", 0), 0u) << error;
+  EXPECT_NE(error.find("write failed"), std::string::npos) << error;
+  EXPECT_EQ(testing::ReadFileBytes(path), before);
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    EXPECT_EQ(entry.path().filename(), "m.npz");
+    ++files;
+  }
+  EXPECT_EQ(files, 1);
 }
 
 std::string ZipErrorOf(const std::string& bytes, const std::string& entry = "") {

@@ -14,12 +14,16 @@
 #include <sstream>
 
 #include "core/data_dir.h"
+#include "core/errors.h"
+#include "core/file_bytes.h"
 #include "hand/hand_model.h"
 #include "hand/hand_model_io.h"
 #include "image/image.h"
 #include "image/image_file.h"
 #include "image/mesh_render.h"
+#include "network/detector/mediapipe_hands.h"
 #include "network/detector/tflite_model.h"
+#include "network/detector/tflite_reader.h"
 
 namespace handlabel {
 namespace {
@@ -206,6 +210,67 @@ TEST(TfliteMediapipeModels, PalmDetectorFindsTheRenderedPalm) {
 // Inputs: the rendered hand, seeded noise, grey, and the listed images, each resized
 // (nearest) to the model's input; files in_<size>_<name>.bin (float32 NHWC) and
 // ours_<model>_<name>.bin (all outputs concatenated, float32).
+// Damaged or swapped model files in a --model-dir (issue 46): the lite landmark model
+// under the full model's name (same inputs and outputs: it ran without a word) and a
+// palm model with one NaN weight (it found "no hand" everywhere) are refused when
+// loaded, naming the file; the shipped files load.
+TEST(TfliteMediapipeModels, ALiteModelUnderTheFullNameOrNanWeightsAreRefused) {
+  REQUIRE_MEDIAPIPE_MODELS();
+  namespace fs = std::filesystem;
+  const std::string dir = ::testing::TempDir() + "/swapped_mediapipe_models";
+  fs::create_directories(dir);
+  for (const char* name : {"hand_landmark_full.tflite", "palm_detection_full.tflite"}) {
+    fs::copy_file(MediapipeModel(name), dir + "/" + name,
+                  fs::copy_options::overwrite_existing);
+  }
+  MediapipeHandsOptions options;
+  options.model_dir = dir;
+  EXPECT_NO_THROW(MediapipeHands{options});
+
+  fs::copy_file(MediapipeModel("hand_landmark_lite.tflite"),
+                dir + "/hand_landmark_full.tflite", fs::copy_options::overwrite_existing);
+  std::string error;
+  try {
+    MediapipeHands hands(options);
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find(dir + "/hand_landmark_full.tflite: field 'content': expected the "
+                             "bytes of hand_landmark_full.tflite (sha256 8c0268"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("got the bytes of hand_landmark_lite.tflite"), std::string::npos)
+      << error;
+
+  fs::copy_file(MediapipeModel("hand_landmark_full.tflite"),
+                dir + "/hand_landmark_full.tflite", fs::copy_options::overwrite_existing);
+  std::string palm = ReadFileBytes(MediapipeModel("palm_detection_full.tflite"), "model");
+  const auto graph = ParseTflite(palm, "palm");
+  const TfliteTensor* weights = nullptr;  // the last float32 or float16 constant
+  for (const TfliteTensor& t : graph->tensors) {
+    if (t.has_data && (t.type == 0 || t.type == 1) && t.data_size >= 4) weights = &t;
+  }
+  ASSERT_NE(weights, nullptr) << "no float constant in the palm model";
+  const float nan32 = std::nanf("");
+  const uint16_t nan16 = 0x7e00;  // IEEE half-precision quiet NaN
+  if (weights->type == 0) {
+    palm.replace(weights->data_offset, 4, reinterpret_cast<const char*>(&nan32), 4);
+  } else {
+    palm.replace(weights->data_offset, 2, reinterpret_cast<const char*>(&nan16), 2);
+  }
+  std::ofstream(dir + "/palm_detection_full.tflite", std::ios::binary) << palm;
+  error.clear();
+  try {
+    MediapipeHands hands(options);
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find(dir + "/palm_detection_full.tflite: field 'tensor "),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("expected finite weights"), std::string::npos) << error;
+}
+
 TEST(TfliteMediapipeModels, DISABLED_WritePeerParityFiles) {
   REQUIRE_MEDIAPIPE_MODELS();
   const char* dir = std::getenv("HANDLABEL_TFLITE_PARITY_DIR");

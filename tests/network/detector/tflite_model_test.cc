@@ -11,6 +11,7 @@
 #include "core/errors.h"
 #include "network/detector/tflite_model.h"
 #include "network/detector/tflite_reader.h"
+#include "tests/fuzz_replay.h"
 #include "tests/network/detector/tflite_test_util.h"
 
 namespace handlabel {
@@ -243,6 +244,54 @@ TEST(TfliteModel, RejectsBadIndicesSizesAndShapes) {
         InputErrorOf([&] { TfliteModel::FromBytes(b.Finish({in}, {in}), "m"); });
     EXPECT_NE(m.find("INT8"), std::string::npos) << m;
   }
+}
+
+// A NaN or infinite weight made every answer NaN (a palm model with NaN weights found
+// "no hand" everywhere): refused at load, naming the tensor and the first bad element.
+TEST(TfliteModel, NonFiniteWeightsAreRefusedNamingTheTensor) {
+  for (const float bad : {std::nanf(""), INFINITY}) {
+    TfliteBuilder b;
+    const int in = b.Tensor({1, 4, 4, 2}, "image");
+    std::vector<float> weights(54, 0.1f);
+    weights[7] = bad;
+    const int w = b.Constant({3, 3, 3, 2}, weights);
+    const int out = b.Tensor({1, 4, 4, 3}, "score");
+    b.Op(3, {in, w, -1}, {out}, fb::BuiltinOptions_Conv2DOptions,
+         fb::CreateConv2DOptions(b.fbb(), fb::Padding_SAME, 1, 1).Union());
+    const std::string m =
+        InputErrorOf([&] { TfliteModel::FromBytes(b.Finish({in}, {out}), "m.tflite"); });
+    EXPECT_NE(m.find("m.tflite: field 'tensor 1 ("), std::string::npos) << m;
+    EXPECT_NE(m.find("expected finite weights"), std::string::npos) << m;
+    EXPECT_NE(m.find("1 of 54 values NaN or infinite, the first at element 7"),
+              std::string::npos)
+        << m;
+  }
+  EXPECT_NO_THROW(TfliteModel::FromBytes(SmallModel(), "m.tflite"));
+}
+
+// The kept corpus of tflite_reader_fuzz (docs/fuzzing.md) through the reader the
+// target feeds, with seeded edits, touching what the target touches: every input parses
+// or is an InputError. (Each other corpus has its own *FuzzCorpusSmoke test.)
+TEST(TfliteModel, FuzzCorpusSmoke) {
+  EXPECT_GE(testing::ReplayFuzzCorpus(
+                "tflite_reader",
+                [](const std::string& bytes) {
+                  const auto graph = ParseTflite(bytes, "corpus.tflite");
+                  size_t sum = 0;
+                  for (const TfliteTensor& t : graph->tensors) {
+                    const uint8_t* p = graph->data(t);
+                    for (size_t i = 0; p && i < t.data_size; ++i) sum += p[i];
+                  }
+                  for (const TfliteOp& op : graph->ops) {
+                    for (int i : op.inputs)
+                      sum += i >= 0 ? graph->tensors.at(i).shape.size() : 0;
+                    for (int i : op.outputs) sum += graph->tensors.at(i).shape.size();
+                  }
+                  volatile size_t touched = sum;  // kept: the reads must happen
+                  (void)touched;
+                },
+                /*edits=*/5),
+            100);
 }
 
 TEST(TfliteModel, RunIsThreadSafe) {
