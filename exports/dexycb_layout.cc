@@ -168,8 +168,7 @@ std::string WriteDexYcbLayout(const LabelSeries& series, const HandModel& model,
       PlaceImage(capture.images[f][c], (folder / ("color_" + number + ".jpg")).string(),
                  options.images);
       const std::string npz = (folder / ("labels_" + number + ".npz")).string();
-      WriteNpzFile(npz + ".tmp", CameraLabels(label, capture.rig[c], pca, frame_betas));
-      fs::rename(npz + ".tmp", npz);
+      WriteNpzFile(npz, CameraLabels(label, capture.rig[c], pca, frame_betas));
     }
   }
   std::string what = "DexYCB sequence " + sequence.string() + ", " +
