@@ -126,9 +126,12 @@ def camera_record(name, native, K, cam_from_world, width, height):
                 cam_from_world=cam_from_world[:3].reshape(-1).tolist())
 
 
-def write_detections(capture, frame, out_path, names):
-    """The native detections of `frame` with cameras renamed (native -> layout)."""
+def write_detections(capture, frame, out_path, names, frame_id):
+    """The native detections of `frame` with cameras renamed (native -> layout), as
+    the detections of the layout's frame `frame_id` (readers refuse a file of another
+    frame)."""
     record = read_json(capture.file("detections", frame))
+    record["frame"] = frame_id
     for view in record["views"]:
         view["camera"] = names[view["camera"]]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
@@ -291,7 +294,8 @@ def write_ho3d_sequence(capture, out, seq, order, order_as_column, rng):
             views.append(dict(camera=f"{seq}{c}", uv=project(K, in_cam).tolist(),
                               toolkit_uv=uv_mano[SNAP_FROM_NATIVE].tolist()))
         write_detections(capture, frame, os.path.join(out, "detections", seq, fid + ".json"),
-                         {cam["name"]: f"{seq}{c}" for c, cam in enumerate(cams)})
+                         {cam["name"]: f"{seq}{c}" for c, cam in enumerate(cams)},
+                         f"{seq}/{fid}")
         frames.append(dict(id=f"{seq}/{fid}", native_frame=frame,
                            keypoints3d=transform(common_from_native, keypoints).tolist(),
                            views=views))
@@ -399,7 +403,7 @@ def make_oakink(capture, out, rng):
                               uv=project(cam["K"], transform(cam["cam_from_world"], keypoints)).tolist(),
                               toolkit_uv=project(K32, hand_j.astype(np.float64)).tolist()))
         write_detections(capture, frame, os.path.join(out, "detections", group + ".json"),
-                         {cam["name"]: str(c) for c, cam in enumerate(cams)})
+                         {cam["name"]: str(c) for c, cam in enumerate(cams)}, group)
         frames.append(dict(id=group, native_frame=frame,
                            keypoints3d=transform(world_from_native, keypoints).tolist(),
                            vertices_first=transform(world_from_native,
