@@ -251,12 +251,23 @@ void CheckPositionsNearImage(const ViewKeypoints& view, const RigCamera& camera,
   }
 }
 
+// Frame ids of dataset inputs are relative to the job's input folder ("0000" with the
+// sequence's folder, "ABF1/0000" with the split's): one file serves both.
+bool SameFrame(const std::string& a, const std::string& b) {
+  const auto ends_with = [](const std::string& id, const std::string& tail) {
+    return id.size() > tail.size() && id[id.size() - tail.size() - 1] == '/' &&
+           id.compare(id.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  return a == b || ends_with(a, b) || ends_with(b, a);
+}
+
 }  // namespace
 
 std::vector<std::optional<ViewKeypoints>> FrameKeypointsFromJson(
     const json& j, const std::string& source, const std::string& frame, const Rig& rig) {
   const std::vector<ViewKeypoints> views = ViewKeypointsFromJson(j, source);
-  if (j.contains("frame") && !(j["frame"].is_string() && j["frame"] == frame)) {
+  if (j.contains("frame") && !(j["frame"].is_string() &&
+                               SameFrame(j["frame"].get<std::string>(), frame))) {
     throw InputError(source, "frame",
                      "'" + frame +
                          "' (the frame this file is read for; a file of another "

@@ -100,7 +100,9 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const nlohmann::json& json,
 // One frame's keypoint or detection file as a reader of frame `frame` of `rig` takes
 // it: ViewKeypointsFromJson, then what needs the frame and the cameras, each an
 // InputError naming `source` and the field: the file's "frame" (optional) must be
-// `frame` (a file copied under another frame's name is not used); each view's camera
+// `frame` (a file copied under another frame's name is not used; ids of dataset inputs,
+// relative to the input folder, match when one is the other's tail after a '/':
+// "0000" and "ABF1/0000"); each view's camera
 // must be a camera of `rig`, once; each position given (not null) must be finite and
 // within its camera's image widened by the image's size on every side (so 1e308, or a
 // position in another image's pixels, is refused), except ground-truth keypoints marked

@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <limits>
 
@@ -37,7 +38,9 @@ std::string WriteDetections(const std::string& frame, const nlohmann::json& keyp
   views[0].keypoints.confidence.setConstant(0.9);
   nlohmann::json j = ViewKeypointsToJson(frame, views, /*ground_truth=*/false);
   j["views"][0]["keypoints"][3] = keypoint;
-  const std::string path = testing::ScratchDir() + "/" + frame + ".json";
+  std::string name = frame;
+  std::replace(name.begin(), name.end(), '/', '_');
+  const std::string path = testing::ScratchDir() + "/" + name + ".json";
   std::ofstream(path) << j.dump();
   return path;
 }
@@ -84,6 +87,13 @@ TEST(FrameKeypoints, AFileOfAnotherFrameIsRefused) {
   EXPECT_THAT(error, HasSubstr(path + ": field 'frame': expected '000002'"));
   EXPECT_THAT(error, HasSubstr("got \"000003\""));
   EXPECT_EQ(ErrorOf(path, "000003"), "");
+  // Dataset frame ids are relative to the job's input folder: "ABF1/0000" is "0000"
+  // read from the sequence's folder, not "ABF2/0000".
+  const std::string sequence = WriteDetections("ABF1/0000", {50.0, 40.0});
+  EXPECT_EQ(ErrorOf(sequence, "0000"), "");
+  EXPECT_EQ(ErrorOf(sequence, "ABF1/0000"), "");
+  EXPECT_THAT(ErrorOf(sequence, "ABF2/0000"), HasSubstr("field 'frame'"));
+  EXPECT_THAT(ErrorOf(sequence, "10000"), HasSubstr("field 'frame'"));
 }
 
 }  // namespace

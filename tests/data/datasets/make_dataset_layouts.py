@@ -126,11 +126,12 @@ def camera_record(name, native, K, cam_from_world, width, height):
                 cam_from_world=cam_from_world[:3].reshape(-1).tolist())
 
 
-def write_detections(capture, frame, out_path, names, layout_frame):
-    """The native detections of `frame` with cameras renamed (native -> layout), as the
-    record of the layout's frame `layout_frame` (readers refuse a file naming another)."""
+def write_detections(capture, frame, out_path, names, frame_id):
+    """The native detections of `frame` with cameras renamed (native -> layout), as
+    the detections of the layout's frame `frame_id` (readers refuse a file of another
+    frame)."""
     record = read_json(capture.file("detections", frame))
-    record["frame"] = layout_frame
+    record["frame"] = frame_id
     for view in record["views"]:
         view["camera"] = names[view["camera"]]
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
@@ -293,7 +294,8 @@ def write_ho3d_sequence(capture, out, seq, order, order_as_column, rng):
             views.append(dict(camera=f"{seq}{c}", uv=project(K, in_cam).tolist(),
                               toolkit_uv=uv_mano[SNAP_FROM_NATIVE].tolist()))
         write_detections(capture, frame, os.path.join(out, "detections", seq, fid + ".json"),
-                         {cam["name"]: f"{seq}{c}" for c, cam in enumerate(cams)}, fid)
+                         {cam["name"]: f"{seq}{c}" for c, cam in enumerate(cams)},
+                         f"{seq}/{fid}")
         frames.append(dict(id=f"{seq}/{fid}", native_frame=frame,
                            keypoints3d=transform(common_from_native, keypoints).tolist(),
                            views=views))
