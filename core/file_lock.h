@@ -6,8 +6,8 @@
 // the file, so that the process refused can say who holds the folder.
 //
 // Users: a capture folder (`capture init --overwrite`, `capture import`, `detect
-// --capture`), a training run folder (`train`), a label output folder and its shards
-// (pipeline/output_lock.h). A lock is per open file: a second lock of the same file in
+// --capture`), a `detect --images` output folder, a training run folder (`train`), a
+// label output folder and its shards (pipeline/output_lock.h). A lock is per open file: a second lock of the same file in
 // one process conflicts with the first like another process's would.
 
 #include <string>

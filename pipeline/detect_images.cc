@@ -10,6 +10,7 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/file_lock.h"
 #include "core/json_util.h"
 #include "image/image_file.h"
 
@@ -128,6 +129,9 @@ int DetectImages(const MediapipeHands& detector, const std::vector<std::string>&
                  const std::string& out_dir, int threads,
                  const std::function<void(int, int)>& on_image) {
   std::filesystem::create_directories(out_dir);
+  // One writer per folder: a second run into it would mix its records with this
+  // run's, and each removes the other's beyond its own image count.
+  const FileLock writer = LockFolderForWriting(out_dir, "detect --images", "--out", "");
   nlohmann::json summary = {{"detector", "handlabel MediapipeHands"},
                             {"model", detector.options().model},
                             {"max_hands", detector.options().max_hands}};

@@ -26,7 +26,8 @@ nlohmann::json DetectionRecordJson(const std::string& image_path, const ImageU8&
 // Runs the detector on each image and writes <out_dir>/<index>.json (index = position in
 // `images`) and <out_dir>/summary.json (per-image times and hand counts, means).
 // `threads` images at once (0 = one per core); `on_image(done, total)` after each
-// image, one call at a time. Throws InputError naming an unreadable image.
+// image, one call at a time. Throws InputError naming an unreadable image, or naming
+// the holder when another process writes into `out_dir` (core/file_lock.h).
 // Records <n>.json of an earlier run with more images (n >= images.size()) are removed
 // at the end, so the folder describes this run only; files that are not such records
 // (by name and content) are never touched. Returns how many were removed.

@@ -7,8 +7,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <chrono>
-#include <thread>
+#include <string>
 
 #include "pipeline/frame_log.h"
 #include "pipeline/label_outputs.h"
@@ -23,16 +22,7 @@ namespace {
 using ::testing::HasSubstr;
 using testing::SpawnHandlabel;
 using testing::WaitForExit;
-
-// Waits until `pid` has recorded itself in its shard lock (it holds the folder).
-bool WaitUntilHolding(pid_t pid, const std::string& lock_path) {
-  const std::string mark = "pid " + std::to_string(pid) + " ";
-  for (int i = 0; i < 3000; ++i) {
-    if (ReadLockHolder(lock_path).find(mark) != std::string::npos) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return false;
-}
+using testing::WaitUntilHolding;
 
 int OkFrames(const std::string& out) {
   int ok = 0;

@@ -9,10 +9,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "apps/commands.h"
+#include "core/file_lock.h"
 
 namespace handlabel::testing {
 
@@ -64,6 +67,17 @@ inline int WaitForExit(pid_t pid) {
   int status = 0;
   waitpid(pid, &status, 0);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+// Waits (up to 15 s) until `pid` has recorded itself in the lock file `lock_path`
+// (core/file_lock.h): it holds the folder. False if it never did.
+inline bool WaitUntilHolding(pid_t pid, const std::string& lock_path) {
+  const std::string mark = "pid " + std::to_string(pid) + " ";
+  for (int i = 0; i < 7500; ++i) {
+    if (ReadLockHolder(lock_path).find(mark) != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return false;
 }
 
 }  // namespace handlabel::testing
