@@ -44,12 +44,13 @@ bool MediapipeModelsPresent() {
          std::filesystem::exists(ShippedModelPath("mediapipe/hand_landmark_lite.tflite"));
 }
 
-// Every file of `dir` (not the lock file), by name, with its bytes.
+// Every file directly in `dir` (not the lock file, not folders), by name, with its
+// bytes.
 std::map<std::string, std::string> FilesOf(const std::string& dir) {
   std::map<std::string, std::string> files;
   for (const auto& e : std::filesystem::directory_iterator(dir)) {
     const std::string name = e.path().filename().string();
-    if (name != ".handlabel.lock")
+    if (e.is_regular_file() && name != ".handlabel.lock")
       files[name] = testing::ReadFileBytes(e.path().string());
   }
   return files;
