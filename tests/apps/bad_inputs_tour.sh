@@ -1,10 +1,10 @@
 #!/bin/bash
-# A tour of the bad inputs and faults of issue 22's "Why" (docs/reliability.md) with a
-# built binary, as a user meets them: each gives a non-zero exit (or a failed frame in
-# an otherwise good run) whose message names the file, the field and what was
-# expected, and loses nothing already written. Prints PASS/FAIL per check; exit 1 if
-# any failed. The same cases have GoogleTest tests; this script checks a whole build
-# (e.g. a release) in about a minute.
+# A tour of the bad inputs and faults of issue 22's "Why" and of issue 46
+# (docs/reliability.md) with a built binary, as a user meets them: each gives a
+# non-zero exit (or a failed frame in an otherwise good run) whose message names the
+# file, the field and what was expected, and loses nothing already written. Prints
+# PASS/FAIL per check; exit 1 if any failed. The same cases have GoogleTest tests;
+# this script checks a whole build (e.g. a release) in a few minutes.
 # usage: tests/apps/bad_inputs_tour.sh BUILD/apps/handlabel SOURCE_DIR SCRATCH_DIR
 H=$(realpath "$1"); SRC=$(realpath "$2")
 mkdir -p "$3" && D=$(mktemp -d "$3/tour.XXXXXX") && cd "$D" || exit 2
@@ -235,6 +235,86 @@ expect_fail "huge --shard says the range" "N <= 999999999" $H label --job j46.ya
 head -c 3000 $SRC/models/poem_small_dexycb.pt > cut.pt
 out=$($H eval-network --weights cut.pt --frames 1 2>&1); rc=$?
 [ $rc = 1 ] && [ "$(wc -l <<< "$out")" = 1 ] && grep -qF cut.pt <<< "$out"; report "damaged --weights: one line naming the file" $((1-$?)) "rc=$rc $out"
+
+# --- issue 46: one view of 2D, one writer per folder, stale evidence, training -----
+first_camera() { $PY -c "import json; print(json.load(open('$1/capture.json'))['cameras'][0])"; }
+# wait_holding PID FOLDER: until PID has recorded itself in FOLDER's lock
+wait_holding() { for k in $(seq 1500); do grep -q "pid $1 " $2/.handlabel.lock 2>/dev/null && return 0; sleep 0.01; done; return 1; }
+cp -r cap cap1v
+json_edit cap1v/detections/000001.json "
+for v in j['views'][1:]: v['confidence']=[0.0]*21"
+job one cap1v out1v
+$H label --job one.yaml > one.log 2>&1; rc=$?
+r=$(manifest_reason out1v 000001)
+contains_all "$r" "failed|2D keypoints in only 1 view ($(first_camera cap))|depth is not determined"
+report "2D keypoints in one view only -> frame fails by name" $((1-$?)) "rc=$rc $r"
+oks=$(for f in 000000 000002 000003; do manifest_reason out1v $f; done | grep -c "^ok ")
+[ $rc = 0 ] && [ "$oks" = 3 ]; report "  ... the other frames are labelled" $((1-$?)) "rc=$rc ok=$oks"
+$H label --job one.yaml --resume > one2.log 2>&1; report "  ... --resume finishes" $((1-$?)) "$(tail -n2 one2.log)"
+
+# capture import: one writer; the first completes
+mkdir -p rec40 && cp -r cap40/images/. rec40/
+$H capture init --rig json:cap40/rig.json --out imp > imp_init.log 2>&1
+$H capture import --capture imp --images rec40 --threads 1 > imp.log 2>&1 &
+ipid=$!
+wait_holding $ipid imp; kill -STOP $ipid
+expect_fail "capture import --overwrite while an import runs" \
+  "no other process is writing|in use by capture import, pid $ipid" \
+  $H capture import --capture imp --images rec40 --overwrite
+expect_fail "detect --capture while an import runs" "in use by capture import, pid $ipid" \
+  $H detect --capture imp
+kill -CONT $ipid; wait $ipid; report "  ... the first import finishes" $((1-$?)) "$(tail -n2 imp.log)"
+st=$($PY -c "import json; j=json.load(open('imp/capture.json')); print(j['generator'].get('import_status'), len(j['frames']))")
+n=$(ls imp/images/*/*.png | wc -l)
+[ "$st" = "complete 40" ] && [ "$n" = $((40 * $(ls rec40 | wc -l))) ]
+report "  ... complete, 40 frames, every view on disk" $((1-$?)) "$st, $n images"
+# two detects (full, then lite) on one capture
+cp -r cap40 cap40d
+$H detect --capture cap40d --overwrite --threads 1 > det1.log 2>&1 &
+dpid=$!
+wait_holding $dpid cap40d; kill -STOP $dpid
+expect_fail "detect --capture while a detect runs" "in use by detect --capture, pid $dpid" \
+  $H detect --capture cap40d --overwrite --model lite
+kill -CONT $dpid; wait $dpid; report "  ... the first detect finishes" $((1-$?)) "$(tail -n2 det1.log)"
+
+# a re-import with --overwrite: the old recording's 2D, masks and truth are unlisted
+cp -r cap cap_re; mkdir -p rec4 && cp -r cap/images/. rec4/
+out=$($H capture import --capture cap_re --images rec4 --overwrite 2>&1); rc=$?
+files=$($PY -c "import json; print(sorted(json.load(open('cap_re/capture.json'))['files']))")
+[ $rc = 0 ] && [ "$files" = "['image']" ] && contains_all "$out" "no longer lists|detections (detections/{frame}.json)|keypoints|mask|ground_truth"
+report "capture import --overwrite unlists the old detections, keypoints, masks, truth" $((1-$?)) "rc=$rc $files $out"
+
+# training: one writer, resume with other data, damaged optimizer state, sizes, full disk
+train_yaml() { # file out_dir seed batch
+  printf '%s\n' "network: tiny" 'hand_model: ""' \
+    "data: {preset: dexycb, width: 320, height: 240, seed: $3}" "train:" "  steps: 4" \
+    "  batch_size: $4" "  warmup_steps: 1" "  checkpoint_every: 1" "  log_every: 1" \
+    "  validate_every: 4" "  validation_samples: 1" "  prefetch_batches: 0" \
+    "  out_dir: $2" > $1
+}
+train_yaml tr.yaml run46 4 1
+$H train --config tr.yaml > tr.log 2>&1 &
+tpid=$!
+wait_holding $tpid run46; kill -STOP $tpid
+expect_fail "train --resume while a training runs on the folder" "in use by train, pid $tpid" \
+  $H train --config tr.yaml --resume
+kill -CONT $tpid; wait $tpid; report "  ... the first training finishes" $((1-$?)) "$(tail -n2 tr.log)"
+steps=$(tail -n +2 run46/loss.csv | cut -d, -f1 | tr '\n' ' ')
+[ "$steps" = "1 2 3 4 " ]; report "  ... loss.csv has each step once" $((1-$?)) "$steps"
+train_yaml tr5.yaml run46 5 1
+expect_fail "train --resume with another data seed" "latest.json: field 'data.synth.seed'|got 5" \
+  $H train --config tr5.yaml --resume --steps 5
+optim=$(ls run46/checkpoints/*.optim | tail -n1); truncate -s 100 $optim
+expect_fail "train --resume with a truncated .optim" "$optim" $H train --config tr.yaml --resume --steps 5
+[ "$(grep -c "error" <<< "$LAST_OUT")" = 1 ] && ! grep -qE "Exception raised from|frame #" <<< "$LAST_OUT"
+report "  ... one error line, no backtrace" $((1-$?)) "$LAST_OUT"
+train_yaml trbig.yaml runbig 4 1000000000
+expect_fail "train.batch_size 1000000000" "train.batch_size|fit in memory" $H train --config trbig.yaml
+train_yaml trfull.yaml runfull 4 1
+out=$( (trap '' XFSZ; ulimit -f 16; exec $H train --config trfull.yaml) 2>&1); rc=$?
+grep -qF "cannot write 'runfull/checkpoints/step_00000001.pt'" <<< "$out" && [ $rc = 1 ] \
+  && [ -z "$(find runfull -name '*.tmp*')" ] && [ ! -e runfull/latest.json ]
+report "a full disk while a checkpoint is written: one line naming the file, no .tmp" $((1-$?)) "rc=$rc $(tail -c 300 <<< "$out")"
 
 echo "---- $pass passed, $fail failed"
 [ $fail = 0 ]
