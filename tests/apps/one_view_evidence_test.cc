@@ -8,6 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -81,13 +82,17 @@ std::map<std::string, std::string> ExpectOthersLabelledNearTheTruth(
     const std::string& capture, const std::string& out,
     const std::set<std::string>& failed, int frames) {
   std::map<std::string, std::string> labels;
+  double worst = 0;
   for (int f = 0; f < frames; ++f) {
     const std::string id = FrameId(f);
     if (failed.count(id)) continue;
     EXPECT_EQ(ManifestEntry(out, id)["status"], "ok") << id;
-    EXPECT_LT(LabelError(capture, out, id), kFarOffM) << id;
+    const double error = LabelError(capture, out, id);
+    EXPECT_LT(error, kFarOffM) << id;
+    worst = std::max(worst, error);
     labels[id] = testing::ReadFileBytes(LabelFilePath(out, id));
   }
+  ::testing::Test::RecordProperty("worst_label_error_um", static_cast<int>(1e6 * worst));
   return labels;
 }
 
