@@ -357,6 +357,18 @@ torch::Tensor PoemModelImpl::MaskLogitsOnFrozenFeatures(const torch::Tensor& ima
   return mask_head->forward(features).view({B, N, M, M});
 }
 
+void PoemModelImpl::UseBf16ForInference() {
+  ConvertToBf16ForInference(*img_backbone);
+  ConvertToBf16ForInference(*uv_delayer);
+  ConvertToBf16ForInference(*feat_delayer);
+  if (mask_head) ConvertToBf16ForInference(*mask_head);
+  PoemHeadImpl& head = *ptEmb_head;
+  ConvertToBf16ForInference(*head.merge_net_feature);
+  ConvertToBf16ForInference(*head.merge_net_query_feature);
+  ConvertToBf16ForInference(*head.query_embedding);
+  ConvertToBf16ForInference(*head.transformer);
+}
+
 PoemModel MakeRandomPoemModel(const PoemConfig& config, uint64_t seed) {
   torch::manual_seed(seed);
   return PoemModel(config);
