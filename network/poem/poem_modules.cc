@@ -42,8 +42,13 @@ torch::Tensor FoldedConv::operator()(const torch::Tensor& x) const {
   if (weight.scalar_type() == x.scalar_type()) {
     return at::conv2d(x, weight, bias, stride, padding);
   }
-  const torch::Tensor y = at::conv2d(CastForInference(x, weight.scalar_type()), weight,
-                                     bias, stride, padding);
+  // Channels-last: oneDNN's bf16 kernels then read and write the activations in place
+  // of reordering them to and from its blocked layout on every call.
+  const torch::Tensor low =
+      at::empty(x.sizes(), x.options().dtype(weight.scalar_type()),
+                at::MemoryFormat::ChannelsLast)
+          .copy_(x);
+  const torch::Tensor y = at::conv2d(low, weight, bias, stride, padding);
   return CastForInference(y, x.scalar_type());
 }
 
@@ -261,8 +266,13 @@ torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
   HL_CHECK(x.size(-1) == in, "InferenceLinear: input width differs from the layer's");
   std::vector<int64_t> shape = x.sizes().vec();
   shape.back() = out;
+  // One pass: a cast writes contiguous rows whatever x's strides.
+  const torch::Tensor flat = x.reshape({-1, in});
   const torch::Tensor rows =
-      CastForInference(x.reshape({-1, in}).contiguous(), layer.weight.scalar_type());
+      layer.weight.scalar_type() == x.scalar_type()
+          ? flat.contiguous()
+          : at::empty(flat.sizes(), flat.options().dtype(layer.weight.scalar_type()))
+                .copy_(flat);
   const int64_t m = rows.size(0);
   if (m == 0) return torch::empty(shape, x.options());
   // Row-major (m, in) is a (1, in, m, 1) image in channels-last layout: no copy, and
