@@ -260,8 +260,11 @@ torch::nn::Sequential Mlp(int64_t in, int64_t hidden, int64_t out) {
 
 bool UseInferenceKernels() { return !torch::GradMode::is_enabled(); }
 
-torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
-                              const torch::Tensor& x) {
+namespace {
+
+// layer(x) in the layer's own precision (bf16 after ConvertToBf16ForInference).
+torch::Tensor LinearInLayerPrecision(const torch::nn::LinearImpl& layer,
+                                     const torch::Tensor& x) {
   const int64_t out = layer.weight.size(0), in = layer.weight.size(1);
   HL_CHECK(x.size(-1) == in, "InferenceLinear: input width differs from the layer's");
   std::vector<int64_t> shape = x.sizes().vec();
@@ -274,7 +277,7 @@ torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
           : at::empty(flat.sizes(), flat.options().dtype(layer.weight.scalar_type()))
                 .copy_(flat);
   const int64_t m = rows.size(0);
-  if (m == 0) return torch::empty(shape, x.options());
+  if (m == 0) return torch::empty(shape, rows.options());
   // Row-major (m, in) is a (1, in, m, 1) image in channels-last layout: no copy, and
   // oneDNN writes the (1, out, m, 1) result channels-last, i.e. row-major (m, out).
   const torch::Tensor image = rows.as_strided({1, in, m, 1}, {m * in, 1, in, in});
@@ -282,21 +285,31 @@ torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
       image, layer.weight.view({out, in, 1, 1}),
       layer.bias.defined() ? c10::optional<torch::Tensor>(layer.bias) : c10::nullopt,
       {0, 0}, {1, 1}, {1, 1}, 1);
-  return CastForInference(y.permute({0, 2, 3, 1}).reshape(shape), x.scalar_type());
+  return y.permute({0, 2, 3, 1}).reshape(shape);
+}
+
+}  // namespace
+
+torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
+                              const torch::Tensor& x) {
+  return CastForInference(LinearInLayerPrecision(layer, x), x.scalar_type());
 }
 
 torch::Tensor InferenceMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {
+  // Between the layers the activations stay in the layers' precision: with bf16
+  // products on attention-sized chunks, casting every hidden activation to fp32 and
+  // back cost about as much as the products.
   torch::Tensor y = x;
   for (const auto& child : mlp.children()) {
     if (const auto* linear = child->as<torch::nn::Linear>()) {
-      y = InferenceLinear(*linear, y);
+      y = LinearInLayerPrecision(*linear, y);
     } else {
       HL_CHECK(child->as<torch::nn::ReLU>() != nullptr,
                "InferenceMlp: only Linear and ReLU modules");
       y = torch::relu_(y);
     }
   }
-  return y;
+  return CastForInference(y, x.scalar_type());
 }
 
 torch::Tensor RunMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {

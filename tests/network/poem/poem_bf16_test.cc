@@ -49,6 +49,29 @@ TEST(Bf16Inference, LinearIsTheProductOfRoundedInputsRoundedOnce) {
   EXPECT_GT(MaxAbsDiff(got, fp32), 0.0) << "the product did not run in bf16";
 }
 
+// An MLP in bf16 is the chain of rounded products (its hidden activations are the first
+// product's bf16 results).
+TEST(Bf16Inference, MlpIsTheChainOfRoundedProducts) {
+  SKIP_WITHOUT_BF16();
+  torch::manual_seed(13);
+  torch::NoGradGuard no_grad;
+  torch::nn::Sequential mlp = Mlp(3, 32, 16);
+  auto* first = mlp[0]->as<torch::nn::Linear>();
+  auto* second = mlp[2]->as<torch::nn::Linear>();
+  const torch::Tensor x = torch::randn({2, 300, 3});
+  namespace F = torch::nn::functional;
+  const torch::Tensor hidden = RoundedToBf16(torch::relu(F::linear(
+      RoundedToBf16(x), RoundedToBf16(first->weight), RoundedToBf16(first->bias))));
+  const torch::Tensor want =
+      F::linear(hidden, RoundedToBf16(second->weight), RoundedToBf16(second->bias));
+  ConvertToBf16ForInference(*mlp);
+  const torch::Tensor got = InferenceMlp(*mlp, x);
+  EXPECT_EQ(got.scalar_type(), torch::kFloat);
+  // The hidden values may round the other way where the two accumulation orders
+  // straddle a bf16 boundary: a few output ulps, not more.
+  EXPECT_LT(MaxAbsDiff(got, want), 4 * std::ldexp(1.0, -8) * want.abs().max().item<double>());
+}
+
 TEST(Bf16Inference, FoldedConvolutionIsTheConvolutionOfRoundedInputs) {
   SKIP_WITHOUT_BF16();
   torch::manual_seed(12);
