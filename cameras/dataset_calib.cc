@@ -65,8 +65,9 @@ struct SizedIntrinsicsFile {
 // <serial>_<W>x<H>.yml; the size comes from the name. DexYCB's toolkit always reads
 // <serial>_640x480.yml (its images are 640x480), so that file wins when several sizes
 // sit side by side; a single other size is taken as it is; several without 640x480
-// are ambiguous and an error.
-Camera DexYcbIntrinsics(const fs::path& folder, const std::string& serial) {
+// are ambiguous and an error. `chosen` is set to the file read.
+Camera DexYcbIntrinsics(const fs::path& folder, const std::string& serial,
+                        std::string* chosen) {
   static const std::regex size_suffix("_([0-9]+)x([0-9]+)\\.yml");
   std::vector<SizedIntrinsicsFile> found;
   if (fs::is_directory(folder)) {
@@ -101,6 +102,7 @@ Camera DexYcbIntrinsics(const fs::path& folder, const std::string& serial) {
     }
   }
   const fs::path& file = found[pick].file;
+  *chosen = file.string();
   const int width = found[pick].width;
   const int height = found[pick].height;
   const YAML::Node color = LoadYaml(file)["color"];
@@ -151,6 +153,7 @@ Rig ReadDexYcb(const fs::path& path, RigFileInfo* info) {
   const fs::path intrinsics_folder =
       fs::absolute(extrinsics_file).parent_path().parent_path() / "intrinsics";
   Rig rig;
+  std::vector<std::string> intrinsics_files;
   for (const std::string& serial : serials) {
     const YAML::Node values = map[serial];
     const std::string field = "extrinsics." + serial;
@@ -160,10 +163,15 @@ Rig ReadDexYcb(const fs::path& path, RigFileInfo* info) {
     }
     std::vector<double> v;
     for (const YAML::Node& x : values) v.push_back(YamlNumber(x, p, field));
-    rig.Add({serial, DexYcbIntrinsics(intrinsics_folder, serial),
+    intrinsics_files.emplace_back();
+    rig.Add({serial,
+             DexYcbIntrinsics(intrinsics_folder, serial, &intrinsics_files.back()),
              CamFromCommon(v, p, field)});
   }
-  if (info) info->world = "DexYCB common frame (master camera " + master + ")";
+  if (info) {
+    info->world = "DexYCB common frame (master camera " + master + ")";
+    info->intrinsics_files = intrinsics_files;
+  }
   return rig;
 }
 

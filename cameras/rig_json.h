@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "geometry/rig.h"
 
@@ -49,6 +50,10 @@ void CheckPlausibleCamera(const RigCamera& camera, const std::string& source,
 // What a rig file holds beyond the cameras.
 struct RigFileInfo {
   std::string world;  // free text, "" if absent
+  // Per camera, the file its intrinsics and image size were read from when that is not
+  // the rig file itself (DexYCB: calibration/intrinsics/<serial>_<W>x<H>.yml), so that
+  // a size mismatch found later can name it; empty otherwise. Not written to JSON.
+  std::vector<std::string> intrinsics_files;
 };
 
 Rig RigFromJson(const nlohmann::json& json, const std::string& source,

@@ -62,8 +62,11 @@ bool HasHand(const std::vector<double>& values) {
 // The labels' seg (H x W, uint8: 0 background, 255 hand, 1..254 the YCB id of the
 // object at that pixel) as the view's hand mask and object mask; both empty when the
 // file has no seg.
+// `size_origin` says where the camera's size comes from (a DexYCB intrinsics file of
+// another size than the images is otherwise found only here, in every frame).
 void AddSegmentation(const NamedArrays& arrays, const std::string& file,
-                     const Camera& camera, FrameInput* frame) {
+                     const Camera& camera, const std::string& size_origin,
+                     FrameInput* frame) {
   const NdArray* seg = nullptr;
   for (const auto& [key, array] : arrays) {
     if (key == "seg") seg = &array;
@@ -79,7 +82,7 @@ void AddSegmentation(const NamedArrays& arrays, const std::string& file,
     if (seg->shape[0] != camera.height() || seg->shape[1] != camera.width()) {
       throw InputError(file, "seg",
                        "the camera's size " + std::to_string(camera.height()) + " x " +
-                           std::to_string(camera.width()),
+                           std::to_string(camera.width()) + " (from " + size_origin + ")",
                        seg->ShapeString());
     }
     hand.resize(seg->shape[0], seg->shape[1]);
@@ -133,7 +136,11 @@ DexYcbSequence ReadDexYcbSequence(const std::string& dir) {
                      listed ? Shown(sides[0]) : Shown(sides));
   }
   seq.side = *side;
-  seq.rig = ReadDatasetRig("dexycb", m);  // serials + <root>/calibration
+  RigFileInfo info;
+  seq.rig = ReadDatasetRig("dexycb", m, &info);  // serials + <root>/calibration
+  for (const std::string& file : info.intrinsics_files) {
+    seq.size_origins.push_back("its intrinsics file " + file);
+  }
   for (const RigCamera& camera : seq.rig.cameras()) {
     if (!fs::is_directory(fs::path(dir) / camera.name)) {
       throw InputError(m, "serials",
@@ -185,6 +192,7 @@ DexYcbFrameSource::DexYcbFrameSource(const std::string& path,
         replaced.Add(cameras->Find(camera.name));  // InputError lists the known names
       }
       seq.rig = replaced;
+      seq.size_origins.assign(seq.rig.size(), "cameras.file");
     }
     if (!sequences_.empty() && seq.side != sequences_.front().side) {
       throw InputError((dir / "meta.yml").string(), "mano_sides",
@@ -291,7 +299,7 @@ FrameInput DexYcbFrameSource::Load(const std::string& id) const {
       }
     }
     frame.keypoints_2d.push_back(view);
-    AddSegmentation(arrays, file, seq.rig[v].camera, &frame);
+    AddSegmentation(arrays, file, seq.rig[v].camera, seq.size_origins[v], &frame);
     if (!frame.ground_truth && HasHand(xyz)) {
       const Eigen::Map<const Points3d> in_camera(xyz.data(), kNumHandKeypoints, 3);
       FrameGroundTruth truth;

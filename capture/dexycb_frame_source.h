@@ -35,6 +35,9 @@ struct DexYcbSequence {
   std::string dir;     // the sequence folder
   std::string prefix;  // "" (one sequence) or "<subject>/<sequence>/" before frame ids
   Rig rig;             // serial order of meta.yml
+  // Per camera, where its image size comes from, for messages: "its intrinsics file
+  // <path>" (the size is in the file's name) or "cameras.file".
+  std::vector<std::string> size_origins;
   int num_frames = 0;
   HandSide side = HandSide::kRight;
   bool has_labels = false;  // labels_%06d.npz next to the images

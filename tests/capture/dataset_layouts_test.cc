@@ -134,6 +134,25 @@ TEST(DatasetLayouts, DexYcbAsTheToolkitReadsIt) {
   EXPECT_EQ(unlabelled, 1);  // the script's one (-1, -1) keypoint
 }
 
+// Without a serial's <serial>_640x480.yml the reader takes its only other file
+// (1280x720, docs/cameras.md), and every frame then fails on that view's seg size
+// (issue 46: the message named neither that file nor where the size came from).
+TEST(DatasetLayouts, DexYcbSegOfAnotherSizeNamesTheIntrinsicsFileOfTheSize) {
+  const DatasetLayout layout = WriteDatasetLayout(testing::ScratchDir(), "dexycb", 1);
+  const nlohmann::json& e = layout.expected;
+  ASSERT_FALSE(e.is_null());
+  const std::string serial = e["cameras"][1]["name"];
+  const std::string intrinsics = layout.root + "/calibration/intrinsics/" + serial;
+  ASSERT_TRUE(fs::remove(intrinsics + "_640x480.yml"));
+  const DexYcbFrameSource source(e["path"].get<std::string>());
+  const std::string error = testing::InputErrorOf(
+      [&] { source.Load(e["frames"][0]["id"].get<std::string>()); });
+  EXPECT_THAT(error, HasSubstr("/" + serial + "/labels_"));
+  EXPECT_THAT(error, HasSubstr("field 'seg'"));
+  EXPECT_THAT(error, HasSubstr("720 x 1280 (from its intrinsics file " + intrinsics +
+                               "_1280x720.yml)"));
+}
+
 // Two sequences of one split: ABF1 with cam_orders 1 3 2 4 0, GPMF1 with a random
 // permutation written by np.savetxt. The files of index i belong to camera folder
 // <SEQ><order[i]>: with the pairing by value every camera but one would be wrong here
