@@ -60,10 +60,10 @@ int RunOnSynth(EvalNetworkFlags& f) {
       "MPJPE    %.2f mm (keypoints: %s)\nMPVPE    %.2f mm\nPA-MPJPE %.2f mm\nPA-MPVPE "
       "%.2f mm\n"
       "AUC joints (0-20 mm)   %.3f\nAUC vertices (0-20 mm) %.3f\n"
-      "network %.2f frames/s\n",
+      "network %.2f frames/s (%s)\n",
       r.frames, o.synth.rig.preset.c_str(), static_cast<unsigned long long>(o.synth.seed),
       r.mpjpe_mm, ToString(o.keypoints).c_str(), r.mpvpe_mm, r.pa_mpjpe_mm, r.pa_mpvpe_mm,
-      r.joint_pck.auc, r.vertex_pck.auc, r.frames_per_second);
+      r.joint_pck.auc, r.vertex_pck.auc, r.frames_per_second, r.precision.c_str());
   std::printf(
       "MPJPE by keypoint reading (--keypoints): joints %.2f mm, mesh %.2f mm (true mesh: "
       "%.2f mm), mean %.2f mm\n",
@@ -191,6 +191,11 @@ int RunEvalNetwork(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--threads", o.threads,
                  "LibTorch threads; --capture: the job's threads (0 = all cores)")
+      ->capture_default_str();
+  app.add_option("--precision", o.precision,
+                 "synthetic: arithmetic of the network's products: fp32, bf16 or auto "
+                 "(bf16 where the CPU has a bf16 unit; docs/speed.md)")
+      ->check(CLI::IsMember({"fp32", "bf16", "auto"}))
       ->capture_default_str();
   app.add_flag("--objects", f.objects, "objects held in or near the hand");
   app.add_flag("--no-clutter", f.no_clutter, "plain grey backgrounds");

@@ -9,13 +9,13 @@ namespace handlabel {
 int RunExport(int argc, char** argv) {
   CLI::App app(
       "Write a labeling job's labels in another format (docs/exports.md): npz "
-      "(keypoints, "
-      "joints, vertices and MANO parameters per frame, in smplx's or manopth's "
-      "convention), csv (21 keypoints per frame) or coco (COCO-WholeBody-style 2D hand "
-      "keypoints and boxes per view, projected with the capture's cameras), glb (a "
-      "skinned hand in glTF 2.0 with one animation over the labels), dexycb or ho3d "
-      "(per-frame annotations in DexYCB's or HO3D's layout, with the capture's "
-      "cameras and images, readable by their toolkits and our in-place readers).\n"
+      "(keypoints, joints, vertices and MANO parameters per frame, in smplx's, "
+      "manopth's or manotorch's convention), csv (21 keypoints per frame) or coco "
+      "(COCO-WholeBody-style 2D hand keypoints and boxes per view, projected with the "
+      "capture's cameras), glb (a skinned hand in glTF 2.0 with one animation over the "
+      "labels), dexycb or ho3d (per-frame annotations in DexYCB's or HO3D's layout, "
+      "with the capture's cameras and images, readable by their toolkits and our "
+      "in-place readers).\n"
       "Example: handlabel export --labels /tmp/demo_out --format npz --out "
       "/tmp/demo_out/keypoints.npz --mano-convention manopth",
       "export");
@@ -28,14 +28,15 @@ int RunExport(int argc, char** argv) {
   app.add_option("--out", request.out,
                  "the file to write (dexycb, ho3d: the dataset folder)")
       ->required();
-  app.add_option(
-         "--mano-convention", convention,
-         "npz: MANO parameters for smplx.MANO or manopth.ManoLayer (default smplx)")
-      ->check(CLI::IsMember({"smplx", "manopth"}));
+  app.add_option("--mano-convention", convention,
+                 "npz: MANO parameters for smplx.MANO, manopth.ManoLayer or manotorch's "
+                 "ManoLayer (default smplx)")
+      ->check(CLI::IsMember({"smplx", "manopth", "manotorch"}));
   app.add_option(
          "--flat-hand-mean", flat,
          "npz: the layer's flat_hand_mean; false subtracts the model's hands_mean "
-         "from hand_pose (default: the layer's own, smplx false, manopth true)")
+         "from hand_pose (default: the layer's own, smplx false, manopth and manotorch "
+         "true)")
       ->check(CLI::IsMember({"true", "false"}));
   app.add_option("--hand-model", request.hand_model,
                  "npz with --flat-hand-mean false, glb: the labels' hand model file, "

@@ -108,33 +108,43 @@ void BM_Poem(benchmark::State& state, const std::string& config) {
   o.num_views = static_cast<int>(state.range(0));
   o.batch_size = static_cast<int>(state.range(1));
   o.num_threads = static_cast<int>(state.range(2));
+  o.precision = state.range(3) ? "bf16" : "fp32";
   auto predictor = CreateHandMeshPredictor(o);
   const auto frames =
       SyntheticFrames(o.batch_size, predictor->num_views(), predictor->crop_size());
+  // Warm-up: oneDNN generates its kernels and the allocator grows its heap on the first
+  // call (for the released model's two timed iterations that first call was 10-20 %).
+  predictor->Predict(frames);
   for (auto _ : state) benchmark::DoNotOptimize(predictor->Predict(frames));
   state.counters["frames_per_s"] =
       benchmark::Counter(static_cast<double>(state.iterations()) * o.batch_size,
                          benchmark::Counter::kIsRate);
 }
 
+// Arguments: views, frames per pass, threads, precision (0 = fp32, 1 = bf16).
 BENCHMARK_CAPTURE(BM_Poem, Small, std::string("small"))
-    ->Args({4, 1, 1})
-    ->Args({4, 4, 1})
-    ->Args({4, 1, 2})
-    ->Args({4, 4, 2})
-    ->Args({8, 1, 2})
+    ->Args({4, 1, 1, 0})
+    ->Args({4, 4, 1, 0})
+    ->Args({4, 1, 2, 0})
+    ->Args({4, 4, 2, 0})
+    ->Args({8, 1, 2, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Poem, Shipped, std::string("models/poem_small_dexycb.pt"))
-    ->Args({8, 1, 1})
-    ->Args({8, 1, 2})
-    ->Args({8, 4, 2})
+    ->Args({8, 1, 1, 0})
+    ->Args({8, 1, 1, 1})
+    ->Args({8, 1, 2, 0})
+    ->Args({8, 1, 2, 1})
+    ->Args({8, 4, 2, 0})
+    ->Args({8, 4, 2, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 // The released 8-view model takes seconds per frame: a few iterations only.
 BENCHMARK_CAPTURE(BM_Poem, Released, std::string("released-dexycb"))
-    ->Args({8, 1, 1})
-    ->Args({8, 1, 2})
+    ->Args({8, 1, 1, 0})
+    ->Args({8, 1, 1, 1})
+    ->Args({8, 1, 2, 0})
+    ->Args({8, 1, 2, 1})
     ->Iterations(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
@@ -207,15 +217,36 @@ std::map<std::string, double> StageFlops(const PoemConfig& c, int64_t B) {
   return f;
 }
 
-void BM_PoemStages(benchmark::State& state, const std::string& config) {
-  const int views = static_cast<int>(state.range(0));
-  const int threads = static_cast<int>(state.range(1));
-  at::set_num_threads(threads);
+// The model as the predictor prepares it.
+PoemModel InferenceModel(const std::string& config, int views, bool bf16) {
   PoemModel model = IsFile(config)
                         ? LoadPoemCheckpoint(Shipped(config))
                         : MakeRandomPoemModel(PoemConfigByName(config, views), 1);
   model->eval();
-  FoldNormsForInference(*model);  // as the predictor does
+  FoldNormsForInference(*model);
+  if (bf16) model->UseBf16ForInference();
+  return model;
+}
+
+// The frame through the reference path: for fp32 the autograd path (plain ATen, the
+// code before the inference kernels), for bf16 the fp32 inference kernels.
+torch::Tensor ReferenceCoords(PoemModel& model, const std::string& config, bool bf16,
+                              const PoemBatch& batch) {
+  if (bf16) {
+    torch::NoGradGuard no_grad;
+    PoemModel fp32 = InferenceModel(config, model->config().num_views, false);
+    return fp32->forward(batch).layer_coords;
+  }
+  torch::AutoGradMode with_grad(true);
+  return model->forward(batch).layer_coords.detach();
+}
+
+void BM_PoemStages(benchmark::State& state, const std::string& config) {
+  const int views = static_cast<int>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
+  const bool bf16 = state.range(2) != 0;
+  at::set_num_threads(threads);
+  PoemModel model = InferenceModel(config, views, bf16);
   const PoemConfig& c = model->config();
   const PoemBatch batch =
       MakePoemBatch(SyntheticFrames(1, c.num_views, c.crop_size), 0, 1, c);
@@ -235,23 +266,19 @@ void BM_PoemStages(benchmark::State& state, const std::string& config) {
   // Process CPU time (all threads): on a shared machine the wall time includes waiting.
   const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   model->stage_times = nullptr;
-  // Exactness: the same frame through the autograd path (plain ATen, the code before
-  // the inference kernels), largest coordinate difference over all decoder layers.
-  // Rounding scale: the same path on images scaled by 1 + 1e-6 (a few ulps). The ball
-  // query and kNN selections make the outputs jump where a point crosses a boundary,
-  // so a pure rounding change can move them by this much.
-  torch::Tensor reference, nudged_reference;
-  {
-    torch::AutoGradMode with_grad(true);
-    reference = model->forward(batch).layer_coords.detach();
-    PoemBatch nudged = batch;
-    nudged.images = batch.images * (1 + 1e-6);
-    nudged_reference = model->forward(nudged).layer_coords.detach();
-  }
+  // Exactness: the same frame through the reference path, largest coordinate
+  // difference over all decoder layers. Rounding scale: the reference on images scaled
+  // by 1 + 1e-6 (a few ulps). The ball query and kNN selections make the outputs jump
+  // where a point crosses a boundary, so a pure rounding change can move them this much.
+  PoemBatch nudged = batch;
+  nudged.images = batch.images * (1 + 1e-6);
+  const torch::Tensor reference = ReferenceCoords(model, config, bf16, batch);
+  const torch::Tensor nudged_reference = ReferenceCoords(model, config, bf16, nudged);
   const double nudge_diff = (nudged_reference - reference).abs().max().item<double>();
   const torch::Tensor diff = (fast.layer_coords - reference).abs();
   const double max_diff = diff.max().item<double>();
   const double final_diff = diff[-1].max().item<double>();
+  const double final_mean = diff[-1].norm(2, -1).mean().item<double>();
   const double n = static_cast<double>(state.iterations());
   const auto flops = StageFlops(c, 1);
   double frame_flops = 0;
@@ -262,11 +289,13 @@ void BM_PoemStages(benchmark::State& state, const std::string& config) {
       config.c_str(), c.num_views, threads, 1e3 * total / n, frame_flops * 1e-9,
       frame_flops * 1e-9 / (total / n));
   std::fprintf(stderr, "  process CPU time per frame: %.1f ms\n", 1e3 * cpu / n);
+  const char* reference_name = bf16 ? "fp32" : "the autograd path";
   std::fprintf(stderr,
-               "  largest difference to the autograd path: %.3g m (final layer %.3g m)\n",
-               max_diff, final_diff);
-  std::fprintf(stderr, "  autograd path on images x (1 + 1e-6): moves by %.3g m\n",
-               nudge_diff);
+               "  largest difference to %s: %.3g m (final layer %.3g m, mean point "
+               "distance %.3g m)\n",
+               reference_name, max_diff, final_diff, final_mean);
+  std::fprintf(stderr, "  %s on images x (1 + 1e-6): moves by %.3g m\n",
+               reference_name, nudge_diff);
   std::fprintf(stderr, "  %-36s %10s %8s %10s\n", "stage", "ms", "GFLOP", "GFLOP/s");
   for (const auto& [stage, seconds] : times.seconds) {
     const double f = flops.count(stage) ? flops.at(stage) : 0.0;
@@ -275,21 +304,25 @@ void BM_PoemStages(benchmark::State& state, const std::string& config) {
   }
   state.counters["GFLOP_per_frame"] = frame_flops * 1e-9;
   state.counters["max_diff_m"] = max_diff;
+  state.counters["final_mean_diff_m"] = final_mean;
   state.counters["cpu_ms_per_frame"] = 1e3 * cpu / n;
   state.counters["GFLOP_per_s"] =
       benchmark::Counter(frame_flops * 1e-9 * n, benchmark::Counter::kIsRate);
   state.counters["frames_per_s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
 }
 
+// Arguments: views, threads, precision (0 = fp32, 1 = bf16).
 BENCHMARK_CAPTURE(BM_PoemStages, Released, std::string("released-dexycb"))
-    ->Args({8, 1})
-    ->Args({8, 2})
+    ->Args({8, 1, 0})
+    ->Args({8, 2, 0})
+    ->Args({8, 2, 1})
     ->Iterations(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_PoemStages, Shipped, std::string("models/poem_small_dexycb.pt"))
-    ->Args({8, 1})
-    ->Args({8, 2})
+    ->Args({8, 1, 0})
+    ->Args({8, 2, 0})
+    ->Args({8, 2, 1})
     ->Iterations(10)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -47,6 +47,9 @@ void NetworkEvalOptions::Check(const std::string& source) const {
   RequireAtLeast(source, "--frames", frames, 1);
   RequireAtLeast(source, "--batch", batch_size, 1);
   RequireAtLeast(source, "--threads", threads, 1);
+  if (precision != "fp32" && precision != "bf16" && precision != "auto") {
+    throw InputError(source, "--precision", "fp32, bf16 or auto", precision);
+  }
   // The parts keep their own names in messages, as their fields are theirs.
   synth.Check("synth options");
   pck.Check("PckOptions");
@@ -59,6 +62,7 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
   po.weights = o.weights;
   po.num_threads = o.threads;
   po.batch_size = o.batch_size;  // one forward pass per batch of samples
+  po.precision = o.precision;
   const std::unique_ptr<HandMeshPredictor> predictor = CreateHandMeshPredictor(po);
   TrainingSampleOptions so;
   so.crop_size = predictor->crop_size();
@@ -84,6 +88,7 @@ NetworkEvalResult EvaluatePoemOnSynth(const HandModel& hand, const NetworkEvalOp
                       "frames (each keeps its 21 keypoint and " +
                           std::to_string(hand.num_vertices()) + " vertex errors)");
   NetworkEvalResult r;
+  r.precision = predictor->precision();
   MaskIouCounts mask_iou;
   Eigen::MatrixXd joint_errors(o.frames, 21), vertex_errors;
   for (int first = 0; first < o.frames; first += o.batch_size) {

@@ -27,6 +27,7 @@ struct NetworkEvalOptions {
   int frames = 500;           // held-out frames (>= 1)
   int batch_size = 4;         // frames per forward pass (>= 1)
   int threads = 1;            // LibTorch threads (>= 1)
+  std::string precision = "fp32";  // fp32 | bf16 | auto (HandMeshPredictorOptions)
   SynthCaptureOptions synth;  // rig preset, seed, scene settings
   double box_scale = 2.0;     // crop side / keypoint box side
   PckOptions pck;             // thresholds of the PCK curve (POEM: 0-20 mm, 20 steps)
@@ -52,6 +53,7 @@ struct NetworkEvalResult {
   PckCurve joint_pck, vertex_pck;  // thresholds in metres
   double seconds = 0;              // wall time of the forward passes
   double frames_per_second = 0;    // network only (crops excluded)
+  std::string precision;           // the network's arithmetic ("auto" resolved)
   // Mask head: IoU of the predicted crop masks with the true ones (network/
   // training_sample.h MaskIouCounts, every view); -1 without a mask head.
   double mask_iou = -1;

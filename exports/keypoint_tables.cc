@@ -68,7 +68,8 @@ void AddParameters(const LabelSeries& series, const ManoLayerSetting& setting,
   arrays->emplace_back("hand_pose", NdArray::FromMatrix(pose));
   arrays->emplace_back("betas", NdArray::FromMatrix(betas));
   arrays->emplace_back("transl", NdArray::FromMatrix(transl));
-  if (setting.convention == ManoConvention::kManopth) {
+  // manopth's and manotorch's layers take root and finger rotations as one vector.
+  if (setting.convention != ManoConvention::kSmplx) {
     Eigen::MatrixXd coeffs(n, 3 + kNumPoseParams);
     coeffs << orient, pose;
     arrays->emplace_back("pose_coeffs", NdArray::FromMatrix(coeffs));

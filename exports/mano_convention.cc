@@ -5,19 +5,30 @@
 namespace handlabel {
 
 std::string ToString(ManoConvention convention) {
-  return convention == ManoConvention::kSmplx ? "smplx" : "manopth";
+  switch (convention) {
+    case ManoConvention::kSmplx:
+      return "smplx";
+    case ManoConvention::kManopth:
+      return "manopth";
+    case ManoConvention::kManotorch:
+      return "manotorch";
+  }
+  return "?";
 }
 
 ManoConvention ParseManoConvention(const std::string& text, const std::string& source) {
-  for (ManoConvention c : {ManoConvention::kSmplx, ManoConvention::kManopth}) {
+  for (ManoConvention c :
+       {ManoConvention::kSmplx, ManoConvention::kManopth, ManoConvention::kManotorch}) {
     if (text == ToString(c)) return c;
   }
-  throw InputError(source, "mano convention", "smplx | manopth", "'" + text + "'");
+  throw InputError(source, "mano convention", "smplx | manopth | manotorch",
+                   "'" + text + "'");
 }
 
 bool DefaultFlatHandMean(ManoConvention convention) {
-  // smplx.MANO(flat_hand_mean=False), manopth.ManoLayer(flat_hand_mean=True).
-  return convention == ManoConvention::kManopth;
+  // smplx.MANO(flat_hand_mean=False), manopth's and manotorch's
+  // ManoLayer(flat_hand_mean=True).
+  return convention != ManoConvention::kSmplx;
 }
 
 Eigen::Matrix<double, kNumPoseParams, 1> LayerHandPose(const HandParams& label_params,

@@ -10,8 +10,13 @@
 //   manopth  manopth.ManoLayer(use_pca=False, flat_hand_mean=...)(pose_coeffs (48) =
 //            [global_orient, hand_pose], betas, trans): default flat_hand_mean True;
 //            vertices and 21 joints (SNAP order, manopth's fingertips) in millimetres
-// global_orient, betas and transl are the same for both. Proven against NumPy
-// re-implementations of both layers in tests/exports/mano_conventions_test.cc.
+//   manotorch manotorch.ManoLayer(rot_mode="axisang", use_pca=False, center_idx=None,
+//            flat_hand_mean=...)(pose_coeffs (48), betas): default flat_hand_mean True;
+//            manopth's skinning and joints but in metres and without a translation
+//            argument: add transl to its verts and joints
+// global_orient, betas and transl are the same for all three. Proven against NumPy
+// re-implementations of the layers (tests/apps/mano_layers.py, run by
+// tests/apps/export_command_test.cc).
 
 #include <optional>
 #include <string>
@@ -21,12 +26,13 @@
 
 namespace handlabel {
 
-enum class ManoConvention { kSmplx, kManopth };
+enum class ManoConvention { kSmplx, kManopth, kManotorch };
 
-std::string ToString(ManoConvention convention);  // "smplx" | "manopth"
+std::string ToString(ManoConvention convention);  // "smplx" | "manopth" | "manotorch"
 // Throws InputError naming `source` for another name.
 ManoConvention ParseManoConvention(const std::string& text, const std::string& source);
-// The flat_hand_mean a layer is built with when not told: smplx false, manopth true.
+// The flat_hand_mean a layer is built with when not told: smplx false, manopth and
+// manotorch true.
 bool DefaultFlatHandMean(ManoConvention convention);
 
 // How a label's parameters are handed to a layer.

@@ -188,7 +188,10 @@ std::string JobForNewRecordings(const AdaptRun& run) {
        << "name: adapted\nseed: " << run.o.seed << "\n"
        << "input: {format: native, path: " << quoted(run.o.capture_dir) << "}\n"
        << "network: {weights: " << quoted(run.Path("network.pt"))
-       << ", threads: " << run.o.threads << "}\n"
+       << ", threads: " << run.o.threads
+       // bf16 where the CPU has a bf16 unit: the same labels within rounding, faster
+       // (docs/speed.md "Reduced precision").
+       << ", precision: auto}\n"
        << "refine: {mode: fallback";
   if (chosen) {
     const nlohmann::json& refine = heldout["thresholds"]["refine"];

@@ -268,6 +268,11 @@ void JobConfig::Check(const std::string& source) const {
   if (output_dir.empty()) throw InputError(source, "output.dir", "an output folder");
   RequireAtLeast(source, "network.batch_size", batch_size, 1);
   RequireAtLeast(source, "network.threads", threads, 0);
+  if (network_precision != "fp32" && network_precision != "bf16" &&
+      network_precision != "auto") {
+    throw InputError(source, "network.precision", "fp32, bf16 or auto",
+                     "'" + network_precision + "'");
+  }
   if (network_weights.empty() && refine_mode != RefineMode::kAlways) {
     throw InputError(source, "refine.mode",
                      "'always' when network.weights is empty (without a network every "
@@ -339,6 +344,7 @@ JobConfig LoadJobConfig(const std::string& path) {
   network.Read("weights", &job.network_weights);
   network.Read("batch_size", &job.batch_size);
   network.Read("threads", &job.threads);
+  network.Read("precision", &job.network_precision);
   std::string network_keypoints = ToString(job.network_keypoints);
   network.Read("keypoints", &network_keypoints);
   const std::optional<AnswerKeypoints> how = AnswerKeypointsNamed(network_keypoints);

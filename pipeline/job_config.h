@@ -100,6 +100,8 @@ struct JobConfig {
   std::string network_weights;  // empty = no network: every frame is fitted
   int batch_size = 4;
   int threads = 0;  // 0 = all cores
+  // network.precision: fp32 | bf16 | auto (HandMeshPredictorOptions::precision).
+  std::string network_precision = "fp32";
   // network.keypoints: how the answer's 3D keypoints are read (joints | mesh | mean,
   // hand/mesh_keypoints.h); they are what the quality checks judge and what a kept
   // answer's label carries.

@@ -247,6 +247,7 @@ class LabelJobRun {
         << (n->threads_per_batch == 1 ? "" : "s") << (lanes > 1 ? " each" : "");
     }
     if (!n->keypoints.empty()) s << ", keypoints: " << n->keypoints;
+    if (!n->precision.empty()) s << ", precision " << n->precision;
     return s.str();
   }
 

@@ -64,6 +64,11 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   if (!job.detections.empty()) extra["detections"] = job.detections;
   if (job.keypoints_from_detector) extra["detector"] = job.detector_model;
   if (job.detector_every != 1) extra["detector_every"] = job.detector_every;
+  // The requested arithmetic; what "auto" chose on each machine is in every label's
+  // provenance (model name).
+  if (!weights_sha256.empty() && job.network_precision != "fp32") {
+    extra["network_precision"] = job.network_precision;
+  }
   // Labels made before the reading was chosen used the joints.
   if (!weights_sha256.empty() && job.network_keypoints != AnswerKeypoints::kJoints) {
     extra["network_keypoints"] = ToString(job.network_keypoints);

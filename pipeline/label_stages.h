@@ -48,6 +48,9 @@ struct NetworkStage {
   // How the answers' 3D keypoints are read (network.keypoints), as the job's start
   // line shows it; empty = the network's joints, unannounced.
   std::string keypoints;
+  // network.precision: auto, as the start line shows it ("auto: bf16, the CPU has a
+  // bf16 unit"); empty otherwise (the model name carries a precision other than fp32).
+  std::string precision;
   // One batch; called by up to `lanes` threads at once (each may use threads itself).
   // Returns one prediction per frame, in order. Throws if the whole batch fails; the
   // runner then retries the frames one by one so that one bad frame fails alone.

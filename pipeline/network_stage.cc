@@ -188,12 +188,19 @@ NetworkStage LoadNetworkStage(const JobConfig& job,
   options.weights = weights;
   options.batch_size = job.batch_size;
   options.num_threads = threads / lanes;
+  options.precision = job.network_precision;
   // Shared: std::function needs a copyable callable.
   std::shared_ptr<HandMeshPredictor> network = CreateHandMeshPredictor(options);
   NetworkStage stage;
   stage.model_name =
-      network->name() + " (" + std::filesystem::path(weights).filename().string() + ")";
+      network->name() + " (" + std::filesystem::path(weights).filename().string() +
+      (network->precision() == "fp32" ? "" : ", " + network->precision()) + ")";
   stage.weights_sha256 = Sha256OfFile(weights);
+  if (job.network_precision == "auto") {  // the model name says the arithmetic
+    stage.precision = "auto: " + network->precision() +
+                      (CpuHasBf16Unit() ? ", the CPU has a bf16 unit"
+                                        : ", no bf16 unit on this CPU");
+  }
   stage.predicts_masks = network->predicts_masks();
   stage.num_parameters = network->num_parameters();
   stage.lanes = lanes;

@@ -58,6 +58,8 @@ class HandMeshPredictor {
   virtual bool predicts_masks() const = 0;
   // Learned parameters (weights and biases, not buffers); 0 when unknown.
   virtual int64_t num_parameters() const { return 0; }
+  // The arithmetic actually used: "fp32" or "bf16" ("auto" resolved).
+  virtual std::string precision() const { return "fp32"; }
   // One prediction per frame. Throws InputError naming the frame, view and field of
   // the first invalid input, before any inference runs. Safe to call from several
   // threads at once (the model is only read); each call uses the intra-op threads.
@@ -78,10 +80,23 @@ struct HandMeshPredictorOptions {
   // hardware threads.
   int num_threads = 0;
   int batch_size = 4;        // frames per forward pass
+  // Arithmetic of the network's products (docs/speed.md "Reduced precision"): "fp32";
+  // "bf16" (bf16 inputs and weights, fp32 accumulation; emulated, slowly, on AVX-512
+  // CPUs without a bf16 unit; refused on CPUs without AVX-512); "auto" = bf16 where the
+  // CPU has a bf16 unit (AVX512_BF16 or AMX-BF16), else fp32.
+  std::string precision = "fp32";
   uint64_t random_seed = 0;  // random weights only
   // Throws InputError naming the field.
   void Check(const std::string& source) const;
 };
+
+// True when the CPU computes bf16 products in hardware (AVX512_BF16 or AMX-BF16).
+bool CpuHasBf16Unit();
+// True when LibTorch's oneDNN can run bf16 products at all (AVX-512 BW/VL/DQ; emulated,
+// slower than fp32, without a bf16 unit). precision "bf16" is refused elsewhere.
+bool CpuCanRunBf16();
+// "fp32" or "bf16" for a precision option ("auto" resolved on this CPU).
+std::string ResolvePrecision(const std::string& precision);
 
 // Loads the model and validates it; throws InputError naming the file or option.
 std::unique_ptr<HandMeshPredictor> CreateHandMeshPredictor(

@@ -310,8 +310,10 @@ PoemOutputs PoemModelImpl::forward(const PoemBatch& batch) {
   const auto f = img_backbone->forward(batch.images.reshape({B * N, 3, S, S}));
   clock.Lap("backbone");
   const torch::Tensor feat_full = UDecodeBeforePool(feat_delayer, f);  // (BN, w, 2H, 2W)
+  // Contiguous: bf16 inference leaves the decoders' outputs channels-last, and the
+  // head's sampling reads them faster in the plain layout.
   const torch::Tensor feat =
-      feat_in(F::max_pool2d(feat_full, F::MaxPool2dFuncOptions(2).stride(2)));
+      feat_in(F::max_pool2d(feat_full, F::MaxPool2dFuncOptions(2).stride(2))).contiguous();
   if (mask_head) {
     const int64_t M = c.mask_size();
     out.mask_logits = mask_head->forward(feat_full).view({B, N, M, M});
@@ -355,6 +357,18 @@ torch::Tensor PoemModelImpl::MaskLogitsOnFrozenFeatures(const torch::Tensor& ima
                                  img_backbone->forward(images.reshape({B * N, 3, S, S})));
   }
   return mask_head->forward(features).view({B, N, M, M});
+}
+
+void PoemModelImpl::UseBf16ForInference() {
+  ConvertToBf16ForInference(*img_backbone);
+  ConvertToBf16ForInference(*uv_delayer);
+  ConvertToBf16ForInference(*feat_delayer);
+  if (mask_head) ConvertToBf16ForInference(*mask_head);
+  PoemHeadImpl& head = *ptEmb_head;
+  ConvertToBf16ForInference(*head.merge_net_feature);
+  ConvertToBf16ForInference(*head.merge_net_query_feature);
+  ConvertToBf16ForInference(*head.query_embedding);
+  ConvertToBf16ForInference(*head.transformer);
 }
 
 PoemModel MakeRandomPoemModel(const PoemConfig& config, uint64_t seed) {

@@ -97,6 +97,12 @@ struct PoemModelImpl : torch::nn::Module {
   // head run without gradients: training the head on frozen features. Needs
   // config.mask_head.
   torch::Tensor MaskLogitsOnFrozenFeatures(const torch::Tensor& images);
+  // network.precision: bf16 (docs/speed.md "Reduced precision"): the backbone, the
+  // decoders, the view-merge and query MLPs and the transformer's attention compute
+  // their products in bf16 (ConvertToBf16ForInference). The geometry (soft-argmax,
+  // DLT, inverse skinning, the ball centre and the regression heads) stays fp32.
+  // Inference only: call after eval() and FoldNormsForInference.
+  void UseBf16ForInference();
 
   const PoemConfig& config() const { return config_; }
   // Optional: every forward() adds its stage times here (not owned; null = off).

@@ -31,8 +31,25 @@ torch::Tensor FrozenBatchNorm2dImpl::forward(const torch::Tensor& x) {
   return x * scale + shift;
 }
 
+torch::Tensor CastForInference(const torch::Tensor& x, torch::ScalarType type) {
+  if (x.scalar_type() == type) return x;
+  // empty + copy_ keeps x's memory format and runs ATen's vectorised conversion (on
+  // LibTorch 1.13, x.to(kBFloat16) took 20-40x as long for the same copy).
+  return at::empty_like(x, x.options().dtype(type)).copy_(x);
+}
+
 torch::Tensor FoldedConv::operator()(const torch::Tensor& x) const {
-  return at::conv2d(x, weight, bias, stride, padding);
+  if (weight.scalar_type() == x.scalar_type()) {
+    return at::conv2d(x, weight, bias, stride, padding);
+  }
+  // Channels-last: oneDNN's bf16 kernels then read and write the activations in place
+  // of reordering them to and from its blocked layout on every call.
+  const torch::Tensor low =
+      at::empty(x.sizes(), x.options().dtype(weight.scalar_type()),
+                at::MemoryFormat::ChannelsLast)
+          .copy_(x);
+  const torch::Tensor y = at::conv2d(low, weight, bias, stride, padding);
+  return CastForInference(y, x.scalar_type());
 }
 
 FoldedConv FoldConvNorm(const torch::nn::Conv2dImpl& conv, torch::nn::Module& norm) {
@@ -59,6 +76,27 @@ FoldedConv FoldConvNorm(const torch::nn::Conv2dImpl& conv, torch::nn::Module& no
   f.padding =
       c10::IntArrayRef(c10::get<torch::ExpandingArray<2>>(conv.options.padding())).vec();
   return f;
+}
+
+void ConvertToBf16ForInference(torch::nn::Module& module) {
+  torch::NoGradGuard no_grad;
+  auto convert = [](FoldedConv& f) {
+    if (!f.defined()) return;
+    f.weight = f.weight.to(torch::kBFloat16);
+    f.bias = f.bias.to(torch::kBFloat16);
+  };
+  for (const auto& m : module.modules()) {
+    if (auto* block = m->as<BasicBlock>()) {
+      HL_CHECK(block->folded1.defined(), "ConvertToBf16ForInference: fold the norms first");
+      convert(block->folded1), convert(block->folded2), convert(block->folded_downsample);
+    }
+    if (auto* resnet = m->as<ResNet>()) convert(resnet->folded_stem);
+    if (auto* conv_block = m->as<ConvBlock>()) convert(conv_block->folded);
+    if (auto* linear = m->as<torch::nn::Linear>()) {
+      linear->weight.set_data(linear->weight.to(torch::kBFloat16));
+      if (linear->bias.defined()) linear->bias.set_data(linear->bias.to(torch::kBFloat16));
+    }
+  }
 }
 
 void FoldNormsForInference(torch::nn::Module& model) {
@@ -222,15 +260,24 @@ torch::nn::Sequential Mlp(int64_t in, int64_t hidden, int64_t out) {
 
 bool UseInferenceKernels() { return !torch::GradMode::is_enabled(); }
 
-torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
-                              const torch::Tensor& x) {
+namespace {
+
+// layer(x) in the layer's own precision (bf16 after ConvertToBf16ForInference).
+torch::Tensor LinearInLayerPrecision(const torch::nn::LinearImpl& layer,
+                                     const torch::Tensor& x) {
   const int64_t out = layer.weight.size(0), in = layer.weight.size(1);
   HL_CHECK(x.size(-1) == in, "InferenceLinear: input width differs from the layer's");
   std::vector<int64_t> shape = x.sizes().vec();
   shape.back() = out;
-  const torch::Tensor rows = x.reshape({-1, in}).contiguous();
+  // One pass: a cast writes contiguous rows whatever x's strides.
+  const torch::Tensor flat = x.reshape({-1, in});
+  const torch::Tensor rows =
+      layer.weight.scalar_type() == x.scalar_type()
+          ? flat.contiguous()
+          : at::empty(flat.sizes(), flat.options().dtype(layer.weight.scalar_type()))
+                .copy_(flat);
   const int64_t m = rows.size(0);
-  if (m == 0) return torch::empty(shape, x.options());
+  if (m == 0) return torch::empty(shape, rows.options());
   // Row-major (m, in) is a (1, in, m, 1) image in channels-last layout: no copy, and
   // oneDNN writes the (1, out, m, 1) result channels-last, i.e. row-major (m, out).
   const torch::Tensor image = rows.as_strided({1, in, m, 1}, {m * in, 1, in, in});
@@ -241,18 +288,28 @@ torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
   return y.permute({0, 2, 3, 1}).reshape(shape);
 }
 
+}  // namespace
+
+torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
+                              const torch::Tensor& x) {
+  return CastForInference(LinearInLayerPrecision(layer, x), x.scalar_type());
+}
+
 torch::Tensor InferenceMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {
+  // Between the layers the activations stay in the layers' precision: with bf16
+  // products on attention-sized chunks, casting every hidden activation to fp32 and
+  // back cost about as much as the products.
   torch::Tensor y = x;
   for (const auto& child : mlp.children()) {
     if (const auto* linear = child->as<torch::nn::Linear>()) {
-      y = InferenceLinear(*linear, y);
+      y = LinearInLayerPrecision(*linear, y);
     } else {
       HL_CHECK(child->as<torch::nn::ReLU>() != nullptr,
                "InferenceMlp: only Linear and ReLU modules");
       y = torch::relu_(y);
     }
   }
-  return y;
+  return CastForInference(y, x.scalar_type());
 }
 
 torch::Tensor RunMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {

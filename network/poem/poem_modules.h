@@ -37,6 +37,16 @@ FoldedConv FoldConvNorm(const torch::nn::Conv2dImpl& conv, torch::nn::Module& no
 // training never fold). Outputs differ from the unfolded path by rounding only.
 void FoldNormsForInference(torch::nn::Module& model);
 
+// Reduced precision for inference (network.precision: bf16, docs/speed.md): gives every
+// folded convolution and every Linear under `module` bf16 weights. Their products then
+// take bf16 inputs (cast on the way in) and accumulate in fp32 inside oneDNN; the
+// results are cast back, so every other operation still sees and computes fp32.
+// Inference only, after FoldNormsForInference: the autograd path no longer runs on the
+// converted Linears.
+void ConvertToBf16ForInference(torch::nn::Module& module);
+// x as `type`, in x's memory format; x itself when it already has that type.
+torch::Tensor CastForInference(const torch::Tensor& x, torch::ScalarType type);
+
 // ResNet basic block; `frozen_bn` selects FrozenBatchNorm2d (first block of a stage in
 // the reference) or BatchNorm2d (the others).
 struct BasicBlockImpl : torch::nn::Module {

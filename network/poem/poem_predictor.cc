@@ -23,11 +23,13 @@ std::string FrameView(size_t f, size_t v) {
 
 class PoemPredictor : public HandMeshPredictor {
  public:
-  PoemPredictor(PoemModel model, int batch_size)
-      : model_(std::move(model)), batch_size_(batch_size) {
+  PoemPredictor(PoemModel model, int batch_size, const std::string& precision)
+      : model_(std::move(model)), batch_size_(batch_size), precision_(precision) {
     model_->eval();
     FoldNormsForInference(*model_);
+    if (precision_ == "bf16") model_->UseBf16ForInference();
   }
+  std::string precision() const override { return precision_; }
 
   std::string name() const override { return "poem"; }
   int num_views() const override { return model_->config().num_views; }
@@ -132,6 +134,7 @@ class PoemPredictor : public HandMeshPredictor {
 
   PoemModel model_;
   int batch_size_;
+  std::string precision_;
 };
 
 PoemModel LoadModel(const HandMeshPredictorOptions& o) {
@@ -168,6 +171,27 @@ void HandMeshPredictorOptions::Check(const std::string& source) const {
   RequireAtLeast(source, "num_threads", num_threads, 0,
                  ">= 0 (0 = all hardware threads)");
   RequireAtLeast(source, "batch_size", batch_size, 1);
+  if (precision != "fp32" && precision != "bf16" && precision != "auto") {
+    throw InputError(source, "precision", "fp32, bf16 or auto", precision);
+  }
+}
+
+bool CpuHasBf16Unit() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512bf16") || __builtin_cpu_supports("amx-bf16");
+}
+
+bool CpuCanRunBf16() {
+  // LibTorch 1.13's oneDNN bf16 convolutions refuse CPUs without these (they emulate
+  // the bf16 products with AVX-512 where there is no bf16 unit).
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl") &&
+         __builtin_cpu_supports("avx512dq");
+}
+
+std::string ResolvePrecision(const std::string& precision) {
+  if (precision != "auto") return precision;
+  return CpuHasBf16Unit() ? "bf16" : "fp32";
 }
 
 std::unique_ptr<HandMeshPredictor> CreateHandMeshPredictor(
@@ -176,8 +200,16 @@ std::unique_ptr<HandMeshPredictor> CreateHandMeshPredictor(
   const int threads = options.num_threads > 0
                           ? options.num_threads
                           : std::max(1u, std::thread::hardware_concurrency());
+  const std::string precision = ResolvePrecision(options.precision);
+  if (precision == "bf16" && !CpuCanRunBf16()) {
+    throw InputError("hand mesh predictor options", "precision",
+                     "fp32 or auto on this CPU (bf16 needs AVX-512 BW/VL/DQ, which it "
+                     "lacks)",
+                     "bf16");
+  }
   at::set_num_threads(threads);
-  return std::make_unique<PoemPredictor>(LoadModel(options), options.batch_size);
+  return std::make_unique<PoemPredictor>(LoadModel(options), options.batch_size,
+                                         precision);
 }
 
 void WriteRandomPoemCheckpoint(const PoemConfig& config, uint64_t seed,

@@ -123,6 +123,7 @@ TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
   EXPECT_EQ(next.quality.max_detector_rms_px, chosen["max_detector_rms_px"].get<double>());
   EXPECT_TRUE(next.keypoints_from_detector);
   EXPECT_GT(next.detector_every, 1);
+  EXPECT_EQ(next.network_precision, "auto");
   const auto new_job = RunHandlabelCommand({"label", "--job", out + "/new_recordings.yaml"});
   ASSERT_EQ(new_job.status, 0) << new_job.err;
   // Frames where the detector finds the hand in no view fail by name (issue 46: they

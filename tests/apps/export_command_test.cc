@@ -28,9 +28,9 @@ using testing::RunHandlabelCommand;
 
 using ExportCommand = testing::LabelledCaptureForExport;
 
-TEST_F(ExportCommand, SmplxAndManopthLayersReproduceTheLabels) {
+TEST_F(ExportCommand, ManoLayersOfEveryConventionReproduceTheLabels) {
   std::string npz_specs;
-  for (const std::string convention : {"smplx", "manopth"}) {
+  for (const std::string convention : {"smplx", "manopth", "manotorch"}) {
     for (const std::string flat : {"true", "false"}) {
       const std::string out = *dir_ + "/" + convention + "_" + flat + ".npz";
       const auto r = RunHandlabelCommand({"export", "--labels", OutDir(), "--format",
@@ -61,9 +61,9 @@ TEST_F(ExportCommand, SmplxAndManopthLayersReproduceTheLabels) {
     ++right;
   }
   // 2 layers x 2 flat_hand_mean settings from the labels, manotorch's 4 (both
-  // flat_hand_mean, center_idx=9, quaternions), and the 4 npz files' parameters, plus
-  // their stored arrays.
-  EXPECT_EQ(right, 4 + 4 + 4 + 4);
+  // flat_hand_mean, center_idx=9, quaternions), and the 6 npz files' parameters (3
+  // conventions x 2 flat_hand_mean), plus their stored arrays.
+  EXPECT_EQ(right, 4 + 4 + 6 + 6);
   EXPECT_EQ(wrong, 3);
 }
 

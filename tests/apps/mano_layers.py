@@ -282,6 +282,10 @@ def npz_cases(model, spec):
             v, j = smplx_mano(model, data["betas"][i], data["global_orient"][i],
                               data["hand_pose"][i], data["transl"][i], flat)
             k = keypoints_from_smplx(model, v, j)
+        elif convention == "manotorch":  # no translation argument: add transl after
+            v, k, _ = manotorch_layer(model, data["pose_coeffs"][i], data["betas"][i],
+                                      flat)
+            v, k, j = v + data["transl"][i], k + data["transl"][i], None
         else:
             v, k = manopth_layer(model, data["pose_coeffs"][i], data["betas"][i],
                                  data["transl"][i], flat)

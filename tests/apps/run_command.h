@@ -12,6 +12,7 @@
 #include <chrono>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "apps/commands.h"
@@ -39,8 +40,30 @@ inline CommandResult RunHandlabelCommand(std::vector<std::string> args) {
 // Starts build/apps/handlabel with `args`; stdout and stderr are appended to `log`.
 // With `file_size_limit` > 0, the child cannot write a file beyond that many bytes
 // (RLIMIT_FSIZE; the write fails with EFBIG, SIGXFSZ ignored): a disk that fills up.
+// `env` (name, value) pairs are set in the child's environment on top of the test's.
 inline pid_t SpawnHandlabel(const std::vector<std::string>& args, const std::string& log,
-                            rlim_t file_size_limit = 0) {
+                            rlim_t file_size_limit = 0,
+                            const std::vector<std::pair<std::string, std::string>>& env = {}) {
+  // Everything the child needs is built before fork: the child only calls
+  // async-signal-safe functions.
+  std::string binary = std::string(HANDLABEL_BINARY_DIR) + "/apps/handlabel";
+  std::vector<std::string> copy = args;
+  std::vector<char*> argv = {binary.data()};
+  for (std::string& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> variables;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string variable = *e;
+    const std::string name = variable.substr(0, variable.find('='));
+    bool replaced = false;
+    for (const auto& set : env) replaced = replaced || set.first == name;
+    if (!replaced) variables.push_back(variable);
+  }
+  for (const auto& [name, value] : env) variables.push_back(name + "=" + value);
+  std::vector<char*> envp;
+  for (std::string& v : variables) envp.push_back(v.data());
+  envp.push_back(nullptr);
+
   const pid_t pid = fork();
   if (pid == 0) {
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
@@ -51,12 +74,7 @@ inline pid_t SpawnHandlabel(const std::vector<std::string>& args, const std::str
       const rlimit limit{file_size_limit, file_size_limit};
       if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(126);
     }
-    std::string binary = std::string(HANDLABEL_BINARY_DIR) + "/apps/handlabel";
-    std::vector<std::string> copy = args;
-    std::vector<char*> argv = {binary.data()};
-    for (std::string& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(binary.c_str(), argv.data());
+    execve(binary.c_str(), argv.data(), envp.data());
     _exit(127);
   }
   return pid;

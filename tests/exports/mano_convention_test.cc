@@ -16,13 +16,16 @@ HandModel ModelWithMean() {
 }
 
 TEST(ManoConvention, LayerDefaultsAreTheLibrariesOwn) {
-  EXPECT_FALSE(DefaultFlatHandMean(ManoConvention::kSmplx));   // smplx.MANO
-  EXPECT_TRUE(DefaultFlatHandMean(ManoConvention::kManopth));  // manopth.ManoLayer
+  EXPECT_FALSE(DefaultFlatHandMean(ManoConvention::kSmplx));     // smplx.MANO
+  EXPECT_TRUE(DefaultFlatHandMean(ManoConvention::kManopth));    // manopth.ManoLayer
+  EXPECT_TRUE(DefaultFlatHandMean(ManoConvention::kManotorch));  // manotorch's ManoLayer
   EXPECT_EQ(ParseManoConvention("manopth", "--x"), ManoConvention::kManopth);
+  EXPECT_EQ(ParseManoConvention("manotorch", "--x"), ManoConvention::kManotorch);
   EXPECT_EQ(ToString(ParseManoConvention("smplx", "--x")), "smplx");
+  EXPECT_EQ(ToString(ManoConvention::kManotorch), "manotorch");
   EXPECT_NE(testing::InputErrorOf([] {
-              ParseManoConvention("manotorch", "--x");
-            }).find("smplx | manopth"),
+              ParseManoConvention("smpl", "--x");
+            }).find("smplx | manopth | manotorch"),
             std::string::npos);
 }
 

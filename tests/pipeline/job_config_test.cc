@@ -53,6 +53,10 @@ TEST(JobConfig, ReadsFieldsAndResolvesPathsAgainstTheJobFolder) {
   const JobConfig joints = LoadJobConfig(WriteJob(
       "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w, keypoints: joints}\n"));
   EXPECT_EQ(joints.network_keypoints, AnswerKeypoints::kJoints);
+  EXPECT_EQ(job.network_precision, "fp32");  // default: the same labels on every CPU
+  const JobConfig bf16 = LoadJobConfig(WriteJob(
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w, precision: auto}\n"));
+  EXPECT_EQ(bf16.network_precision, "auto");
   const JobConfig with_files = LoadJobConfig(
       WriteJob(std::string(kValidJob) + "evidence: {keypoints_2d: both}\n"));
   EXPECT_DOUBLE_EQ(with_files.network_mask_sigma_px, 16.0);
@@ -99,6 +103,9 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
   ExpectError(
       "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w, keypoints: tips}\n",
       "network.keypoints", "joints | mesh | mean");
+  ExpectError(
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w, precision: fp16}\n",
+      "network.precision", "fp32, bf16 or auto");
   ExpectError(base + "refine: {mode: always}\nevidence: {network_mask_sigma_px: -1}\n",
               "evidence.network_mask_sigma_px", "> 0 pixels");
 }

@@ -335,6 +335,11 @@ TEST(LabelJob, JobHashIgnoresWhereOutputsGoButNotWhatChangesLabels) {
   c.network_keypoints = AnswerKeypoints::kJoints;
   EXPECT_NE(JobHash(a, "w"), JobHash(c, "w"));
   EXPECT_EQ(JobHash(a, ""), JobHash(c, ""));
+  // So does the network's arithmetic (fp32, the default, keeps older jobs' hash).
+  JobConfig d = a;
+  d.network_precision = "bf16";
+  EXPECT_NE(JobHash(a, "w"), JobHash(d, "w"));
+  EXPECT_EQ(JobHash(a, ""), JobHash(d, ""));
 }
 
 // The fields `handlabel fit` brought into the job change the hash only when set, so a
