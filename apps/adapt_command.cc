@@ -47,6 +47,10 @@ int RunAdapt(int argc, char** argv) {
                  "the label stage's check thresholds are chosen on the held-out "
                  "answers: one farther than this from its fit label is bad (default "
                  "10)");
+  app.add_option("--synth-share", o.synth_share,
+                 "share of training samples that are synthetic hands rendered with the "
+                 "capture's cameras over its own backgrounds, with exact targets "
+                 "(0..1, default 0.5; 0 = the capture's frames only)");
   app.add_option("--seed", o.seed, "training order, augmentation and torch seeds");
   bool no_overlays = false;
   app.add_flag("--no-overlays", no_overlays,

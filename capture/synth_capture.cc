@@ -69,6 +69,32 @@ SynthGenerator::SynthGenerator(const HandModel& model, Rig rig,
   anatomy_ = ComputeHandAnatomy(model_);
   limits_ = DefaultHandLimits();
   for (const RigCamera& cam : rig_.cameras()) rays_.emplace_back(cam.camera);
+  CheckPhotoBackgrounds();
+  // The photographs show the real table: the look's own would hide it.
+  if (options_.view.photo_backgrounds) options_.view.realistic.table = false;
+}
+
+void SynthGenerator::CheckPhotoBackgrounds() const {
+  const auto& photos = options_.view.photo_backgrounds;
+  if (!photos) return;
+  if (photos->size() != rig_.size()) {
+    throw InputError("synth options", "view.photo_backgrounds",
+                     "one per rig camera (" + std::to_string(rig_.size()) + ")",
+                     std::to_string(photos->size()));
+  }
+  for (size_t c = 0; c < rig_.size(); ++c) {
+    const ImageU8& photo = (*photos)[c];
+    const Camera& camera = rig_[c].camera;
+    if (photo.width != camera.width() || photo.height != camera.height() ||
+        photo.channels != 3) {
+      throw InputError(
+          "synth options", "view.photo_backgrounds[" + std::to_string(c) + "]",
+          "RGB of camera " + rig_[c].name + "'s size " + std::to_string(camera.width()) +
+              " x " + std::to_string(camera.height()),
+          std::to_string(photo.width) + " x " + std::to_string(photo.height) + " x " +
+              std::to_string(photo.channels));
+    }
+  }
 }
 
 SynthFrame SynthGenerator::Generate(int index) const {
@@ -83,8 +109,11 @@ SynthFrame SynthGenerator::Generate(int index) const {
   }
   for (size_t c = 0; c < rig_.size(); ++c) {
     std::mt19937_64 bg_rng(MixSeed(options_.seed, index, kBackgroundStream + 16 * c));
+    const ImageU8* photo = options_.view.photo_backgrounds
+                               ? &(*options_.view.photo_backgrounds)[c]
+                               : nullptr;
     frame.views.push_back(
-        RenderSynthView(frame.scene, rig_[c], rays_[c], options_.view, bg_rng));
+        RenderSynthView(frame.scene, rig_[c], rays_[c], options_.view, bg_rng, photo));
     if (options_.write_detections) {
       std::mt19937_64 det_rng(MixSeed(options_.seed, index, kDetectionStream + 16 * c));
       frame.detections.push_back(

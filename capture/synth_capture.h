@@ -61,6 +61,8 @@ class SynthGenerator {
   SynthFrame Generate(int index) const;
 
  private:
+  void CheckPhotoBackgrounds() const;
+
   HandModel model_;
   Rig rig_;
   SynthCaptureOptions options_;

@@ -1,5 +1,6 @@
 #include "capture/synth_view.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/errors.h"
@@ -16,9 +17,58 @@ void SynthViewOptions::Check(const std::string& source) const {
   }
 }
 
+namespace {
+
+// Pixels of a drawn one's edge that take the render's blur and noise too, so the
+// render's edges blend into a photograph.
+constexpr int kBlendPx = 2;
+
+// Over a photograph the camera's blur and noise belong to the rendered pixels only (the
+// photograph has its own, and a whole-image pass costs more than the render): they are
+// applied to the drawn pixels' bounding box and kept within kBlendPx of a drawn pixel.
+void ApplyCameraEffectsToDrawn(const VisibilityBuffer& buffer, double blur_sigma,
+                               double noise_sigma, std::mt19937_64& rng, ImageU8* rgb) {
+  const int w = buffer.width, h = buffer.height;
+  int x0 = w, y0 = h, x1 = -1, y1 = -1;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (buffer.mesh_id[buffer.index(x, y)] < 0) continue;
+      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+  }
+  if (x1 < 0) return;  // nothing drawn
+  const int margin = kBlendPx + static_cast<int>(std::ceil(3 * blur_sigma));
+  x0 = std::max(0, x0 - margin), y0 = std::max(0, y0 - margin);
+  x1 = std::min(w - 1, x1 + margin), y1 = std::min(h - 1, y1 + margin);
+  ImageU8 box(x1 - x0 + 1, y1 - y0 + 1, 3);
+  for (int y = y0; y <= y1; ++y) {
+    std::copy_n(&rgb->at(x0, y), 3 * box.width, &box.at(0, y - y0));
+  }
+  ApplyCameraBlurAndNoise(blur_sigma, noise_sigma, rng, &box);
+  const auto near_drawn = [&](int x, int y) {
+    for (int dy = -kBlendPx; dy <= kBlendPx; ++dy) {
+      for (int dx = -kBlendPx; dx <= kBlendPx; ++dx) {
+        const int u = x + dx, v = y + dy;
+        if (u >= 0 && v >= 0 && u < w && v < h && buffer.mesh_id[buffer.index(u, v)] >= 0) {
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      if (near_drawn(x, y)) std::copy_n(&box.at(x - x0, y - y0), 3, &rgb->at(x, y));
+    }
+  }
+}
+
+}  // namespace
+
 SynthView RenderSynthView(const SynthScene& scene, const RigCamera& camera,
                           const PixelRays& rays, const SynthViewOptions& options,
-                          std::mt19937_64& background_rng) {
+                          std::mt19937_64& background_rng,
+                          const ImageU8* photo_background) {
   const int w = camera.camera.width(), h = camera.camera.height();
   SynthView view;
   VisibilityBuffer buffer;
@@ -41,12 +91,21 @@ SynthView RenderSynthView(const SynthScene& scene, const RigCamera& camera,
   }
 
   const bool realistic = options.appearance == SynthAppearance::kRealistic;
-  view.rgb = realistic ? MakeWallBackground(w, h, background_rng)
-                       : MakeBackground(w, h, options.background, background_rng);
+  if (photo_background) {
+    view.rgb = *photo_background;
+  } else {
+    view.rgb = realistic ? MakeWallBackground(w, h, background_rng)
+                         : MakeBackground(w, h, options.background, background_rng);
+  }
   ShadeVisible(meshes, buffer, camera.cam_from_world, rays, scene.lighting, &view.rgb);
   if (realistic) {
     const double noise = Uniform(background_rng, 1.0, options.realistic.max_noise);
-    ApplyCameraBlurAndNoise(options.realistic.blur, noise, background_rng, &view.rgb);
+    if (photo_background) {
+      ApplyCameraEffectsToDrawn(buffer, options.realistic.blur, noise, background_rng,
+                                &view.rgb);
+    } else {
+      ApplyCameraBlurAndNoise(options.realistic.blur, noise, background_rng, &view.rgb);
+    }
   }
   view.hand_mask = ImageU8(w, h, 1);
   view.object_mask = ImageU8(w, h, 1);

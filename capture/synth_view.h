@@ -20,8 +20,10 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "capture/synth_appearance.h"
 #include "capture/synth_background.h"
@@ -46,6 +48,14 @@ struct SynthViewOptions {
   // drawn in both.
   SynthAppearance appearance = SynthAppearance::kBasic;
   RealisticLookOptions realistic;
+  // Photographs of the scene without the hand, one per rig camera (rig order), each of
+  // its camera's size: drawn behind the render instead of the wall or the procedural
+  // background, so the hand appears in the user's own scene (image/median_image.h
+  // makes them from a recording). Empty: none. SynthGenerator checks the count and
+  // sizes, and leaves the realistic look's table out (the photographs have the real one);
+  // the look's camera blur and noise then touch the rendered pixels and their edges only
+  // (the photographs have their own).
+  std::shared_ptr<const std::vector<ImageU8>> photo_backgrounds;
   void Check(const std::string& source) const;
 };
 
@@ -62,9 +72,11 @@ struct SynthView {
   std::string status;              // "visible", "occluded" or "out_of_frame"
 };
 
-// `rays` must belong to `camera.camera`. The background is drawn from `background_rng`.
+// `rays` must belong to `camera.camera`. The background is `photo_background` when
+// given (the camera's size), else drawn from `background_rng`.
 SynthView RenderSynthView(const SynthScene& scene, const RigCamera& camera,
                           const PixelRays& rays, const SynthViewOptions& options,
-                          std::mt19937_64& background_rng);
+                          std::mt19937_64& background_rng,
+                          const ImageU8* photo_background = nullptr);
 
 }  // namespace handlabel

@@ -31,7 +31,8 @@ nlohmann::json ReadIfExists(const std::string& path) {
 }
 
 // A job over the capture's detections without masks (their 2D is the evidence).
-JobConfig CaptureJob(const AdaptRun& run, const std::string& name, const std::string& out) {
+JobConfig CaptureJob(const AdaptRun& run, const std::string& name,
+                     const std::string& out) {
   JobConfig job;
   job.source_file = "handlabel adapt";
   job.name = name;
@@ -105,7 +106,9 @@ void ClaimFolder(const AdaptRun& run) {
   const std::string path = run.Path("adapt.json");
   const nlohmann::json wanted = AdaptOptionsJson(run.o);
   if (fs::exists(path)) {
-    const nlohmann::json had = ReadJsonFileStrict(path);
+    nlohmann::json had = ReadJsonFileStrict(path);
+    // Runs from before synthetic samples trained on the capture alone.
+    if (!had.contains("synth_share")) had["synth_share"] = 0.0;
     for (const auto& [key, value] : wanted.items()) {
       if (!had.contains(key) || had[key] != value) {
         throw InputError(path, key,
@@ -119,7 +122,8 @@ void ClaimFolder(const AdaptRun& run) {
     return;
   }
   if (fs::exists(run.out) && !fs::is_empty(run.out)) {
-    throw InputError(run.out.string(), "--out", "a new or empty folder (or an adapt run's)",
+    throw InputError(run.out.string(), "--out",
+                     "a new or empty folder (or an adapt run's)",
                      "a folder with other files and no adapt.json");
   }
   fs::create_directories(run.out / "stages");
@@ -144,11 +148,11 @@ void RunStage(AdaptRun* run, const std::string& name, StageFn&& stage) {
   stage();
   const double seconds = SecondsSince(t0);
   run->progress[name] = run->progress.value(name, 0.0) + seconds;
-  WriteFileAtomically(run->Path("progress.json"),
-                      nlohmann::json{{"seconds", run->progress},
-                                     {"total_seconds", run->ElapsedSeconds()}}
-                              .dump(1) +
-                          "\n");
+  WriteFileAtomically(
+      run->Path("progress.json"),
+      nlohmann::json{{"seconds", run->progress}, {"total_seconds", run->ElapsedSeconds()}}
+              .dump(1) +
+          "\n");
   WriteFileAtomically(marker, nlohmann::json{{"seconds", seconds}}.dump() + "\n");
   run->Say(name + ": done in " + FormatNumber(std::round(seconds)) + " s");
 }
@@ -215,7 +219,8 @@ AdaptRun PrepareRun(const AdaptOptions& options, std::ostream* log) {
   run.o.weights = fs::absolute(run.o.weights).lexically_normal().string();
   const CaptureReader capture(run.o.capture_dir);
   run.num_cameras = capture.num_cameras();
-  for (int f = 0; f < capture.num_frames(); ++f) run.frames.push_back(capture.frame_id(f));
+  for (int f = 0; f < capture.num_frames(); ++f)
+    run.frames.push_back(capture.frame_id(f));
   std::sort(run.frames.begin(), run.frames.end());
   SplitFrames(&run);
   return run;
@@ -226,11 +231,14 @@ AdaptSummary RunStages(const AdaptOptions& options, std::ostream* log) {
   AdaptRun run = PrepareRun(options, log);
   ClaimFolder(run);
   LoadProgress(&run);
-  run.Say(std::to_string(run.frames.size()) + " frames, " + std::to_string(run.train.size()) +
-          " to train on, " + std::to_string(run.heldout.size()) + " held out; budget " +
+  run.Say(std::to_string(run.frames.size()) + " frames, " +
+          std::to_string(run.train.size()) + " to train on, " +
+          std::to_string(run.heldout.size()) + " held out; budget " +
           FormatNumber(run.o.budget_minutes) + " min");
   RunStage(&run, "detect", [&] { DetectStage(run); });
   RunStage(&run, "fit", [&] { FitStage(run); });
+  if (run.o.synth_share > 0)
+    RunStage(&run, "backgrounds", [&] { BackgroundsStage(run); });
   RunStage(&run, "train", [&] { TrainStage(&run); });
   RunStage(&run, "export", [&] { ExportStage(run); });
   if (!run.heldout.empty()) RunStage(&run, "heldout", [&] { HeldoutStage(run); });
@@ -249,21 +257,27 @@ AdaptSummary RunStages(const AdaptOptions& options, std::ostream* log) {
 }  // namespace adapt
 
 void AdaptOptions::Check(const std::string& source) const {
-  if (capture_dir.empty()) throw InputError(source, "--capture", "a capture folder", "empty");
+  if (capture_dir.empty())
+    throw InputError(source, "--capture", "a capture folder", "empty");
   if (out_dir.empty()) throw InputError(source, "--out", "an output folder", "empty");
   RequireGreater(source, "--budget", budget_minutes, 0);
   RequireAtLeast(source, "--threads", threads, 1);
   RequireGreater(source, "--learning-rate", learning_rate, 0);
   RequireGreater(source, "--accept-mm", accept_mm, 0);
+  RequireInRange(source, "--synth-share", synth_share, 0.0, 1.0);
   selection.Check(source);
 }
 
 nlohmann::json AdaptOptionsJson(const AdaptOptions& o) {
-  return {{"capture", o.capture_dir},        {"weights", o.weights},
-          {"heldout", o.heldout},            {"label_min_views", o.selection.min_views},
+  return {{"capture", o.capture_dir},
+          {"weights", o.weights},
+          {"heldout", o.heldout},
+          {"label_min_views", o.selection.min_views},
           {"label_max_rms_px", o.selection.max_view_rms_px},
-          {"learning_rate", o.learning_rate}, {"seed", o.seed},
-          {"accept_mm", o.accept_mm}};
+          {"learning_rate", o.learning_rate},
+          {"seed", o.seed},
+          {"accept_mm", o.accept_mm},
+          {"synth_share", o.synth_share}};
 }
 
 AdaptSummary RunAdaptation(const AdaptOptions& options, std::ostream* log) {

@@ -6,8 +6,12 @@
 //   detect    MediaPipe Hands on every frame, when the capture has no detections yet
 //             (written into the capture, as `handlabel detect --capture` does)
 //   fit       a fit-only job from the detections: <out>/fit/labels/
+//   backgrounds  every camera's empty scene, the median of frames with the labelled
+//             hand left out, for synthetic hands in the capture's look (only with
+//             synth_share > 0): <out>/backgrounds/<camera>.png
 //   train     fine-tunes the starting weights on the frames whose fit label agrees
-//             with its detections (LabelSelectionRule), validating on a block of
+//             with its detections (LabelSelectionRule) mixed with synthetic hands
+//             over those backgrounds (synth_share), validating on a block of
 //             held-out frames that never trains; the number of steps is planned once
 //             from the measured time per step and the budget: <out>/train/ (plan.json)
 //   export    the mean of the checkpoints of the last 30 % of the steps (low learning
@@ -23,6 +27,7 @@
 // It lives in pipeline/ because it builds and runs label jobs (JobConfig, their
 // quality thresholds) and a training config around the network and the fitter. The
 // code: adapt.cc (options, output folder, the stages in order; detect, fit, label),
+// adapt_synthetic.cc (backgrounds, the synthetic samples),
 // adapt_training.cc (train, export), adapt_report.cc (held-out measurement, model
 // card), adapt_thresholds.h (the thresholds' choice); adapt_run.h is their shared,
 // internal state.
@@ -55,6 +60,11 @@ struct AdaptOptions {
   // held-out answers (pipeline/adapt_thresholds.h): an answer farther than this from
   // its fit label (mean keypoint distance, mm) counts as bad.
   double accept_mm = 10;
+  // Share of training samples rendered in the capture's look (0..1): hands with exact
+  // targets drawn with the capture's cameras over its own backgrounds (the backgrounds
+  // stage); the rest are the capture's frames with their fit labels. 0: capture frames
+  // only (and no backgrounds stage).
+  double synth_share = 0.5;
   uint64_t seed = 1;  // training order, augmentation and torch seeds
   // Also write overlay pictures of the held-out and final labels.
   bool overlays = true;
@@ -66,9 +76,9 @@ struct AdaptOptions {
 nlohmann::json AdaptOptionsJson(const AdaptOptions& options);
 
 struct AdaptSummary {
-  std::string network_path;     // <out>/network.pt
-  std::string labels_dir;       // <out>/labels
-  nlohmann::json card;          // the model card's content
+  std::string network_path;  // <out>/network.pt
+  std::string labels_dir;    // <out>/labels
+  nlohmann::json card;       // the model card's content
 };
 
 // Runs (or continues) the stages. Throws InputError naming the file and field when

@@ -6,15 +6,20 @@
 // command's interface.
 
 #include <filesystem>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "capture/frame_source.h"
+#include "hand/hand_model.h"
 #include "pipeline/adapt.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_summary.h"
+#include "training/capture_training_samples.h"
+#include "training/training_samples.h"
 
 namespace handlabel {
 namespace adapt {
@@ -54,8 +59,9 @@ LabelSummary RunJob(const AdaptRun& run, const JobConfig& job);
 std::vector<std::string> WithFitLabel(const AdaptRun& run,
                                       const std::vector<std::string>& frames);
 
-// The stages of adapt_training.cc and adapt_report.cc (pipeline/adapt.h says what each
-// does and writes).
+// The stages of adapt_synthetic.cc, adapt_training.cc and adapt_report.cc
+// (pipeline/adapt.h says what each does and writes).
+void BackgroundsStage(const AdaptRun& run);
 void TrainStage(AdaptRun* run);
 void ExportStage(const AdaptRun& run);
 void HeldoutStage(const AdaptRun& run);
@@ -65,6 +71,13 @@ void HeldoutStage(const AdaptRun& run);
 // kNewRecordingsDetectorEvery and the network's crops tracked in between.
 constexpr int kNewRecordingsDetectorEvery = 10;
 std::string JobForNewRecordings(const AdaptRun& run);
+
+// Synthetic training samples in the capture's look (adapt_synthetic.cc): hands rendered
+// with `capture`'s cameras over the backgrounds stage's pictures, placed where the
+// training `labels` put the hand, realistic look, half of them holding objects.
+std::unique_ptr<SynthTrainingSamples> CaptureLookSynthSamples(
+    const AdaptRun& run, const FrameSource& capture, const HandModel& hand,
+    const std::vector<LabeledFrame>& labels, const TrainingSampleOptions& samples);
 
 // The model card (model_card.json) and its Markdown (model_card.md).
 nlohmann::json ModelCard(const AdaptRun& run);

@@ -17,12 +17,16 @@
 #include "core/json_util.h"
 #include "core/stopwatch.h"
 #include "core/text.h"
+#include "image/image_file.h"
 #include "network/poem/loss_plot.h"
 #include "network/poem/poem_trainer.h"
 #include "pipeline/capture_training_data.h"
 #include "pipeline/label_record.h"
 #include "pipeline/train_config.h"
 #include "training/capture_training_samples.h"
+#include "training/mixed_training_samples.h"
+#include "training/sample_sheet.h"
+#include "training/training_samples.h"
 
 namespace handlabel {
 namespace adapt {
@@ -36,6 +40,7 @@ constexpr int64_t kTimingSteps = 20;
 // The averaged checkpoints: those of the last 30 % of the steps, where the rate is low.
 constexpr double kDecayAt = 0.7;
 constexpr int kMaxBatchNormSamples = 256;
+constexpr int kSynthFrameReuse = 4;
 
 std::string CpuModelName() {
   std::ifstream in("/proc/cpuinfo");
@@ -89,17 +94,35 @@ TrainConfig AdaptTrainConfig(const AdaptRun& run) {
   return c;
 }
 
-// The capture's labelled frames as training and held-out samples.
+// The capture's labelled frames as training and held-out samples, and the training
+// samples: those frames mixed with synthetic ones in the capture's look.
 struct AdaptSamples {
   CaptureTrainingData data;
-  std::unique_ptr<CaptureTrainingSamples> train, heldout, batch_norm;
+  std::unique_ptr<CaptureTrainingSamples> capture_train, heldout, batch_norm;
+  std::unique_ptr<SynthTrainingSamples> synth;
+  std::unique_ptr<MixedTrainingSamples> mixed;
+  const TrainingSampleSource* train = nullptr;  // one of the above
 };
 
-AdaptSamples LoadSamples(const AdaptRun& run, const TrainConfig& c, const HandModel& hand) {
+AdaptSamples LoadSamples(const AdaptRun& run, const TrainConfig& c,
+                         const HandModel& hand) {
   AdaptSamples s;
   s.data = LoadCaptureTrainingData(TrainingInputs(run), hand.num_vertices());
-  s.train = std::make_unique<CaptureTrainingSamples>(*s.data.source, s.data.train,
-                                                     CaptureSampleOptionsFor(c, false));
+  s.capture_train = std::make_unique<CaptureTrainingSamples>(
+      *s.data.source, s.data.train, CaptureSampleOptionsFor(c, false));
+  s.train = s.capture_train.get();
+  if (run.o.synth_share > 0) {
+    TrainingSampleOptions synth = c.samples;
+    synth.crop_size = c.network.crop_size;
+    synth.augment_seed = run.o.seed;
+    // Each rendered frame gives several samples (fresh augmentation each): rendering
+    // a frame of every camera costs more than a training step's share of it.
+    synth.frame_reuse = kSynthFrameReuse;
+    s.synth = CaptureLookSynthSamples(run, *s.data.source, hand, s.data.train, synth);
+    s.mixed = std::make_unique<MixedTrainingSamples>(*s.capture_train, *s.synth,
+                                                     1.0 - run.o.synth_share, run.o.seed);
+    s.train = s.mixed.get();
+  }
   // Batch-norm statistics are measured on the training frames as inference crops them.
   s.batch_norm = std::make_unique<CaptureTrainingSamples>(
       *s.data.source, s.data.train, CaptureSampleOptionsFor(c, true));
@@ -110,8 +133,27 @@ AdaptSamples LoadSamples(const AdaptRun& run, const TrainConfig& c, const HandMo
   return s;
 }
 
-PoemTrainSummary TrainUntil(const AdaptRun& run, const TrainConfig& c, const HandModel& hand,
-                            const AdaptSamples& s, int64_t stop_at) {
+// train/samples.jpg: the first training samples of each source as the network sees
+// them, their targets drawn (training/sample_sheet.h).
+void WriteSampleSheet(const AdaptRun& run, const AdaptSamples& s) {
+  constexpr int kRowsPerSource = 4;
+  std::vector<TrainingSample> rows;
+  int from_capture = 0, synthetic = 0;
+  for (int64_t i = 0; i < 200 && (from_capture < kRowsPerSource ||
+                                  (s.mixed && synthetic < kRowsPerSource));
+       ++i) {
+    const bool capture = !s.mixed || s.mixed->FromFirst(i);
+    int& count = capture ? from_capture : synthetic;
+    if (count >= kRowsPerSource) continue;
+    ++count;
+    rows.push_back(s.train->Sample(i));
+  }
+  WriteJpeg(run.Path("train/samples.jpg"), MakeTrainingSampleSheet(rows));
+}
+
+PoemTrainSummary TrainUntil(const AdaptRun& run, const TrainConfig& c,
+                            const HandModel& hand, const AdaptSamples& s,
+                            int64_t stop_at) {
   PoemTrainerOptions t = c.trainer;
   t.validation_samples = std::max<int>(1, static_cast<int>(s.data.validation.size()));
   if (!s.heldout) {
@@ -172,7 +214,8 @@ void ApplyPlan(const nlohmann::json& plan, TrainConfig* c) {
 }
 
 // The checkpoints of the last 30 % of the steps (the latest one if none).
-std::vector<std::string> AveragedCheckpoints(const std::string& train_dir, int64_t steps) {
+std::vector<std::string> AveragedCheckpoints(const std::string& train_dir,
+                                             int64_t steps) {
   std::vector<std::string> paths;
   const int64_t first = static_cast<int64_t>(std::ceil(kDecayAt * steps));
   for (const auto& entry : fs::directory_iterator(train_dir + "/checkpoints")) {
@@ -192,15 +235,16 @@ void TrainStage(AdaptRun* run) {
   std::string hand_source;
   const HandModel hand = LoadTrainingHandModel(c, &hand_source);
   const AdaptSamples samples = LoadSamples(*run, c, hand);
-  WriteFileAtomically(run->Path("train/capture_labels.json"),
-                      LabelSelectionJson(run->o.selection, samples.data.selection).dump(1) +
-                          "\n");
+  WriteFileAtomically(
+      run->Path("train/capture_labels.json"),
+      LabelSelectionJson(run->o.selection, samples.data.selection).dump(1) + "\n");
   run->Say("train: " + std::to_string(samples.data.train.size()) + " of " +
            std::to_string(run->train.size()) + " training frames kept (" +
            std::to_string(run->train.size() - samples.data.selection.size()) +
            " without a fit label; train/capture_labels.json), " +
            std::to_string(samples.data.validation.size()) + " of " +
            std::to_string(run->heldout.size()) + " held-out frames with a fit label");
+  WriteSampleSheet(*run, samples);
   const std::string plan_path = run->Path("train/plan.json");
   if (!fs::exists(plan_path)) {
     const Clock::time_point t0 = Clock::now();
@@ -231,18 +275,18 @@ void ExportStage(const AdaptRun& run) {
   const std::vector<std::string> paths =
       AveragedCheckpoints(c.trainer.out_dir, plan["steps"].get<int64_t>());
   const int batch = c.trainer.batch_size;
-  const int bn_samples =
-      std::min<int>(kMaxBatchNormSamples,
-                    4 * static_cast<int>(samples.data.train.size())) / batch * batch;
+  const int bn_samples = std::min<int>(kMaxBatchNormSamples,
+                                       4 * static_cast<int>(samples.data.train.size())) /
+                         batch * batch;
   ExportPoemCheckpointAverageAsHalf(paths, run.Path("network.pt"),
                                     samples.batch_norm.get(), bn_samples, batch);
   nlohmann::json names = nlohmann::json::array();
   for (const std::string& p : paths) names.push_back(fs::path(p).filename().string());
-  WriteFileAtomically(run.Path("export.json"),
-                      nlohmann::json{{"averaged_checkpoints", names},
-                                     {"batch_norm_samples", bn_samples}}
-                              .dump(1) +
-                          "\n");
+  WriteFileAtomically(
+      run.Path("export.json"),
+      nlohmann::json{{"averaged_checkpoints", names}, {"batch_norm_samples", bn_samples}}
+              .dump(1) +
+          "\n");
 }
 
 }  // namespace adapt

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/errors.h"
 #include "core/option_checks.h"
@@ -209,7 +210,12 @@ TrainingSample MakeTrainingSample(const SynthFrame& frame, const Rig& rig,
 SynthTrainingSamples::SynthTrainingSamples(const HandModel& model,
                                            const SynthCaptureOptions& synth,
                                            const TrainingSampleOptions& options)
-    : generator_(model, MakePresetRig(synth.rig, synth.seed),
+    : SynthTrainingSamples(model, MakePresetRig(synth.rig, synth.seed), synth, options) {}
+
+SynthTrainingSamples::SynthTrainingSamples(const HandModel& model, Rig rig,
+                                           const SynthCaptureOptions& synth,
+                                           const TrainingSampleOptions& options)
+    : generator_(model, std::move(rig),
                  [&] {
                    SynthCaptureOptions s = synth;
                    s.view.depth = false;

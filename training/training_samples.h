@@ -65,6 +65,9 @@ class SynthTrainingSamples : public TrainingSampleSource {
   // Depth rendering and detections are switched off in `synth` (not needed).
   SynthTrainingSamples(const HandModel& model, const SynthCaptureOptions& synth,
                        const TrainingSampleOptions& options);
+  // On the given rig (pinhole cameras, e.g. a capture's own) instead of synth.rig's.
+  SynthTrainingSamples(const HandModel& model, Rig rig, const SynthCaptureOptions& synth,
+                       const TrainingSampleOptions& options);
   int num_views() const override { return static_cast<int>(generator_.rig().size()); }
   int crop_size() const override { return options_.crop_size; }
   TrainingSample Sample(int64_t index) const override;

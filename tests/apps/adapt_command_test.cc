@@ -14,6 +14,7 @@
 #include <string>
 
 #include "core/json_util.h"
+#include "image/image.h"
 #include "pipeline/job_config.h"
 #include "tests/apps/run_command.h"
 #include "tests/test_util.h"
@@ -58,7 +59,8 @@ std::string SmallCapture(const std::string& dir) {
   return capture;
 }
 
-const char* const kStages[] = {"detect", "fit", "train", "export", "heldout", "label"};
+const char* const kStages[] = {"detect", "fit",     "backgrounds", "train",
+                                "export", "heldout", "label"};
 
 TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
   const std::string dir = testing::ScratchDir();
@@ -74,6 +76,16 @@ TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
     EXPECT_TRUE(fs::exists(out + "/stages/" + stage + ".done")) << stage;
   }
   EXPECT_THAT(first.err, HasSubstr("the capture has detections"));
+  // Synthetic hands in the capture's look: one background per camera, of its size,
+  // and the picture of what training saw.
+  for (int c = 0; c < 8; ++c) {
+    const std::string path = out + "/backgrounds/cam0" + std::to_string(c) + ".png";
+    ASSERT_TRUE(fs::exists(path)) << path;
+    const ImageU8 background = ReadPng(path);
+    EXPECT_EQ(background.width, 160);
+    EXPECT_EQ(background.height, 120);
+  }
+  EXPECT_TRUE(fs::exists(out + "/train/samples.jpg"));
   // A budget too small for training gets the fewest steps, and says so.
   const nlohmann::json plan = ReadJsonFileStrict(out + "/train/plan.json");
   EXPECT_EQ(plan["steps"], 40);
@@ -177,6 +189,10 @@ TEST(AdaptCommand, MissingWeightsAndBadBudgetNameTheFlag) {
       {"adapt", "--capture", dir, "--out", dir + "/a", "--budget", "0"});
   EXPECT_EQ(budget.status, 1);
   EXPECT_THAT(budget.err, HasSubstr("--budget"));
+  const auto share = RunHandlabelCommand(
+      {"adapt", "--capture", dir, "--out", dir + "/a", "--synth-share", "1.5"});
+  EXPECT_EQ(share.status, 1);
+  EXPECT_THAT(share.err, HasSubstr("--synth-share"));
 }
 
 }  // namespace

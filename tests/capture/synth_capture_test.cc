@@ -5,7 +5,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <algorithm>
 #include <map>
+#include <memory>
+#include <random>
 
 #include "capture/capture_reader.h"
 #include "core/errors.h"
@@ -311,6 +314,83 @@ TEST(SynthCapture, BadOptionsNameTheField) {
   o = SmallOptions();
   o.detections.outlier_rate = 1.5;
   EXPECT_THROW(o.Check("test"), InputError);
+}
+
+// Photographs behind the render: every pixel nothing was drawn on is the camera's own
+// photograph, the rendered ones are not, and the realistic look leaves its table out.
+TEST(SynthCapture, PhotoBackgroundsShowWhereNothingIsDrawn) {
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
+  SynthCaptureOptions o = SmallOptions();
+  const Rig rig = MakePresetRig(o.rig, o.seed);
+  auto photos = std::make_shared<std::vector<ImageU8>>();
+  std::mt19937_64 rng(5);
+  for (size_t c = 0; c < rig.size(); ++c) {
+    ImageU8 photo(rig[c].camera.width(), rig[c].camera.height(), 3);
+    for (uint8_t& v : photo.data) v = static_cast<uint8_t>(rng() % 256);
+    photos->push_back(photo);
+  }
+  o.view.photo_backgrounds = photos;
+  const SynthFrame frame = SynthGenerator(model, rig, o).Generate(1);
+  int drawn = 0, photo_pixels = 0;
+  for (size_t c = 0; c < rig.size(); ++c) {
+    const SynthView& view = frame.views[c];
+    for (int y = 0; y < view.rgb.height; ++y) {
+      for (int x = 0; x < view.rgb.width; ++x) {
+        const bool nothing_drawn = view.depth.at(x, y) == 0;
+        const bool same = view.rgb.at(x, y, 0) == (*photos)[c].at(x, y, 0) &&
+                          view.rgb.at(x, y, 1) == (*photos)[c].at(x, y, 1) &&
+                          view.rgb.at(x, y, 2) == (*photos)[c].at(x, y, 2);
+        if (nothing_drawn) {
+          ASSERT_TRUE(same) << "camera " << c << " pixel " << x << ", " << y;
+          ++photo_pixels;
+        } else {
+          drawn += !same;
+        }
+      }
+    }
+  }
+  EXPECT_GT(drawn, 100);
+  EXPECT_GT(photo_pixels, drawn);
+
+  // The realistic look: no table, and its blur and noise leave the photograph alone
+  // away from the render's edges.
+  o.view.appearance = SynthAppearance::kRealistic;
+  const SynthGenerator realistic(model, rig, o);
+  EXPECT_FALSE(realistic.options().view.realistic.table);
+  const SynthFrame look = realistic.Generate(1);
+  int untouched = 0, changed = 0;
+  for (size_t c = 0; c < rig.size(); ++c) {
+    const SynthView& view = look.views[c];
+    const auto drawn_near = [&](int x, int y) {
+      for (int v = std::max(0, y - 3); v <= std::min(view.rgb.height - 1, y + 3); ++v) {
+        for (int u = std::max(0, x - 3); u <= std::min(view.rgb.width - 1, x + 3); ++u) {
+          if (view.depth.at(u, v) > 0) return true;
+        }
+      }
+      return false;
+    };
+    for (int y = 0; y < view.rgb.height; ++y) {
+      for (int x = 0; x < view.rgb.width; ++x) {
+        if (drawn_near(x, y)) continue;
+        const bool same = view.rgb.at(x, y, 0) == (*photos)[c].at(x, y, 0) &&
+                          view.rgb.at(x, y, 1) == (*photos)[c].at(x, y, 1) &&
+                          view.rgb.at(x, y, 2) == (*photos)[c].at(x, y, 2);
+        (same ? untouched : changed) += 1;
+      }
+    }
+  }
+  EXPECT_EQ(changed, 0);
+  EXPECT_GT(untouched, 1000);
+
+  (*photos)[2] = ImageU8(10, 10, 3);
+  try {
+    SynthGenerator(model, rig, o);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "view.photo_backgrounds[2]");
+  }
+  photos->pop_back();
+  EXPECT_THROW(SynthGenerator(model, rig, o), InputError);
 }
 
 }  // namespace
