@@ -104,7 +104,12 @@ std::string FolderLockPath(const std::string& dir) {
 
 FileLock LockFolderForWriting(const std::string& dir, const std::string& what,
                               const std::string& source, const std::string& field) {
-  const std::string path = FolderLockPath(dir);
+  return LockFolderForWriting(dir, FolderLockPath(dir), what, source, field);
+}
+
+FileLock LockFolderForWriting(const std::string& dir, const std::string& path,
+                              const std::string& what, const std::string& source,
+                              const std::string& field) {
   FileLock lock = FileLock::TryAcquire(path, FileLock::Mode::kExclusive);
   if (!lock.held()) {
     const std::string holder = ReadLockHolder(path);

@@ -6,9 +6,10 @@
 // the file, so that the process refused can say who holds the folder.
 //
 // Users: a capture folder (`capture init --overwrite`, `capture import`, `detect
-// --capture`), a `detect --images` output folder, a training run folder (`train`), a
-// label output folder and its shards (pipeline/output_lock.h). A lock is per open file: a second lock of the same file in
-// one process conflicts with the first like another process's would.
+// --capture`), a `detect --images` output folder, a training run folder (`train`), an
+// `adapt` run folder, a label output folder and its shards (pipeline/output_lock.h). A
+// lock is per open file: a second lock of the same file in one process conflicts with the
+// first like another process's would.
 
 #include <string>
 
@@ -58,5 +59,10 @@ std::string FolderLockPath(const std::string& dir);
 // another process holds it.
 FileLock LockFolderForWriting(const std::string& dir, const std::string& what,
                               const std::string& source, const std::string& field);
+// Same with the lock file `path` instead: for a command whose folder's .handlabel.lock
+// belongs to a job it runs inside it (`adapt` locks <out>/adapt.lock).
+FileLock LockFolderForWriting(const std::string& dir, const std::string& path,
+                              const std::string& what, const std::string& source,
+                              const std::string& field);
 
 }  // namespace handlabel

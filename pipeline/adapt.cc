@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/data_dir.h"
 #include "core/errors.h"
+#include "core/file_lock.h"
 #include "core/json_util.h"
 #include "core/option_checks.h"
 #include "core/stopwatch.h"
@@ -101,6 +102,23 @@ void SplitFrames(AdaptRun* run) {
   }
 }
 
+constexpr char kRunLock[] = "adapt.lock";
+
+// One adapt process per folder at a time (core/file_lock.h): the run's label jobs lock
+// <out>/.handlabel.lock themselves, so the run holds <out>/adapt.lock.
+FileLock LockRun(const AdaptRun& run) {
+  fs::create_directories(run.out);
+  return LockFolderForWriting(run.out.string(), run.Path(kRunLock), "adapt", kSource,
+                              "--out");
+}
+
+bool IsEmptyBesidesLock(const fs::path& dir) {
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().filename() != kRunLock) return false;
+  }
+  return true;
+}
+
 // adapt.json: a folder holds one run; a later command must ask for the same one.
 void ClaimFolder(const AdaptRun& run) {
   const std::string path = run.Path("adapt.json");
@@ -121,7 +139,7 @@ void ClaimFolder(const AdaptRun& run) {
     run.Say("continuing the run in " + run.out.string());
     return;
   }
-  if (fs::exists(run.out) && !fs::is_empty(run.out)) {
+  if (fs::exists(run.out) && !IsEmptyBesidesLock(run.out)) {
     throw InputError(run.out.string(), "--out",
                      "a new or empty folder (or an adapt run's)",
                      "a folder with other files and no adapt.json");
@@ -229,6 +247,7 @@ AdaptRun PrepareRun(const AdaptOptions& options, std::ostream* log) {
 // The stages in order, each skipped when an earlier run finished it.
 AdaptSummary RunStages(const AdaptOptions& options, std::ostream* log) {
   AdaptRun run = PrepareRun(options, log);
+  const FileLock writer = LockRun(run);
   ClaimFolder(run);
   LoadProgress(&run);
   run.Say(std::to_string(run.frames.size()) + " frames, " +

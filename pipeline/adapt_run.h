@@ -5,6 +5,7 @@
 // (held-out measurement, thresholds and the model card). pipeline/adapt.h has the
 // command's interface.
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <ostream>
@@ -65,6 +66,16 @@ void BackgroundsStage(const AdaptRun& run);
 void TrainStage(AdaptRun* run);
 void ExportStage(const AdaptRun& run);
 void HeldoutStage(const AdaptRun& run);
+
+// The training plan checked once on the way (plan.json): after the first tenth of its
+// steps (at least 100; ReplanStep, 0 for a plan too short for a check) the seconds
+// per step measured since the timing run replace the timing run's estimate (10 steps:
+// with synthetic hands a step's cost varies by a third from one batch to the next),
+// and Replan plans the steps again for what is left of the budget, `seconds` having
+// passed since the plan was made (its seconds_before_training counts the timing run).
+// The check comes before the learning rate's decay (70 %): only where it starts moves.
+int64_t ReplanStep(const nlohmann::json& plan);
+void Replan(int64_t step, double seconds_per_step, double seconds, nlohmann::json* plan);
 
 // The label job file for new recordings of the rig (new_recordings.yaml): the adapted
 // network with the chosen thresholds, the detector on 1 frame in

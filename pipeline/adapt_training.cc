@@ -230,6 +230,25 @@ std::vector<std::string> AveragedCheckpoints(const std::string& train_dir,
 
 }  // namespace
 
+int64_t ReplanStep(const nlohmann::json& plan) {
+  const int64_t steps = plan["steps"].get<int64_t>();
+  const int64_t at = std::max<int64_t>(5 * kTimingSteps, steps / 10);
+  return 2 * at <= steps ? at : 0;
+}
+
+void Replan(int64_t step, double seconds_per_step, double seconds, nlohmann::json* plan) {
+  const double spent = (*plan)["seconds_before_training"].get<double>() + seconds;
+  const double left = (*plan)["budget_seconds"].get<double>() - spent -
+                      (*plan)["reserve_seconds"].get<double>();
+  const int64_t extra =
+      left > 0 ? static_cast<int64_t>(0.95 * left / seconds_per_step) : kTimingSteps;
+  (*plan)["first_plan_steps"] = (*plan)["steps"];
+  (*plan)["steps"] = step + std::max<int64_t>(extra, kTimingSteps);
+  (*plan)["replanned"] = {{"at_step", step},
+                          {"seconds_per_step", seconds_per_step},
+                          {"seconds_spent", spent}};
+}
+
 void TrainStage(AdaptRun* run) {
   TrainConfig c = AdaptTrainConfig(*run);
   std::string hand_source;
@@ -258,11 +277,28 @@ void TrainStage(AdaptRun* run) {
     WriteFileAtomically(plan_path, plan.dump(1) + "\n");
     run->progress.erase("train_timing");  // the stage's own time counts it
   }
-  const nlohmann::json plan = ReadJsonFileStrict(plan_path);
+  nlohmann::json plan = ReadJsonFileStrict(plan_path);
   run->Say("train: " + plan["steps"].dump() + " steps planned at " +
            FormatNumber(plan["seconds_per_step"].get<double>()) + " s/step (" +
            plan_path + ")");
   ApplyPlan(plan, &c);
+  const int64_t check_at = ReplanStep(plan);
+  const int64_t from =
+      std::max<int64_t>(kTimingSteps, LatestPoemCheckpointStep(c.trainer.out_dir));
+  // A run continued past the check (killed before it wrote the new plan) keeps the first.
+  if (check_at > 0 && !plan.contains("replanned") && from < check_at) {
+    const Clock::time_point t0 = Clock::now();
+    TrainUntil(*run, c, hand, samples, check_at);
+    const double seconds = SecondsSince(t0);
+    Replan(check_at, seconds / static_cast<double>(check_at - from), seconds, &plan);
+    WriteFileAtomically(plan_path, plan.dump(1) + "\n");
+    run->Say("train: steps " + std::to_string(from) + "-" + std::to_string(check_at) +
+             " took " +
+             FormatNumber(plan["replanned"]["seconds_per_step"].get<double>()) +
+             " s/step: " + plan["steps"].dump() + " steps in all (first plan " +
+             plan["first_plan_steps"].dump() + ")");
+    ApplyPlan(plan, &c);
+  }
   TrainUntil(*run, c, hand, samples, -1);
 }
 

@@ -6,6 +6,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 
 #include <filesystem>
 #include <fstream>
@@ -60,16 +61,16 @@ std::string SmallCapture(const std::string& dir) {
 }
 
 const char* const kStages[] = {"detect", "fit",     "backgrounds", "train",
-                                "export", "heldout", "label"};
+                               "export", "heldout", "label"};
 
 TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
   const std::string dir = testing::ScratchDir();
   const std::string weights = TinyWeights(dir), capture = SmallCapture(dir);
   const std::string out = dir + "/adapted";
-  const std::vector<std::string> command = {
-      "adapt",     "--capture", capture, "--out",        out,     "--weights",
-      weights,     "--budget",  "0.01",  "--threads",    "1",     "--heldout",
-      "4:6",       "--no-overlays"};
+  const std::vector<std::string> command = {"adapt", "--capture",    capture, "--out",
+                                            out,     "--weights",    weights, "--budget",
+                                            "0.01",  "--threads",    "1",     "--heldout",
+                                            "4:6",   "--no-overlays"};
   const auto first = RunHandlabelCommand(command);
   ASSERT_EQ(first.status, 0) << first.err;
   for (const char* stage : kStages) {
@@ -97,7 +98,8 @@ TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
   EXPECT_EQ(card["heldout"]["after"]["frames"], 2);
   EXPECT_GT(card["heldout"]["after"]["mpjpe_mm_vs_fit_labels"].get<double>(), 0);
   int labelled = 0;
-  for (const auto& [path, count] : card["labels_by_path"].items()) labelled += count.get<int>();
+  for (const auto& [path, count] : card["labels_by_path"].items())
+    labelled += count.get<int>();
   EXPECT_EQ(labelled, 6);
   int fit_labels = 0;
   for (const auto& entry : fs::directory_iterator(out + "/fit/labels")) {
@@ -129,14 +131,17 @@ TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
   // it runs as written (on the same capture here).
   const JobConfig next = LoadJobConfig(out + "/new_recordings.yaml");
   EXPECT_EQ(next.network_weights, out + "/network.pt");
-  EXPECT_EQ(next.quality.max_reprojection_px, chosen["max_reprojection_px"].get<double>());
+  EXPECT_EQ(next.quality.max_reprojection_px,
+            chosen["max_reprojection_px"].get<double>());
   EXPECT_EQ(next.quality.max_view_disagreement_mm,
             chosen["max_view_disagreement_mm"].get<double>());
-  EXPECT_EQ(next.quality.max_detector_rms_px, chosen["max_detector_rms_px"].get<double>());
+  EXPECT_EQ(next.quality.max_detector_rms_px,
+            chosen["max_detector_rms_px"].get<double>());
   EXPECT_TRUE(next.keypoints_from_detector);
   EXPECT_GT(next.detector_every, 1);
   EXPECT_EQ(next.network_precision, "auto");
-  const auto new_job = RunHandlabelCommand({"label", "--job", out + "/new_recordings.yaml"});
+  const auto new_job =
+      RunHandlabelCommand({"label", "--job", out + "/new_recordings.yaml"});
   ASSERT_EQ(new_job.status, 0) << new_job.err;
   // Frames where the detector finds the hand in no view fail by name (issue 46: they
   // were labelled from no 2D at all, about 20 cm off); every other frame is labelled.
@@ -176,6 +181,27 @@ TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
   EXPECT_EQ(refused.status, 1);
   EXPECT_THAT(refused.err, HasSubstr("adapt.json"));
   EXPECT_THAT(refused.err, HasSubstr("heldout"));
+}
+
+// Two runs in one folder would train, export and label over each other: a second one
+// is refused, naming the first, while the first runs.
+TEST(AdaptCommand, ASecondRunIntoTheFolderIsRefusedWhileTheFirstRuns) {
+  const std::string dir = testing::ScratchDir();
+  const std::string weights = TinyWeights(dir), capture = SmallCapture(dir);
+  const std::string out = dir + "/adapted";
+  const std::vector<std::string> command = {
+      "adapt", "--capture", capture, "--out",     out, "--weights",
+      weights, "--budget",  "0.01",  "--threads", "1", "--no-overlays"};
+  const pid_t first = testing::SpawnHandlabel(command, dir + "/first.log");
+  ASSERT_TRUE(testing::WaitUntilHolding(first, out + "/adapt.lock"))
+      << testing::ReadFileBytes(dir + "/first.log");
+  kill(first, SIGSTOP);  // keeps the lock while the second tries
+  const auto second = RunHandlabelCommand(command);
+  EXPECT_EQ(second.status, 1);
+  EXPECT_THAT(second.err, HasSubstr("--out"));
+  EXPECT_THAT(second.err, HasSubstr("adapt, pid " + std::to_string(first)));
+  kill(first, SIGKILL);
+  EXPECT_EQ(testing::WaitForExit(first), -SIGKILL);
 }
 
 TEST(AdaptCommand, MissingWeightsAndBadBudgetNameTheFlag) {
