@@ -50,7 +50,7 @@ int RunAdapt(int argc, char** argv) {
   app.add_option("--synth-share", o.synth_share,
                  "share of training samples that are synthetic hands rendered with the "
                  "capture's cameras over its own backgrounds, with exact targets "
-                 "(0..1, default 0.5; 0 = the capture's frames only)");
+                 "(0..1, default 0: the capture's frames only; docs/adapt.md)");
   app.add_option("--seed", o.seed, "training order, augmentation and torch seeds");
   bool no_overlays = false;
   app.add_flag("--no-overlays", no_overlays,

@@ -67,10 +67,10 @@ TEST(AdaptCommand, RunsEveryStageContinuesAndRefusesAnotherRunsFolder) {
   const std::string dir = testing::ScratchDir();
   const std::string weights = TinyWeights(dir), capture = SmallCapture(dir);
   const std::string out = dir + "/adapted";
-  const std::vector<std::string> command = {"adapt", "--capture",    capture, "--out",
-                                            out,     "--weights",    weights, "--budget",
-                                            "0.01",  "--threads",    "1",     "--heldout",
-                                            "4:6",   "--no-overlays"};
+  const std::vector<std::string> command = {
+      "adapt", "--capture",     capture,         "--out",     out, "--weights",
+      weights, "--budget",      "0.01",          "--threads", "1", "--heldout",
+      "4:6",   "--no-overlays", "--synth-share", "0.5"};
   const auto first = RunHandlabelCommand(command);
   ASSERT_EQ(first.status, 0) << first.err;
   for (const char* stage : kStages) {
