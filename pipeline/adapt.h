@@ -27,8 +27,7 @@
 // It lives in pipeline/ because it builds and runs label jobs (JobConfig, their
 // quality thresholds) and a training config around the network and the fitter. The
 // code: adapt.cc (options, output folder, the stages in order; detect, fit, label),
-// adapt_synthetic.cc (backgrounds, the synthetic samples),
-// adapt_training.cc (train, export), adapt_report.cc (held-out measurement, model
+// adapt_training.cc (backgrounds, train, export), adapt_report.cc (held-out measurement, model
 // card), adapt_thresholds.h (the thresholds' choice); adapt_run.h is their shared,
 // internal state.
 

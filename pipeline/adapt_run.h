@@ -60,7 +60,7 @@ LabelSummary RunJob(const AdaptRun& run, const JobConfig& job);
 std::vector<std::string> WithFitLabel(const AdaptRun& run,
                                       const std::vector<std::string>& frames);
 
-// The stages of adapt_synthetic.cc, adapt_training.cc and adapt_report.cc
+// The stages of adapt_training.cc and adapt_report.cc
 // (pipeline/adapt.h says what each does and writes).
 void BackgroundsStage(const AdaptRun& run);
 void TrainStage(AdaptRun* run);
@@ -83,7 +83,7 @@ void Replan(int64_t step, double seconds_per_step, double seconds, nlohmann::jso
 constexpr int kNewRecordingsDetectorEvery = 10;
 std::string JobForNewRecordings(const AdaptRun& run);
 
-// Synthetic training samples in the capture's look (adapt_synthetic.cc): hands rendered
+// Synthetic training samples in the capture's look (adapt_training.cc, capture/capture_look.h): hands rendered
 // with `capture`'s cameras over the backgrounds stage's pictures, placed where the
 // training `labels` put the hand, realistic look, half of them holding objects.
 std::unique_ptr<SynthTrainingSamples> CaptureLookSynthSamples(

@@ -1,9 +1,9 @@
 #include "pipeline/adapt_run.h"
 
-// `handlabel adapt`'s train and export stages (pipeline/adapt.h): the capture's
-// selected frames train the starting weights for as many steps as the budget pays for;
-// the export averages the low-learning-rate checkpoints and measures batch norm on the
-// capture.
+// `handlabel adapt`'s backgrounds, train and export stages (pipeline/adapt.h): the
+// capture's selected frames train the starting weights for as many steps as the budget
+// pays for; the export averages the low-learning-rate checkpoints and measures batch norm
+// on the capture.
 
 #include <algorithm>
 #include <chrono>
@@ -12,6 +12,8 @@
 #include <fstream>
 #include <memory>
 
+#include "capture/capture_look.h"
+#include "capture/native_frame_source.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/json_util.h"
@@ -228,7 +230,61 @@ std::vector<std::string> AveragedCheckpoints(const std::string& train_dir,
   return paths;
 }
 
+// Frames the backgrounds' median is taken over: enough that a hand which stays a while
+// somewhere still leaves most of them free there; few enough to read in seconds.
+constexpr size_t kBackgroundFrames = 30;
+
+std::string BackgroundPath(const AdaptRun& run, const std::string& camera) {
+  return run.Path("backgrounds/" + camera + ".png");
+}
+
+// `count` frames spread evenly over `frames` (all of them when there are fewer).
+std::vector<std::string> SpreadFrames(const std::vector<std::string>& frames,
+                                      size_t count) {
+  if (frames.size() <= count) return frames;
+  std::vector<std::string> chosen;
+  for (size_t i = 0; i < count; ++i) chosen.push_back(frames[i * frames.size() / count]);
+  return chosen;
+}
+
 }  // namespace
+
+void BackgroundsStage(const AdaptRun& run) {
+  const std::vector<std::string> frames =
+      SpreadFrames(WithFitLabel(run, run.frames), kBackgroundFrames);
+  if (frames.empty()) {
+    throw InputError(
+        run.Path("fit/labels"), "labels",
+        "fit labels of some frames (to leave the hand out of the backgrounds)", "none");
+  }
+  std::vector<Points3d> hands;
+  for (const std::string& id : frames) {
+    hands.push_back(ReadLabelFile(LabelFilePath(run.Path("fit"), id)).mesh.keypoints);
+  }
+  Rig rig;
+  const std::vector<ImageU8> backgrounds =
+      EmptySceneBackgrounds(NativeFrameSource(run.o.capture_dir), frames, hands, &rig);
+  for (size_t c = 0; c < rig.size(); ++c) {
+    WritePng(BackgroundPath(run, rig[c].name), backgrounds[c]);
+  }
+  run.Say("backgrounds: the median of " + std::to_string(frames.size()) +
+          " frames per camera, the labelled hand left out (" + run.Path("backgrounds") +
+          ")");
+}
+
+std::unique_ptr<SynthTrainingSamples> CaptureLookSynthSamples(
+    const AdaptRun& run, const FrameSource& capture, const HandModel& hand,
+    const std::vector<LabeledFrame>& labels, const TrainingSampleOptions& samples) {
+  const Rig rig = PinholeRig(capture.Load(labels.front().id).rig);
+  auto photos = std::make_shared<std::vector<ImageU8>>();
+  for (const RigCamera& c : rig.cameras()) {
+    photos->push_back(ReadPng(BackgroundPath(run, c.name)));
+  }
+  std::vector<Points3d> hands;
+  for (const LabeledFrame& f : labels) hands.push_back(f.keypoints_3d);
+  return std::make_unique<SynthTrainingSamples>(
+      hand, rig, CaptureLookSynthOptions(hands, photos, run.o.seed), samples);
+}
 
 int64_t ReplanStep(const nlohmann::json& plan) {
   const int64_t steps = plan["steps"].get<int64_t>();
