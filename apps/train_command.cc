@@ -274,6 +274,8 @@ nlohmann::json TrainingDataSettings(const TrainConfig& config, const TrainFlags&
                           {{"box_scale", s.box_scale},
                            {"min_box_px", s.min_box_px},
                            {"frame_reuse", s.frame_reuse}}}};
+  // Only when set, so that runs from before the field resume as they were.
+  if (s.view_dropout > 0) data["samples"]["view_dropout"] = s.view_dropout;
   if (sources.synth_train) data["synth"] = SynthOptionsToJson(config.synth);
   if (!f.capture.capture_dir.empty()) {
     data["capture"] = {

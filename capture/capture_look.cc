@@ -101,12 +101,27 @@ std::vector<ImageU8> EmptySceneBackgrounds(const FrameSource& source,
   return backgrounds;
 }
 
+Eigen::Vector3d RigUp(const Rig& rig) {
+  Eigen::Vector3d mean_view = Eigen::Vector3d::Zero();
+  for (const RigCamera& c : rig.cameras()) {
+    mean_view += c.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitZ();
+  }
+  if (rig.empty()) return Eigen::Vector3d::UnitZ();
+  mean_view /= static_cast<double>(rig.size());
+  // Below a third of a unit the cameras look from all sides.
+  constexpr double kMinAgreement = 0.3;
+  if (mean_view.norm() < kMinAgreement) return Eigen::Vector3d::UnitZ();
+  return -mean_view.normalized();
+}
+
 SynthCaptureOptions CaptureLookSynthOptions(
-    const std::vector<Points3d>& hand_keypoints,
+    const Rig& rig, const std::vector<Points3d>& hand_keypoints,
     std::shared_ptr<const std::vector<ImageU8>> photos, uint64_t seed) {
   SynthCaptureOptions o;
   o.seed = seed;
   o.view.appearance = SynthAppearance::kRealistic;
+  o.view.realistic.up = RigUp(rig);
+  o.view.realistic.table = false;  // the photographs show the real one
   o.view.photo_backgrounds = std::move(photos);
   o.view.depth = false;
   o.write_detections = false;

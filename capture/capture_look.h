@@ -5,6 +5,7 @@
 // draw hands with the capture's cameras over those pictures, where its labels put the
 // hand.
 
+#include <Eigen/Core>
 #include <memory>
 #include <string>
 #include <vector>
@@ -33,11 +34,16 @@ std::vector<ImageU8> EmptySceneBackgrounds(const FrameSource& source,
 // The cameras without lens distortion (training crops are pinhole).
 Rig PinholeRig(const Rig& rig);
 
-// Realistic hands (half of them holding objects) over `photos` (one per camera), placed
-// around the labelled hands' median centre within the distance that holds 80 % of
-// them (3-25 cm).
+// The rig's "up": against the cameras' mean viewing direction (cameras look down at
+// the hand more often than up at it); +z when their directions cancel (a dome, a ring
+// of cameras at the hand's height), where the mean says nothing.
+Eigen::Vector3d RigUp(const Rig& rig);
+
+// Realistic hands (half of them holding objects) over `photos` (one per camera of
+// `rig`), lit from the rig's up, placed around the labelled hands' median centre within
+// the distance that holds 80 % of them (3-25 cm).
 SynthCaptureOptions CaptureLookSynthOptions(
-    const std::vector<Points3d>& hand_keypoints,
+    const Rig& rig, const std::vector<Points3d>& hand_keypoints,
     std::shared_ptr<const std::vector<ImageU8>> photos, uint64_t seed);
 
 }  // namespace handlabel

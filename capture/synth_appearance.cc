@@ -296,8 +296,10 @@ RenderMesh MakeTable(double extent, double height) {
   return table;
 }
 
-// Ambient + key light from above + fill light from the other side, soft skin diffuse.
-ShadingOptions RealisticLighting(std::mt19937_64& rng) {
+// Ambient + key light from above (`up`, unit) + fill light from the other side, soft
+// skin diffuse. Azimuths turn about `up` from the world x axis (or y, if x is nearly
+// up), so that up = +z gives the same lights as before `up` existed.
+ShadingOptions RealisticLighting(const Eigen::Vector3d& up, std::mt19937_64& rng) {
   ShadingOptions s;
   const float warmth = static_cast<float>(Uniform(rng, -0.05, 0.05));
   // Ambient + key + fill stay below ~1.15 in total, so that light skin is not
@@ -307,9 +309,13 @@ ShadingOptions RealisticLighting(std::mt19937_64& rng) {
   const double azimuth = Uniform(rng, 0, 2 * M_PI);
   const double key_elevation = Uniform(rng, 40, 80) * M_PI / 180;
   const double fill_elevation = Uniform(rng, 10, 40) * M_PI / 180;
-  auto from = [](double az, double el) {
-    return Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
-                           std::sin(el));
+  const Eigen::Vector3d x_axis =
+      std::abs(up.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d e1 = (x_axis - x_axis.dot(up) * up).normalized();
+  const Eigen::Vector3d e2 = up.cross(e1);
+  auto from = [&](double az, double el) {
+    return Eigen::Vector3d(std::cos(el) * std::cos(az) * e1 +
+                           std::cos(el) * std::sin(az) * e2 + std::sin(el) * up);
   };
   DirectionalLight key, fill;
   key.direction_in_world = -from(azimuth, key_elevation);
@@ -336,12 +342,19 @@ void RealisticLookOptions::Check(const std::string& source) const {
   if (!std::isfinite(table_height)) throw InputError(source, "table_height", "finite");
   RequireInRange(source, "blur", blur, 0, 3, "0..3 px");
   RequireInRange(source, "max_noise", max_noise, 1, 30, "1..30 levels");
+  if (!up.allFinite() || up.norm() < 1e-9) {
+    throw InputError(source, "up", "a finite direction of non-zero length");
+  }
+  if (table && (up.normalized() - Eigen::Vector3d::UnitZ()).norm() > 1e-9) {
+    throw InputError(source, "table",
+                     "off unless up is +z (the table is the plane z = table_height)");
+  }
 }
 
 void ApplyRealisticLook(const HandModel& model, const RealisticLookOptions& options,
                         std::mt19937_64& rng, SynthScene* scene) {
   ReskinHand(model, rng, scene);
-  scene->lighting = RealisticLighting(rng);
+  scene->lighting = RealisticLighting(options.up.normalized(), rng);
   if (options.forearm) {
     scene->scenery.push_back(MakeForearm(*scene, options.forearm_length, rng));
   }

@@ -19,6 +19,7 @@
 // The extra draws use their own random stream, so the scene (pose, shape, objects,
 // skin tone) of a frame is the same in both looks.
 
+#include <Eigen/Core>
 #include <random>
 #include <string>
 
@@ -43,6 +44,11 @@ struct RealisticLookOptions {
   double forearm_length = 0.4;  // metres from the wrist (mostly leaves the image)
   double blur = 0.6;            // sigma (px) of the camera blur, 0 = none
   double max_noise = 4.0;       // sensor noise sigma (8-bit levels), drawn in [1, this]
+  // The world direction the key and fill lights come down from (any length > 0). A
+  // capture's world need not have z up: the development recording's world is its master
+  // camera's frame, where +z points into the table (capture_look.h picks "up" from the
+  // cameras). The table is the plane z = table_height, so it needs up = +z.
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   // Throws InputError naming the field.
   void Check(const std::string& source) const;
 };

@@ -64,14 +64,14 @@ void SynthCaptureOptions::Check(const std::string& source) const {
 SynthGenerator::SynthGenerator(const HandModel& model, Rig rig,
                                const SynthCaptureOptions& options)
     : model_(model), rig_(std::move(rig)), options_(options) {
+  // The photographs show the real table: the look's own would hide it.
+  if (options_.view.photo_backgrounds) options_.view.realistic.table = false;
   options_.Check("synth options");
   if (rig_.empty()) throw InputError("synth", "rig", "at least one camera", "none");
   anatomy_ = ComputeHandAnatomy(model_);
   limits_ = DefaultHandLimits();
   for (const RigCamera& cam : rig_.cameras()) rays_.emplace_back(cam.camera);
   CheckPhotoBackgrounds();
-  // The photographs show the real table: the look's own would hide it.
-  if (options_.view.photo_backgrounds) options_.view.realistic.table = false;
 }
 
 void SynthGenerator::CheckPhotoBackgrounds() const {

@@ -120,6 +120,9 @@ AdaptSamples LoadSamples(const AdaptRun& run, const TrainConfig& c,
     // Each rendered frame gives several samples (fresh augmentation each): rendering
     // a frame of every camera costs more than a training step's share of it.
     synth.frame_reuse = kSynthFrameReuse;
+    // Views missed as often as the capture's detections miss them, so that the
+    // synthetic samples also teach whole-image views at weight 0.
+    synth.view_dropout = s.capture_train->MissedViewShare();
     s.synth = CaptureLookSynthSamples(run, *s.data.source, hand, s.data.train, synth);
     s.mixed = std::make_unique<MixedTrainingSamples>(*s.capture_train, *s.synth,
                                                      1.0 - run.o.synth_share, run.o.seed);
@@ -283,7 +286,7 @@ std::unique_ptr<SynthTrainingSamples> CaptureLookSynthSamples(
   std::vector<Points3d> hands;
   for (const LabeledFrame& f : labels) hands.push_back(f.keypoints_3d);
   return std::make_unique<SynthTrainingSamples>(
-      hand, rig, CaptureLookSynthOptions(hands, photos, run.o.seed), samples);
+      hand, rig, CaptureLookSynthOptions(rig, hands, photos, run.o.seed), samples);
 }
 
 int64_t ReplanStep(const nlohmann::json& plan) {
@@ -319,6 +322,13 @@ void TrainStage(AdaptRun* run) {
            " without a fit label; train/capture_labels.json), " +
            std::to_string(samples.data.validation.size()) + " of " +
            std::to_string(run->heldout.size()) + " held-out frames with a fit label");
+  if (samples.synth) {
+    run->Say(
+        "train: a share of " + FormatNumber(run->o.synth_share) +
+        " synthetic hands in the capture's look, views cut as missed detections at " +
+        FormatNumber(samples.synth->options().view_dropout) +
+        " (the capture's own missed share)");
+  }
   WriteSampleSheet(*run, samples);
   const std::string plan_path = run->Path("train/plan.json");
   if (!fs::exists(plan_path)) {

@@ -68,6 +68,7 @@ void ReadData(Section data, TrainConfig* c) {
   data.Read("appearance", &appearance);
   data.Read("frame_reuse", &c->samples.frame_reuse);
   data.Read("box_scale", &c->samples.box_scale);
+  data.Read("view_dropout", &c->samples.view_dropout);
   data.Read("generator_threads", &c->synth.num_threads);
   data.RejectUnknownKeys();
   c->synth.scene.objects = objects;

@@ -143,6 +143,19 @@ size_t CaptureTrainingSamples::FrameOfSample(int64_t index) const {
   return order[static_cast<uint64_t>(index) % n];
 }
 
+double CaptureTrainingSamples::MissedViewShare() const {
+  int64_t views = 0, missed = 0;
+  for (const LabeledFrame& label : frames_) {
+    const FrameInput frame = source_.Load(label.id);
+    for (size_t v = 0; v < frame.rig.size(); ++v) {
+      ++views;
+      missed += v >= frame.keypoints_2d.size() || !frame.keypoints_2d[v] ||
+                !CropFromKeypoints(*frame.keypoints_2d[v], crop_);
+    }
+  }
+  return views > 0 ? static_cast<double>(missed) / static_cast<double>(views) : 0.0;
+}
+
 void CaptureTrainingSamples::MakeView(const FrameInput& frame, size_t v,
                                       const LabeledFrame& label,
                                       const CaptureViewDraws& draws,

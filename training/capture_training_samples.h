@@ -21,7 +21,7 @@
 //   targets the label's keypoints through the view's camera and the crop intrinsics;
 //           master_from_cam as the network stage builds it; keypoints and vertices in
 //           the master frame (camera 0).
-// No in-plane rotation and no view dropout yet.
+// No in-plane rotation.
 // Everything random derives from (seed, i), so Sample(i) is the same on every call and
 // every thread. Labels arrive as plain arrays: reading label files is pipeline/'s job.
 
@@ -111,6 +111,10 @@ class CaptureTrainingSamples : public TrainingSampleSource {
 
   // Position in the frame list of the frame that sample `index` is cut from.
   size_t FrameOfSample(int64_t index) const;
+  // The share of the frames' views that inference would cut as missed (no detected
+  // keypoints, or too few to locate the hand: whole image, weight 0). Synthetic
+  // samples drop views at this rate to look like the capture (view_dropout).
+  double MissedViewShare() const;
   const std::vector<LabeledFrame>& frames() const { return frames_; }
 
  private:

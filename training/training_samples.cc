@@ -3,17 +3,20 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <utility>
 
 #include "core/errors.h"
 #include "core/option_checks.h"
 #include "core/random.h"
 #include "core/text.h"
+#include "network/poem/hand_crop.h"
 
 namespace handlabel {
 namespace {
 
 constexpr uint64_t kAugmentStream = 0xA06E;
+constexpr uint64_t kMissedViewStream = 0xD40F;
 
 using Affine2 = Eigen::Matrix<double, 2, 3>;  // crop pixel = A * (x, y, 1)
 
@@ -71,17 +74,13 @@ struct CropTransform {
   double f = 0, s = 0;
 };
 
-CropTransform MakeCropTransform(const Camera& camera, const Eigen::Vector2d& lo,
-                                const Eigen::Vector2d& hi, const ViewAugmentation& aug,
+// `center` in image pixels, `side` in square pixels of focal length f.
+CropTransform MakeCropTransform(const Camera& camera, const Eigen::Vector2d& center,
+                                double side, const ViewAugmentation& aug,
                                 const TrainingSampleOptions& o) {
   const double fx = camera.fx(), fy = camera.fy();
   CropTransform t;
-  // The box is measured in square pixels.
   t.f = 0.5 * (fx + fy);
-  const Eigen::Vector2d center = 0.5 * (lo + hi);
-  const double box = std::max(
-      {(hi.x() - lo.x()) * t.f / fx, (hi.y() - lo.y()) * t.f / fy, o.min_box_px});
-  const double side = box * o.box_scale * aug.scale;
   t.s = o.crop_size / side;
   const double co = std::cos(aug.rotation_rad), si = std::sin(aug.rotation_rad);
   t.rot << co, -si, si, co;
@@ -120,7 +119,8 @@ void ResampleCrop(const SynthView& src, const CropTransform& t,
 // InputError for a camera with lens distortion.
 Eigen::Matrix4d MakeTrainingView(const RigCamera& cam, const SynthView& src,
                                  const Points3d& keypoints, const ViewAugmentation& aug,
-                                 const TrainingSampleOptions& o, TrainingView* view) {
+                                 bool missed, const TrainingSampleOptions& o,
+                                 TrainingView* view) {
   const CameraModelId model = cam.camera.model();
   if (model != CameraModelId::kPinhole && model != CameraModelId::kSimplePinhole) {
     throw InputError("training samples", "camera " + cam.name,
@@ -133,7 +133,22 @@ Eigen::Matrix4d MakeTrainingView(const RigCamera& cam, const SynthView& src,
   std::array<float, 21> weight{};
   Eigen::Vector2d lo, hi;
   ProjectKeypoints(cam, original, keypoints, &uv, &weight, &lo, &hi);
-  const CropTransform t = MakeCropTransform(cam.camera, lo, hi, aug, o);
+  CropTransform t;
+  if (missed) {  // as inference crops a view whose detection missed the hand
+    ViewAugmentation plain = aug;
+    plain.scale = 1;
+    plain.rotation_rad = 0;
+    const CropWindow whole = WholeImageCrop(cam.camera);
+    t = MakeCropTransform(cam.camera, whole.center, whole.side, plain, o);
+  } else {
+    // The box is measured in square pixels.
+    const double f = 0.5 * (cam.camera.fx() + cam.camera.fy());
+    const double box = std::max({(hi.x() - lo.x()) * f / cam.camera.fx(),
+                                 (hi.y() - lo.y()) * f / cam.camera.fy(), o.min_box_px});
+    t = MakeCropTransform(cam.camera, 0.5 * (lo + hi), box * o.box_scale * aug.scale, aug,
+                          o);
+  }
+  view->view_weight = missed ? 0.0f : 1.0f;
 
   const Eigen::Vector2d pp =
       t.lin * Eigen::Vector2d(cam.camera.cx(), cam.camera.cy()) + t.affine.col(2);
@@ -172,6 +187,7 @@ void TrainingSampleOptions::Check(const std::string& source) const {
   RequireGreater(source, "min_box_px", min_box_px, 0);
   RequireAtLeast(source, "frame_reuse", frame_reuse, 1);
   RequireAtLeast(source, "reuse_group", reuse_group, 1);
+  RequireInRange(source, "view_dropout", view_dropout, 0, 1, "0..1");
   augment.Check(source + " augmentation");
 }
 
@@ -180,12 +196,38 @@ int64_t TrainingFrameOf(int64_t index, const TrainingSampleOptions& o) {
   return (index / block) * group + index % group;
 }
 
+std::vector<bool> DrawMissedViews(double view_dropout, int num_views,
+                                  std::mt19937_64& rng) {
+  std::vector<bool> missed(num_views, false);
+  if (view_dropout <= 0) return missed;
+  std::uniform_real_distribution<double> unit(0, 1);
+  int kept = 0;
+  for (int v = 0; v < num_views; ++v) {
+    missed[v] = unit(rng) < view_dropout;
+    kept += !missed[v];
+  }
+  if (kept >= 2) return missed;
+  std::vector<int> order(num_views);
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), rng);
+  for (int v : order) {
+    if (kept >= 2) break;
+    if (missed[v]) {
+      missed[v] = false;
+      ++kept;
+    }
+  }
+  return missed;
+}
+
 TrainingSample MakeTrainingSample(const SynthFrame& frame, const Rig& rig,
                                   const TrainingSampleOptions& o,
-                                  const std::vector<ViewAugmentation>& augmentations) {
+                                  const std::vector<ViewAugmentation>& augmentations,
+                                  const std::vector<bool>& missed) {
   const int N = static_cast<int>(rig.size());
   HL_CHECK(static_cast<int>(frame.views.size()) == N, "one rendered view per camera");
   HL_CHECK(static_cast<int>(augmentations.size()) == N, "one augmentation per view");
+  HL_CHECK(missed.empty() || static_cast<int>(missed.size()) == N, "one flag per view");
   const Points3d& keypoints = frame.scene.hand.keypoints;  // world, SNAP order
 
   TrainingSample sample;
@@ -193,8 +235,9 @@ TrainingSample MakeTrainingSample(const SynthFrame& frame, const Rig& rig,
   sample.views.resize(N);
   std::vector<Eigen::Matrix4d> cam_from_world(N);
   for (int c = 0; c < N; ++c) {
-    cam_from_world[c] = MakeTrainingView(rig[c], frame.views[c], keypoints,
-                                         augmentations[c], o, &sample.views[c]);
+    cam_from_world[c] =
+        MakeTrainingView(rig[c], frame.views[c], keypoints, augmentations[c],
+                         !missed.empty() && missed[c], o, &sample.views[c]);
   }
   // Master frame = the (turned) camera 0.
   const Eigen::Matrix4d master_from_world = cam_from_world[0];
@@ -249,7 +292,11 @@ TrainingSample SynthTrainingSamples::Sample(int64_t index) const {
   for (int c = 0; c < num_views(); ++c) {
     augs.push_back(DrawViewAugmentation(options_.augment, options_.crop_size, rng));
   }
-  TrainingSample sample = MakeTrainingSample(*frame, generator_.rig(), options_, augs);
+  std::mt19937_64 missed_rng(MixSeed(options_.augment_seed, index, kMissedViewStream));
+  const std::vector<bool> missed =
+      DrawMissedViews(options_.view_dropout, num_views(), missed_rng);
+  TrainingSample sample =
+      MakeTrainingSample(*frame, generator_.rig(), options_, augs, missed);
   sample.index = index;
   return sample;
 }

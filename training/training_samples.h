@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,6 +46,10 @@ struct TrainingSampleOptions {
   int frame_reuse = 1;        // samples cut from each rendered frame (>= 1)
   int reuse_group = 1;        // samples per reuse group, e.g. the batch size (>= 1)
   uint64_t augment_seed = 0;  // mixed with the sample index for the augmentation
+  // Chance that a view is cut as inference cuts a view whose detection missed the hand:
+  // the whole image at view weight 0 (0..1). At least two views per sample keep weight
+  // 1 (the network triangulates from them). 0 draws nothing, so samples stay as before.
+  double view_dropout = 0;
   TrainingAugmentOptions augment;
   void Check(const std::string& source) const;
 };
@@ -52,11 +57,20 @@ struct TrainingSampleOptions {
 // The synthetic frame that sample `index` is cut from.
 int64_t TrainingFrameOf(int64_t index, const TrainingSampleOptions& options);
 
+// The views of one sample cut as missed detections: each with chance `view_dropout`,
+// then dropped views, in random order, restored until two keep weight 1 (every view
+// with fewer than three cameras). Draws nothing when view_dropout is 0.
+std::vector<bool> DrawMissedViews(double view_dropout, int num_views,
+                                  std::mt19937_64& rng);
+
 // Cuts one sample out of a frame. `rig` is the generator's rig (pinhole cameras).
+// `missed` (empty = none) marks views cut as a missed detection: the whole image
+// (network/poem/hand_crop.h WholeImageCrop), no scale jitter or turn, view weight 0.
 // Throws InputError if a camera has lens distortion.
 TrainingSample MakeTrainingSample(const SynthFrame& frame, const Rig& rig,
                                   const TrainingSampleOptions& options,
-                                  const std::vector<ViewAugmentation>& augmentations);
+                                  const std::vector<ViewAugmentation>& augmentations,
+                                  const std::vector<bool>& missed = {});
 
 // TrainingSampleSource over a SynthGenerator. Keeps the frames of the last reuse group
 // so consecutive samples do not render them again.

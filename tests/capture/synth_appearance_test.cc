@@ -91,6 +91,48 @@ TEST(SynthAppearance, ForearmStartsAtTheWristAndPointsAwayFromTheFingers) {
   }
 }
 
+// The key light comes down from `up` at 40-80 degrees of elevation and the fill at
+// 10-40, whichever way the world's up points; a direction the table cannot stand on,
+// or none, is refused by name.
+TEST(SynthAppearance, LightsComeDownFromTheGivenUp) {
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
+  const std::vector<Eigen::Vector3d> ups = {
+      Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ(), Eigen::Vector3d(1, 0, 0.01),
+      Eigen::Vector3d(0.3, -2, 0.5)};
+  std::vector<std::vector<uint8_t>> pixels;
+  for (const Eigen::Vector3d& up : ups) {
+    SynthCaptureOptions o = SmallOptions(SynthAppearance::kRealistic);
+    o.view.realistic.up = up;
+    o.view.realistic.table = up == Eigen::Vector3d::UnitZ();
+    const SynthGenerator generator(model, MakePresetRig(o.rig, o.seed), o);
+    for (int frame = 0; frame < 2; ++frame) {
+      const SynthFrame f = generator.Generate(frame);
+      const auto& lights = f.scene.lighting.lights;
+      ASSERT_EQ(lights.size(), 2u);
+      const double key_elevation = -lights[0].direction_in_world.dot(up.normalized());
+      const double fill_elevation = -lights[1].direction_in_world.dot(up.normalized());
+      EXPECT_NEAR(lights[0].direction_in_world.norm(), 1, 1e-12);
+      EXPECT_GE(key_elevation, std::sin(40 * M_PI / 180) - 1e-12) << up.transpose();
+      EXPECT_LE(key_elevation, std::sin(80 * M_PI / 180) + 1e-12) << up.transpose();
+      EXPECT_GE(fill_elevation, std::sin(10 * M_PI / 180) - 1e-12) << up.transpose();
+      EXPECT_LE(fill_elevation, std::sin(40 * M_PI / 180) + 1e-12) << up.transpose();
+      if (frame == 0) pixels.push_back(f.views[3].rgb.data);
+    }
+  }
+  EXPECT_NE(pixels[0], pixels[1]) << "lit from below, the hand must look different";
+  SynthViewOptions view;
+  view.appearance = SynthAppearance::kRealistic;
+  view.realistic.up = -Eigen::Vector3d::UnitZ();
+  EXPECT_EQ(testing::InputErrorOf([&] { view.Check("v"); }),
+            "realistic look options: field 'table': expected off unless up is +z (the "
+            "table is the plane z = table_height)");
+  view.realistic.table = false;
+  view.realistic.up = Eigen::Vector3d::Zero();
+  EXPECT_EQ(testing::InputErrorOf([&] { view.Check("v"); }),
+            "realistic look options: field 'up': expected a finite direction of non-zero "
+            "length");
+}
+
 TEST(SynthAppearance, DeterministicAndNamed) {
   const HandModel model = MakeCapsuleHand(HandSide::kRight);
   const SynthCaptureOptions o = SmallOptions(SynthAppearance::kRealistic);

@@ -249,6 +249,23 @@ TEST_F(CaptureSamplesTest, FramesWithoutTwoDetectedViewsFallBackToLabelWindows) 
   }
 }
 
+// The missed share counts the views inference would cut whole at weight 0: with the
+// detections of every view but view 0 emptied, 7 of 8 in every frame.
+TEST_F(CaptureSamplesTest, MissedViewShareCountsViewsTheDetectionsDoNotLocate) {
+  const OneDetectedView one_view(*source_);
+  CaptureSampleOptions o = StrongOptions();
+  const CaptureTrainingSamples samples(one_view, TruthLabels(), o);
+  HandCropOptions crop;
+  crop.crop_size = o.crop_size;
+  for (const LabeledFrame& label : TruthLabels()) {
+    ASSERT_TRUE(CropFromKeypoints(*one_view.Load(label.id).keypoints_2d[0], crop))
+        << label.id;
+  }
+  EXPECT_DOUBLE_EQ(samples.MissedViewShare(), 7.0 / 8.0);
+  const CaptureTrainingSamples all_views(*source_, TruthLabels(), o);
+  EXPECT_LT(all_views.MissedViewShare(), 0.5);  // the simulated detector finds most
+}
+
 TEST_F(CaptureSamplesTest, BadOptionsAndLabelsNameTheField) {
   CaptureSampleOptions o = StrongOptions();
   o.augment.rotation_probability = 0.5;

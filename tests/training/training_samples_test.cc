@@ -2,10 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
+#include "capture/rig_presets.h"
 #include "core/errors.h"
 #include "hand/capsule_hand.h"
+#include "network/poem/hand_crop.h"
 #include "tests/reference_values.h"
 #include "tests/test_util.h"
 
@@ -201,6 +205,85 @@ testing::ReferenceValues TrainingSampleValues() {
 // within 1e-5 of each array's scale (renders and augmentation go through libm, whose
 // variants differ in the last bits between CPUs; one pixel rounded to the other 8-bit
 // level moves a 64x64 crop's sums by about 1.3e-6 of their scale).
+// A view cut as a missed detection is what inference cuts where the detections miss:
+// the whole image through network/poem/hand_crop.h (a second implementation of the
+// crop), at view weight 0, with its targets still on the projections; the others stay
+// hand crops at weight 1.
+TEST(TrainingSamples, MissedViewsAreTheWholeImageAtWeightZero) {
+  const SynthCaptureOptions synth = SmallSynth(3);
+  // Square pixels (fx = fy), as synthetic crops have them, so that hand_crop.h's
+  // window (which keeps fx and fy) is the same crop.
+  const Rig preset = MakePresetRig(synth.rig, synth.seed);
+  Rig rig;
+  for (const RigCamera& c : preset.cameras()) {
+    RigCamera square = c;
+    const double f = 0.5 * (c.camera.fx() + c.camera.fy());
+    square.camera = Camera::Pinhole(f, f, c.camera.cx(), c.camera.cy(), c.camera.width(),
+                                    c.camera.height());
+    rig.Add(square);
+  }
+  TrainingSampleOptions o;
+  o.crop_size = 64;
+  o.augment.enabled = false;
+  o.view_dropout = 0.5;
+  const SynthTrainingSamples source(MakeCapsuleHand(HandSide::kRight), rig, synth, o);
+  const SynthFrame frame = source.generator().Generate(0);
+  int missed_seen = 0;
+  for (int64_t index = 0; index < 4; ++index) {
+    const TrainingSample s = source.Sample(index);
+    int weighted = 0;
+    for (size_t c = 0; c < s.views.size(); ++c) {
+      const TrainingView& v = s.views[c];
+      weighted += v.view_weight == 1.0f;
+      if (v.view_weight != 0.0f) continue;
+      ++missed_seen;
+      if (s.frame != 0) continue;
+      const RigCamera& cam = source.generator().rig()[c];
+      const CropWindow whole = WholeImageCrop(cam.camera);
+      const Eigen::Matrix3d K = CropIntrinsics(cam.camera, whole, o.crop_size);
+      EXPECT_NEAR((v.intrinsics - K).norm(), 0, 1e-9) << "view " << c;
+      HandCropOptions crop;
+      crop.crop_size = o.crop_size;
+      const ImageU8& rgb = frame.views[c].rgb;
+      const std::vector<float> expected =
+          WarpCrop({rgb.width, rgb.height, rgb.data.data()}, cam.camera, whole, crop);
+      ASSERT_EQ(v.image.size(), expected.size());
+      double worst = 0;
+      for (size_t i = 0; i < expected.size(); ++i) {
+        worst = std::max(worst, std::abs(double{v.image[i]} - expected[i]));
+      }
+      EXPECT_LT(worst, 1e-4) << "view " << c;
+    }
+    EXPECT_GE(weighted, 2) << "sample " << index;
+  }
+  EXPECT_GT(missed_seen, 0);
+}
+
+// Views go missing at the asked rate (a little less: two views always stay), never
+// below two weighted views, and not at all at rate 0.
+TEST(TrainingSamples, MissedViewsComeAtTheirRate) {
+  std::mt19937_64 rng(5);
+  int64_t missed = 0, views = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const std::vector<bool> m = DrawMissedViews(0.3, 8, rng);
+    int kept = 0;
+    for (bool x : m) kept += !x;
+    ASSERT_GE(kept, 2);
+    missed += 8 - kept;
+    views += 8;
+  }
+  EXPECT_NEAR(static_cast<double>(missed) / views, 0.3, 0.02);
+  for (int i = 0; i < 100; ++i) {
+    const std::vector<bool> all = DrawMissedViews(1.0, 5, rng);
+    EXPECT_EQ(std::count(all.begin(), all.end(), false), 2);
+    const std::vector<bool> two = DrawMissedViews(1.0, 2, rng);
+    EXPECT_EQ(std::count(two.begin(), two.end(), true), 0);
+  }
+  std::mt19937_64 untouched(9), reference(9);
+  EXPECT_EQ(DrawMissedViews(0.0, 8, untouched), std::vector<bool>(8, false));
+  EXPECT_EQ(untouched(), reference());
+}
+
 TEST(TrainingSamples, SameIndexKeepsItsSample) {
   const testing::ReferenceValues first = TrainingSampleValues();
   EXPECT_EQ(first.Bits(), TrainingSampleValues().Bits());
@@ -214,6 +297,10 @@ TEST(TrainingSamples, OptionsRejectBadValues) {
   o = TrainingSampleOptions();
   o.augment.gain_min = 1.5;
   EXPECT_THROW(o.Check("test"), InputError);
+  o = TrainingSampleOptions();
+  o.view_dropout = 1.5;
+  EXPECT_EQ(testing::InputErrorOf([&] { o.Check("test"); }),
+            "test: field 'view_dropout': expected 0..1, got 1.5");
 }
 
 }  // namespace
