@@ -325,9 +325,10 @@ void TrainStage(AdaptRun* run) {
   if (samples.synth) {
     run->Say(
         "train: a share of " + FormatNumber(run->o.synth_share) +
-        " synthetic hands in the capture's look, views cut as missed detections at " +
-        FormatNumber(samples.synth->options().view_dropout) +
-        " (the capture's own missed share)");
+        " synthetic hands in the capture's look, " +
+        std::to_string(std::lround(100 * samples.synth->options().view_dropout)) +
+        " % of their views cut as missed detections (as the capture's detections miss "
+        "on its training frames)");
   }
   WriteSampleSheet(*run, samples);
   const std::string plan_path = run->Path("train/plan.json");
