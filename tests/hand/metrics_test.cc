@@ -158,7 +158,7 @@ std::vector<MotionFrame> QuadraticFrames(int count, const Points3d& p0, const Po
 TEST(MotionMetrics, QuadraticTrajectoriesHaveTheirConstantAcceleration) {
   const Points3d p0 = Pts({{0.1, 0.2, 0.3}, {-0.2, 0.0, 0.5}});
   const Points3d v = Pts({{0.01, -0.02, 0.0}, {0.0, 0.005, 0.003}});
-  const Points3d truth_acc = Pts({{0.003, 0.0, 0.004}, {0.0, -0.001, 0.0}});  // 5, 1 mm
+  const Points3d truth_acc = Pts({{0.003, 0.0, 0.004}, {0.0, -0.001, 0.0}});   // 5, 1 mm
   const Points3d predicted_acc = Pts({{0.0, 0.0, 0.004}, {0.0, 0.001, 0.0}});  // 4, 1 mm
   const MotionMetrics m =
       ComputeMotionMetrics(QuadraticFrames(10, p0, v, truth_acc, predicted_acc));
@@ -240,4 +240,3 @@ TEST(MotionMetrics, FramesOutOfOrderAreRefused) {
 
 }  // namespace
 }  // namespace handlabel
-
