@@ -47,6 +47,20 @@ void AddRigAndSceneFlags(CLI::App& app, SynthFlags* f) {
       ->capture_default_str();
 }
 
+// Frames as one motion (capture/synth_sequence.h).
+void AddSequenceFlags(CLI::App& app, SynthFlags* f) {
+  SynthSequenceOptions& q = f->options.sequence;
+  CLI::Option* sequence =
+      app.add_flag("--sequence", q.enabled,
+                   "frames form one smooth motion (reach, grasp, carry, release, "
+                   "repeated) instead of independent scenes");
+  app.add_option("--fps", q.fps,
+                 "with --sequence: frames per second (frame f shows time f / fps; the "
+                 "motion's speeds are in seconds, so the rate changes sampling only)")
+      ->capture_default_str()
+      ->needs(sequence);
+}
+
 // The simulated detections and the rendered images.
 void AddDetectionAndImageFlags(CLI::App& app, SynthFlags* f) {
   SynthCaptureOptions& o = f->options;
@@ -137,6 +151,7 @@ int RunSynth(int argc, char** argv) {
       "synth");
   SynthFlags flags;
   AddRigAndSceneFlags(app, &flags);
+  AddSequenceFlags(app, &flags);
   AddDetectionAndImageFlags(app, &flags);
   AddHandAndRunFlags(app, &flags);
   if (const int status = ParseCommandLine(app, argc, argv); status >= 0) return status;

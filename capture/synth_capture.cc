@@ -54,6 +54,7 @@ void SynthCaptureOptions::Check(const std::string& source) const {
   // The parts keep their own names in messages, as their fields are theirs.
   rig.Check("rig options");
   scene.Check("synthetic scene options");
+  sequence.Check("synthetic sequence options");
   view.Check("synthetic view options");
   detections.Check("detection noise options");
   RequireInRange(source, "num_frames", num_frames, 1, 100000000, "1..1e8");
@@ -100,15 +101,26 @@ void SynthGenerator::CheckPhotoBackgrounds() const {
 SynthFrame SynthGenerator::Generate(int index) const {
   SynthFrame frame;
   frame.index = index;
-  std::mt19937_64 scene_rng(MixSeed(options_.seed, index, kSceneStream));
-  frame.scene =
-      SampleSynthScene(model_, anatomy_, limits_, rig_, options_.scene, scene_rng);
+  const SynthSequenceOptions& sequence = options_.sequence;
+  if (sequence.enabled) {
+    frame.scene =
+        SampleSynthSequenceScene(model_, anatomy_, limits_, rig_, options_.scene,
+                                 sequence, options_.seed, index / sequence.fps);
+  } else {
+    std::mt19937_64 scene_rng(MixSeed(options_.seed, index, kSceneStream));
+    frame.scene =
+        SampleSynthScene(model_, anatomy_, limits_, rig_, options_.scene, scene_rng);
+  }
+  // A sequence is one scene before fixed cameras: every frame takes frame 0's look
+  // and backgrounds (their sensor noise included), so nothing but the motion changes.
+  const int look_index = sequence.enabled ? 0 : index;
   if (options_.view.appearance == SynthAppearance::kRealistic) {
-    std::mt19937_64 look_rng(MixSeed(options_.seed, index, kAppearanceStream));
+    std::mt19937_64 look_rng(MixSeed(options_.seed, look_index, kAppearanceStream));
     ApplyRealisticLook(model_, options_.view.realistic, look_rng, &frame.scene);
   }
   for (size_t c = 0; c < rig_.size(); ++c) {
-    std::mt19937_64 bg_rng(MixSeed(options_.seed, index, kBackgroundStream + 16 * c));
+    std::mt19937_64 bg_rng(
+        MixSeed(options_.seed, look_index, kBackgroundStream + 16 * c));
     const ImageU8* photo = options_.view.photo_backgrounds
                                ? &(*options_.view.photo_backgrounds)[c]
                                : nullptr;
@@ -174,6 +186,17 @@ nlohmann::json SynthOptionsToJson(const SynthCaptureOptions& o) {
                      {"mask_morph_radius", d.mask_morph_radius},
                      {"mask_blobs", d.mask_blobs}};
   j["depth"] = o.write_depth;
+  // Recorded only for sequences: independent captures stay byte-identical.
+  if (o.sequence.enabled) {
+    const SynthSequenceOptions& q = o.sequence;
+    j["sequence"] = {{"fps", q.fps},
+                     {"reach_seconds", q.reach_seconds},
+                     {"grasp_seconds", q.grasp_seconds},
+                     {"carry_seconds", q.carry_seconds},
+                     {"release_seconds", q.release_seconds},
+                     {"motion_radius", q.motion_radius},
+                     {"rotation_range_deg", q.rotation_range_deg}};
+  }
   return j;
 }
 

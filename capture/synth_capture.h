@@ -6,7 +6,8 @@
 // SynthGenerator makes frames in memory; WriteSynthCapture writes a capture folder in
 // the native layout (capture_format.h, docs/capture-format.md), in parallel over frames
 // with TBB. Frame f depends only on (seed, f): the output is byte-identical for any
-// thread count, and different seeds give different scenes.
+// thread count, and different seeds give different scenes. With sequence.enabled the
+// frames are moments of one motion (capture/synth_sequence.h), still each made alone.
 
 #include <cstdint>
 #include <functional>
@@ -18,6 +19,7 @@
 #include "capture/rig_presets.h"
 #include "capture/synth_detections.h"
 #include "capture/synth_scene.h"
+#include "capture/synth_sequence.h"
 #include "capture/synth_view.h"
 #include "geometry/rig.h"
 #include "hand/hand_anatomy.h"
@@ -30,6 +32,7 @@ namespace handlabel {
 struct SynthCaptureOptions {
   RigPresetOptions rig;              // which cameras
   SynthSceneOptions scene;           // poses, shapes, objects
+  SynthSequenceOptions sequence;     // frames as one motion (off: independent frames)
   SynthViewOptions view;             // backgrounds, visibility, the look (appearance)
   DetectionNoiseOptions detections;  // simulated detector
   int num_frames = 10;               // >= 1

@@ -14,20 +14,6 @@ namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-Eigen::Quaterniond RandomRotation(std::mt19937_64& rng) {
-  Eigen::Vector4d q;
-  for (int i = 0; i < 4; ++i) q[i] = Gaussian(rng, 1.0);
-  return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
-}
-
-Eigen::Vector3d RandomInBall(std::mt19937_64& rng, double radius) {
-  for (;;) {
-    const Eigen::Vector3d p(Uniform(rng, -1, 1), Uniform(rng, -1, 1),
-                            Uniform(rng, -1, 1));
-    if (p.squaredNorm() <= 1.0) return radius * p;
-  }
-}
-
 HandPoseVector ClampToLimits(const HandAnatomy& anatomy, const HandLimits& limits,
                              const HandPoseVector& hand_pose) {
   HandPoseVector angles;
@@ -89,8 +75,24 @@ std::shared_ptr<const ImageU8> MakeObjectTexture(int kind, std::mt19937_64& rng)
   return tex;
 }
 
-SynthObject SampleObject(const Eigen::Vector3d& anchor, const Eigen::Vector3d& away,
-                         std::mt19937_64& rng) {
+}  // namespace
+
+Eigen::Quaterniond UniformRandomRotation(std::mt19937_64& rng) {
+  Eigen::Vector4d q;
+  for (int i = 0; i < 4; ++i) q[i] = Gaussian(rng, 1.0);
+  return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized();
+}
+
+Eigen::Vector3d RandomPointInBall(std::mt19937_64& rng, double radius) {
+  for (;;) {
+    const Eigen::Vector3d p(Uniform(rng, -1, 1), Uniform(rng, -1, 1),
+                            Uniform(rng, -1, 1));
+    if (p.squaredNorm() <= 1.0) return radius * p;
+  }
+}
+
+SynthObject SampleSynthObject(const Eigen::Vector3d& anchor, const Eigen::Vector3d& away,
+                              std::mt19937_64& rng) {
   SynthObject obj;
   const int kind = static_cast<int>(Uniform(rng, 0, 3));
   double half = 0;  // extent along `away`, to keep the object just off the skin
@@ -111,8 +113,8 @@ SynthObject SampleObject(const Eigen::Vector3d& anchor, const Eigen::Vector3d& a
     half = r;
   }
   obj.mesh = MakeObjectMesh(obj.kind, obj.size);
-  obj.world_from_object =
-      Rigid3(RandomRotation(rng), anchor + (half + Uniform(rng, 0.0, 0.01)) * away);
+  obj.world_from_object = Rigid3(UniformRandomRotation(rng),
+                                 anchor + (half + Uniform(rng, 0.0, 0.01)) * away);
   TransformMesh(obj.world_from_object, &obj.mesh);
   obj.color =
       Eigen::Vector3f(Uniform(rng, 0.1, 1), Uniform(rng, 0.1, 1), Uniform(rng, 0.1, 1));
@@ -124,7 +126,6 @@ SynthObject SampleObject(const Eigen::Vector3d& anchor, const Eigen::Vector3d& a
   return obj;
 }
 
-// Cameras whose image holds all `points` (world) with a 2-pixel margin.
 int CamerasSeeingAll(const Rig& rig, const Points3d& points) {
   int count = 0;
   for (const RigCamera& cam : rig.cameras()) {
@@ -138,8 +139,6 @@ int CamerasSeeingAll(const Rig& rig, const Points3d& points) {
   }
   return count;
 }
-
-}  // namespace
 
 RenderMesh MakeObjectMesh(const std::string& kind, const Eigen::Vector3d& size) {
   if (!(size.array() > 0).all()) {
@@ -177,6 +176,51 @@ std::vector<std::string> SynthPoseKindNames() {
   return {"open", "fist", "pinch", "point", "random", "grasp", "pca"};
 }
 
+HandPoseVector SampleSynthPose(const HandModel& model, const HandAnatomy& anatomy,
+                               const HandLimits& limits, const SynthSceneOptions& options,
+                               const std::string& kind, std::mt19937_64& rng) {
+  const std::vector<std::string> names = SynthPoseKindNames();
+  const auto it = std::find(names.begin(), names.end(), kind);
+  if (it == names.end()) {
+    throw InputError("synthetic scene", "pose kind",
+                     "open, fist, pinch, point, random, grasp or pca", kind);
+  }
+  return SamplePose(model, anatomy, limits, options, static_cast<int>(it - names.begin()),
+                    rng);
+}
+
+Eigen::VectorXd SampleSynthBetas(const HandModel& model, const SynthSceneOptions& o,
+                                 std::mt19937_64& rng) {
+  Eigen::VectorXd betas = Eigen::VectorXd::Zero(std::min(model.num_betas(), 10));
+  for (Eigen::Index i = 0; i < betas.size(); ++i) {
+    betas[i] = std::clamp(Gaussian(rng, o.betas_sigma), -2.5 * o.betas_sigma,
+                          2.5 * o.betas_sigma);
+  }
+  return betas;
+}
+
+void HeldObjectAnchor(const HandParams& params, const Points3d& k,
+                      const std::string& pose_kind, Eigen::Vector3d* anchor,
+                      Eigen::Vector3d* away) {
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(params.global_orient.norm(),
+                                              params.global_orient.norm() > 0
+                                                  ? params.global_orient.normalized()
+                                                  : Eigen::Vector3d::UnitX())
+                                .toRotationMatrix();
+  const Eigen::Vector3d palm_normal = r * Eigen::Vector3d(0, -1, 0);
+  const Eigen::Vector3d palm_centre =
+      (k.row(0) + k.row(5) + k.row(9) + k.row(13) + k.row(17)).transpose() / 5.0;
+  if (pose_kind == "pinch") {
+    // Held at the pinching tips, on the side away from the palm (not swallowing the
+    // fingertips).
+    *anchor = 0.5 * (k.row(4) + k.row(8)).transpose();
+    *away = (*anchor - palm_centre).normalized();
+  } else {
+    *anchor = palm_centre + 0.01 * palm_normal;
+    *away = palm_normal;
+  }
+}
+
 namespace {
 
 // Pose kind, pose and shape; objects make grasps more likely, as in hand-object
@@ -192,11 +236,7 @@ void SamplePoseAndShape(const HandModel& model, const HandAnatomy& anatomy,
   scene->pose_kind = SynthPoseKindNames()[kind];
   HandParams& params = scene->params;
   params.hand_pose = SamplePose(model, anatomy, limits, o, kind, rng);
-  params.betas = Eigen::VectorXd::Zero(std::min(model.num_betas(), 10));
-  for (Eigen::Index i = 0; i < params.betas.size(); ++i) {
-    params.betas[i] = std::clamp(Gaussian(rng, o.betas_sigma), -2.5 * o.betas_sigma,
-                                 2.5 * o.betas_sigma);
-  }
+  params.betas = SampleSynthBetas(model, o, rng);
 }
 
 // Placement: the hand at rest orientation, then rotated about the wrist (as the root
@@ -209,9 +249,9 @@ int PlaceHand(const HandModel& model, const Rig& rig, const SynthSceneOptions& o
   const Eigen::RowVector3d centre = rest.keypoints.colwise().mean();
   int best = -1;
   for (int t = 0; t < o.placement_tries; ++t) {
-    const Eigen::Quaterniond q = RandomRotation(rng);
+    const Eigen::Quaterniond q = UniformRandomRotation(rng);
     const Eigen::Vector3d target =
-        o.workspace_center + RandomInBall(rng, o.workspace_radius);
+        o.workspace_center + RandomPointInBall(rng, o.workspace_radius);
     const Eigen::Matrix3d r = q.toRotationMatrix();
     // keypoint' = R (k - wrist) + wrist + transl; centre' = target.
     const Eigen::Vector3d transl =
@@ -234,8 +274,10 @@ int PlaceHand(const HandModel& model, const Rig& rig, const SynthSceneOptions& o
   return best;
 }
 
-// Skin tone with per-vertex shade variation, and the lighting.
-void SampleAppearance(const HandModel& model, std::mt19937_64& rng, SynthScene* scene) {
+}  // namespace
+
+void SampleSynthAppearance(const HandModel& model, std::mt19937_64& rng,
+                           SynthScene* scene) {
   const float* tone = kSkinTones[static_cast<int>(Uniform(rng, 0, 7))];
   for (int c = 0; c < 3; ++c) {
     scene->skin[c] =
@@ -268,35 +310,24 @@ void SampleAppearance(const HandModel& model, std::mt19937_64& rng, SynthScene* 
   }
 }
 
+namespace {
+
 // Objects: the first one in the hand (in front of the palm, or at the thumb and index
 // tips for pinches), the others nearby.
 void AddObjects(const SynthSceneOptions& o, std::mt19937_64& rng, SynthScene* scene) {
-  const HandParams& params = scene->params;
   const int count = 1 + static_cast<int>(Uniform(rng, 0, o.max_objects));
-  const Eigen::Matrix3d r = Eigen::AngleAxisd(params.global_orient.norm(),
-                                              params.global_orient.norm() > 0
-                                                  ? params.global_orient.normalized()
-                                                  : Eigen::Vector3d::UnitX())
-                                .toRotationMatrix();
-  const Eigen::Vector3d palm_normal = r * Eigen::Vector3d(0, -1, 0);
   const Points3d& k = scene->hand.keypoints;
   const Eigen::Vector3d palm_centre =
       (k.row(0) + k.row(5) + k.row(9) + k.row(13) + k.row(17)).transpose() / 5.0;
   for (int i = 0; i < count; ++i) {
     Eigen::Vector3d anchor, away;
-    if (i == 0 && scene->pose_kind == "pinch") {
-      // Held at the pinching tips, on the side away from the palm (not swallowing
-      // the fingertips).
-      anchor = 0.5 * (k.row(4) + k.row(8)).transpose();
-      away = (anchor - palm_centre).normalized();
-    } else if (i == 0) {
-      anchor = palm_centre + 0.01 * palm_normal;
-      away = palm_normal;
+    if (i == 0) {
+      HeldObjectAnchor(scene->params, k, scene->pose_kind, &anchor, &away);
     } else {
-      away = RandomInBall(rng, 1.0).normalized();
+      away = RandomPointInBall(rng, 1.0).normalized();
       anchor = palm_centre + Uniform(rng, 0.05, 0.12) * away;
     }
-    scene->objects.push_back(SampleObject(anchor, away, rng));
+    scene->objects.push_back(SampleSynthObject(anchor, away, rng));
   }
 }
 
@@ -310,7 +341,7 @@ SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
   SamplePoseAndShape(model, anatomy, limits, o, rng, &scene);
   scene.cameras_seeing_hand = PlaceHand(model, rig, o, rng, &scene.params);
   scene.hand = PoseHand(model, scene.params);
-  SampleAppearance(model, rng, &scene);
+  SampleSynthAppearance(model, rng, &scene);
   const bool with_objects = o.objects && (o.object_probability >= 1.0 ||
                                           Uniform(rng, 0, 1) < o.object_probability);
   if (with_objects) AddObjects(o, rng, &scene);

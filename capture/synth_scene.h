@@ -9,6 +9,7 @@
 // model's pose PCA basis, clamped to the limits). Every pose is clamped to the limits.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <random>
 #include <string>
 #include <vector>
@@ -90,5 +91,37 @@ RenderMesh MakeObjectMesh(const std::string& kind, const Eigen::Vector3d& size);
 SynthScene SampleSynthScene(const HandModel& model, const HandAnatomy& anatomy,
                             const HandLimits& limits, const Rig& rig,
                             const SynthSceneOptions& options, std::mt19937_64& rng);
+
+// The draws SampleSynthScene is made of, for scenes composed otherwise (the motion of
+// capture/synth_sequence.h). Each is deterministic in `rng`'s state.
+
+// A pose of one of SynthPoseKindNames()' kinds, within the limits. Throws InputError
+// for another kind.
+HandPoseVector SampleSynthPose(const HandModel& model, const HandAnatomy& anatomy,
+                               const HandLimits& limits, const SynthSceneOptions& options,
+                               const std::string& kind, std::mt19937_64& rng);
+// Shape coefficients ~ N(0, betas_sigma^2), clamped to +-2.5 sigma.
+Eigen::VectorXd SampleSynthBetas(const HandModel& model, const SynthSceneOptions& options,
+                                 std::mt19937_64& rng);
+// Where an object held by the posed hand sits: `anchor` on the palm side (or between
+// the thumb and index tips for "pinch"), `away` the unit direction it extends to.
+void HeldObjectAnchor(const HandParams& params, const Points3d& keypoints,
+                      const std::string& pose_kind, Eigen::Vector3d* anchor,
+                      Eigen::Vector3d* away);
+// A random object (kind, size, rotation, colour, texture) just off the skin at `anchor`
+// along `away`; its mesh in the frame of `anchor`.
+SynthObject SampleSynthObject(const Eigen::Vector3d& anchor, const Eigen::Vector3d& away,
+                              std::mt19937_64& rng);
+// Skin tone, per-vertex shade and lighting; scene->hand_render from scene->hand. The
+// number of draws does not depend on the pose, so one stream gives every pose the same
+// look.
+void SampleSynthAppearance(const HandModel& model, std::mt19937_64& rng,
+                           SynthScene* scene);
+// Cameras whose image holds all `points` (world) with a 2-pixel margin.
+int CamerasSeeingAll(const Rig& rig, const Points3d& points);
+// A rotation uniform over SO(3).
+Eigen::Quaterniond UniformRandomRotation(std::mt19937_64& rng);
+// A point uniform in the ball of `radius` around the origin.
+Eigen::Vector3d RandomPointInBall(std::mt19937_64& rng, double radius);
 
 }  // namespace handlabel

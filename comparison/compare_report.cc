@@ -32,6 +32,8 @@ const std::vector<Column> kColumns = {{"mpvpe_mm", "MPVPE", 2},
                                       {"rr_mpjpe_mm", "RR-J", 2},
                                       {"pa_mpjpe_mm", "PA-J", 2},
                                       {"auc_j", "AUC-J", 3},
+                                      {"accel_error_mm", "Accel-J", 2},
+                                      {"jitter_mm", "Jitter-J", 2},
                                       {"seconds_per_frame", "s/frame", 3},
                                       {"threads", "threads", 0},
                                       {"parameters", "params", 0},
@@ -52,6 +54,10 @@ std::map<std::string, double> RowValues(const MethodRun& run) {
   v["rr_mpjpe_mm"] = 1000 * m.rr_mpjpe;
   v["pa_mpjpe_mm"] = 1000 * m.pa_mpjpe;
   v["auc_j"] = run.scores.joint_pck.auc;
+  if (run.scores.motion.triples > 0) {
+    v["accel_error_mm"] = 1000 * run.scores.motion.acceleration_error;
+    v["jitter_mm"] = 1000 * run.scores.motion.jitter;
+  }
   if (MethodHasVertices(run)) {
     v["mpvpe_mm"] = 1000 * m.mpvpe;
     v["rr_mpvpe_mm"] = 1000 * m.rr_mpvpe;

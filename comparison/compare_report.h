@@ -1,7 +1,9 @@
 #pragma once
 // What `handlabel compare` writes: one table in the POEM paper's layout (Table 1:
 // MPVPE, RR-V, PA-V, AUC-V, MPJPE, RR-J, PA-J, AUC-J; errors in mm, AUC over the
-// comparison's PCK range) with seconds per frame, threads and network parameters per
+// comparison's PCK range), the keypoints' acceleration error and jitter over
+// consecutive frames (Accel-J, Jitter-J, mm/frame^2; empty when no three compared
+// frames follow each other), seconds per frame, threads and network parameters per
 // method, the view-count ablation, the quality-check study and the pictures:
 //   <out>/compare.json    every number (the HTML and Markdown show these, rounded)
 //   <out>/compare.md      the tables, for terminals and docs

@@ -11,6 +11,7 @@
 #include "core/option_checks.h"
 #include "core/stopwatch.h"
 #include "core/text.h"
+#include "pipeline/frame_metrics.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_stage_factory.h"
 #include "pipeline/network_stage.h"
@@ -242,12 +243,16 @@ MethodScores ScoreLabels(const MethodRun& run, const std::vector<std::string>& f
                          const Truths& truths, const PckOptions& pck) {
   MethodScores s;
   std::vector<Eigen::VectorXd> joints, vertices;
+  std::vector<MotionFrame> motion;
+  const std::vector<int64_t> numbers = MotionFrameNumbers(frames);
   bool all_vertices = true;
-  for (const std::string& frame : frames) {
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const std::string& frame = frames[i];
     const auto truth = truths.find(frame);
     if (truth == truths.end()) continue;
     const std::optional<LabelRecord> label = MethodLabel(run, frame);
     if (!label) continue;
+    motion.push_back({numbers[i], label->mesh.keypoints, truth->second.keypoints});
     const FrameGroundTruth& t = truth->second;
     const bool with_vertices =
         t.vertices.rows() > 0 && t.vertices.rows() == label->mesh.vertices.rows();
@@ -271,6 +276,7 @@ MethodScores ScoreLabels(const MethodRun& run, const std::vector<std::string>& f
     s.vertex_pck = ComputePck(s.vertex_errors, pck);
   }
   s.joint_pck = ComputePck(s.joint_errors, pck);
+  s.motion = ComputeMotionMetrics(motion);
   for (const HandFrameMetrics& m : s.per_frame) {
     s.mean.mpjpe += m.mpjpe / n;
     s.mean.rr_mpjpe += m.rr_mpjpe / n;
@@ -394,6 +400,10 @@ class ComparisonRun {
     } else {
       *log_ << run.ok << "/" << run.frames << " labelled in " << run.wall_seconds << " s";
       if (run.has_truth) *log_ << ", MPJPE " << 1000 * run.scores.mean.mpjpe << " mm";
+      if (run.has_truth && run.scores.motion.triples > 0) {
+        *log_ << ", acceleration error " << 1000 * run.scores.motion.acceleration_error
+              << " mm/frame^2";
+      }
       *log_ << "\n";
     }
     return run;

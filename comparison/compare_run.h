@@ -82,6 +82,10 @@ struct MethodScores {
   Eigen::MatrixXd vertex_errors;   // frames x V, 0 columns without true vertices
   PckCurve joint_pck, vertex_pck;  // over the options' range
   HandFrameMetrics mean;           // means over frames
+  // Keypoint acceleration error and jitter over the triples of consecutive compared
+  // frames (metres per frame^2; triples = 0 when no three compared frames follow
+  // each other).
+  MotionMetrics motion;
 };
 
 struct MethodRun {

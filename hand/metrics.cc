@@ -128,4 +128,46 @@ HandFrameMetrics EvaluateHandFrame(const Points3d& predicted_keypoints,
   return m;
 }
 
+namespace {
+
+// a = p_{t-1} - 2 p_t + p_{t+1}, per point.
+Points3d SecondDifference(const Points3d& before, const Points3d& now,
+                          const Points3d& after) {
+  return before - 2.0 * now + after;
+}
+
+}  // namespace
+
+MotionMetrics ComputeMotionMetrics(const std::vector<MotionFrame>& frames) {
+  MotionMetrics m;
+  if (frames.empty()) return m;
+  const bool with_truth = frames.front().truth.rows() > 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    HL_CHECK(i == 0 || frames[i].number > frames[i - 1].number,
+             "motion frames in increasing number order");
+    CheckSameShape(frames[i].predicted, frames.front().predicted);
+    HL_CHECK((frames[i].truth.rows() > 0) == with_truth,
+             "truth for every motion frame or for none");
+    if (with_truth) CheckSameShape(frames[i].predicted, frames[i].truth);
+  }
+  double error = 0, jitter = 0, truth = 0;
+  for (size_t i = 1; i + 1 < frames.size(); ++i) {
+    const MotionFrame &a = frames[i - 1], &b = frames[i], &c = frames[i + 1];
+    if (b.number - a.number != 1 || c.number - b.number != 1) continue;
+    const Points3d predicted = SecondDifference(a.predicted, b.predicted, c.predicted);
+    jitter += predicted.rowwise().norm().mean();
+    if (with_truth) {
+      const Points3d actual = SecondDifference(a.truth, b.truth, c.truth);
+      error += (predicted - actual).rowwise().norm().mean();
+      truth += actual.rowwise().norm().mean();
+    }
+    ++m.triples;
+  }
+  if (m.triples == 0) return m;
+  m.acceleration_error = error / m.triples;
+  m.jitter = jitter / m.triples;
+  m.truth_acceleration = truth / m.triples;
+  return m;
+}
+
 }  // namespace handlabel

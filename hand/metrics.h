@@ -18,6 +18,7 @@
 // All distances are in the units of the inputs (metres in this project).
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -84,5 +85,30 @@ HandFrameMetrics EvaluateHandFrame(const Points3d& predicted_keypoints,
                                    const Points3d& truth_keypoints,
                                    const Points3d& predicted_vertices,
                                    const Points3d& truth_vertices);
+
+// Motion over time, as video methods report it (VIBE, Kocabas et al. 2020: "acceleration
+// error"): the acceleration of a point at frame t is the second finite difference
+// a_t = p_{t-1} - 2 p_t + p_{t+1}, in units per frame^2 (so it depends on the frame
+// rate). Over every triple of consecutive frames and every point:
+//   acceleration error   mean |a_predicted - a_truth|
+//   jitter               mean |a_predicted|
+//   truth acceleration   mean |a_truth| (what the true motion itself accelerates)
+// Frames carry numbers; only triples numbered n - 1, n, n + 1 count, so a missing or
+// failed frame is never differenced across.
+struct MotionFrame {
+  int64_t number = 0;  // consecutive frames have consecutive numbers
+  Points3d predicted;
+  Points3d truth;  // same size as predicted, or empty (jitter only)
+};
+
+struct MotionMetrics {
+  int triples = 0;                  // triples of consecutive frames
+  double acceleration_error = 0.0;  // 0 without truth or triples
+  double jitter = 0.0;
+  double truth_acceleration = 0.0;
+};
+
+// `frames` in increasing number order, every one with truth or none of them.
+MotionMetrics ComputeMotionMetrics(const std::vector<MotionFrame>& frames);
 
 }  // namespace handlabel

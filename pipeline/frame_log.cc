@@ -37,6 +37,10 @@ FrameRecord ParseRecord(const std::string& line, const std::string& source) {
         r.metrics[name] = value.is_null() ? std::nan("") : value.get<double>();
       }
     }
+    if (j.contains("keypoints_mm")) {
+      r.keypoints_mm =
+          j.at("keypoints_mm").get<std::map<std::string, std::vector<double>>>();
+    }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(source, "record", "fields frame and status", e.what());
   }
@@ -118,6 +122,7 @@ void FrameLog::Record(const FrameRecord& record) {
                       {"seconds", record.seconds}};
   if (!record.reason.empty()) j["reason"] = record.reason;
   if (!record.metrics.empty()) j["metrics"] = record.metrics;
+  if (!record.keypoints_mm.empty()) j["keypoints_mm"] = record.keypoints_mm;
   if (record.label_bytes >= 0) j["label_bytes"] = record.label_bytes;
   if (!record.label_sha256.empty()) j["label_sha256"] = record.label_sha256;
   if (!record.job_hash.empty()) j["job_hash"] = record.job_hash;

@@ -21,6 +21,10 @@ struct FrameRecord {
   // Per-frame errors against ground truth, "<group>/<metric>" -> value (label_summary.h);
   // empty when the capture has no ground truth.
   std::map<std::string, double> metrics;
+  // With ground truth: the 21 keypoints (SNAP order, x y z each, millimetres to 1 um)
+  // each metric group was scored on and the truth's ("truth"), for the motion metrics
+  // over consecutive frames; empty otherwise and in older logs.
+  std::map<std::string, std::vector<double>> keypoints_mm;
   // The label file as written (ok records): its size and SHA-256, checked on resume
   // and merge so that a truncated or replaced label is never taken as done. -1 / ""
   // in logs written before these were recorded.

@@ -26,6 +26,7 @@
 #include "formats/sha256.h"
 #include "pipeline/build_info.h"
 #include "pipeline/frame_log.h"
+#include "pipeline/frame_metrics.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/output_lock.h"
@@ -386,6 +387,9 @@ class LabelJobRun {
     record->status = "ok";
     record->path = ToString(outcome.label.path);
     record->metrics = std::move(outcome.metrics);
+    for (const auto& [group, keypoints] : outcome.keypoints) {
+      record->keypoints_mm[group] = KeypointsToMillimetres(keypoints);
+    }
   }
 
   // The network stage as `lanes` serial filters in a row; lane k predicts the batches

@@ -12,10 +12,12 @@ namespace {
 
 void AddMetrics(const std::string& group, const Points3d& keypoints,
                 const Points3d& vertices, const FrameGroundTruth& truth,
-                std::map<std::string, double>* metrics) {
+                FrameOutcome* outcome) {
   for (const auto& [name, value] : HandErrors(keypoints, vertices, truth)) {
-    (*metrics)[group + "/" + name] = value;
+    outcome->metrics[group + "/" + name] = value;
   }
+  outcome->keypoints[group] = keypoints;
+  outcome->keypoints[kTruthKeypoints] = truth.keypoints;
 }
 
 }  // namespace
@@ -171,24 +173,23 @@ class FrameLabeler {
   void Evaluate(FrameOutcome* outcome) const {
     const FrameGroundTruth& truth = *frame_.ground_truth;
     const LabelRecord& label = outcome->label;
-    auto* metrics = &outcome->metrics;
-    AddMetrics("labels", label.mesh.keypoints, label.mesh.vertices, truth, metrics);
+    AddMetrics("labels", label.mesh.keypoints, label.mesh.vertices, truth, outcome);
     AddMetrics(ToString(label.path), label.mesh.keypoints, label.mesh.vertices, truth,
-               metrics);
+               outcome);
     if (prediction_ && prediction_->keypoints.array().isFinite().all()) {
       AddMetrics("network_raw", prediction_->keypoints, prediction_->vertices, truth,
-                 metrics);
+                 outcome);
     }
     if (!job_.baseline || !context_.fitter) return;
     if (label.path == LabelPath::kFallbackFit) {
-      AddMetrics("fit_only", label.mesh.keypoints, label.mesh.vertices, truth, metrics);
+      AddMetrics("fit_only", label.mesh.keypoints, label.mesh.vertices, truth, outcome);
       return;
     }
     // The baseline is for comparison only; its failure does not fail the frame.
     try {
       const LabelFit baseline = Fit(nullptr);
       AddMetrics("fit_only", baseline.mesh.keypoints, baseline.mesh.vertices, truth,
-                 metrics);
+                 outcome);
     } catch (const std::exception&) {
     }
   }

@@ -28,6 +28,9 @@ struct LabelContext {
 struct FrameOutcome {
   LabelRecord label;
   std::map<std::string, double> metrics;  // "<group>/<metric>" (label_summary.h)
+  // With ground truth: the keypoints each metric group was scored on, and the truth's
+  // ("truth"), for the motion metrics over consecutive frames (label_summary.h).
+  std::map<std::string, Points3d> keypoints;
 };
 
 // Where the network's own 2D fills a view that has no file 2D while other views do,

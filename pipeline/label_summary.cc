@@ -1,7 +1,11 @@
 #include "pipeline/label_summary.h"
 
 #include <cstdio>
+#include <set>
 #include <sstream>
+
+#include "hand/metrics.h"
+#include "pipeline/frame_metrics.h"
 
 namespace handlabel {
 namespace {
@@ -10,11 +14,11 @@ namespace {
 const std::vector<std::string> kGroupOrder = {"labels",       "network",     "refined",
                                               "fallback_fit", "network_raw", "fit_only"};
 const std::vector<std::pair<std::string, std::string>> kMetricColumns = {
-    {"mpjpe_mm", "MPJPE mm"},
-    {"pa_mpjpe_mm", "PA-MPJPE mm"},
-    {"mpvpe_mm", "MPVPE mm"},
-    {"pa_mpvpe_mm", "PA-MPVPE mm"},
-    {"auc", "AUC 0-20mm"}};
+    {"mpjpe_mm", "MPJPE mm"},       {"pa_mpjpe_mm", "PA-MPJPE mm"},
+    {"mpvpe_mm", "MPVPE mm"},       {"pa_mpvpe_mm", "PA-MPVPE mm"},
+    {"auc", "AUC 0-20mm"},          {"accel_error_mm", "accel. error mm/f^2"},
+    {"jitter_mm", "jitter mm/f^2"},
+};
 
 std::string Number(double value, int decimals) {
   char text[32];
@@ -39,6 +43,36 @@ std::vector<std::string> GroupsInOrder(
 int GroupFrames(const std::map<std::string, MetricMean>& metrics) {
   const auto it = metrics.find("mpjpe_mm");
   return it == metrics.end() ? 0 : it->second.count;
+}
+
+// The motion metrics of every group with keypoints in the records, over the triples of
+// consecutive frames of `frames` (capture order) that all have the group's keypoints;
+// as means over those triples.
+void AddMotionMetrics(const std::vector<std::string>& frames,
+                      const std::map<std::string, FrameRecord>& records,
+                      LabelSummary* summary) {
+  std::set<std::string> groups;
+  for (const auto& [frame, record] : records) {
+    for (const auto& [group, unused] : record.keypoints_mm) groups.insert(group);
+  }
+  groups.erase(kTruthKeypoints);
+  const std::vector<int64_t> numbers = MotionFrameNumbers(frames);
+  for (const std::string& group : groups) {
+    std::vector<MotionFrame> motion;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const auto it = records.find(frames[i]);
+      if (it == records.end() || it->second.status != "ok") continue;
+      const auto& keypoints = it->second.keypoints_mm;
+      if (!keypoints.count(group) || !keypoints.count(kTruthKeypoints)) continue;
+      motion.push_back({numbers[i], KeypointsFromMillimetres(keypoints.at(group)),
+                        KeypointsFromMillimetres(keypoints.at(kTruthKeypoints))});
+    }
+    const MotionMetrics m = ComputeMotionMetrics(motion);
+    if (m.triples == 0) continue;
+    auto& means = summary->metrics[group];
+    means["accel_error_mm"] = {1000 * m.acceleration_error * m.triples, m.triples};
+    means["jitter_mm"] = {1000 * m.jitter * m.triples, m.triples};
+  }
 }
 
 }  // namespace
@@ -71,6 +105,7 @@ LabelSummary Summarize(const std::vector<std::string>& frames,
       ++m.count;
     }
   }
+  AddMotionMetrics(frames, records, &s);
   return s;
 }
 

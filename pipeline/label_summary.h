@@ -4,7 +4,8 @@
 // capture has ground truth, the errors per group of frames.
 //
 // Metric groups (keys "<group>/<metric>" in FrameRecord::metrics, metrics as in
-// frame_metrics.h):
+// frame_metrics.h; the motion metrics from the records' keypoints over consecutive
+// frames, each group's over the triples of consecutive frames it has):
 //   network, refined, fallback_fit  the labels, grouped by the path that produced them
 //   labels                          every label
 //   network_raw                     the network's answer on every frame it ran on,

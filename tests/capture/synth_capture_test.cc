@@ -2,10 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <algorithm>
 #include <map>
 #include <memory>
 #include <random>
@@ -47,17 +47,8 @@ std::map<std::string, std::string> ReadTree(const std::string& root) {
   return files;
 }
 
-TEST(SynthCapture, StoredKeypointsAreTheGroundTruthJointsProjectedWithTheStoredRig) {
-  const std::string dir = ScratchDir() + "/cap";
-  SynthCaptureOptions o = SmallOptions();
-  o.rig.preset = "random";
-  o.rig.distortion = true;  // projection must include the lens distortion
-  o.rig.num_cameras = 4;
-  WriteSynthCapture(MakeCapsuleHand(HandSide::kRight), o, dir, "builtin:capsule");
-  const CaptureReader reader(dir);
-  ASSERT_EQ(reader.num_frames(), 3);
-  ASSERT_EQ(reader.num_cameras(), 4);
-  EXPECT_TRUE(reader.rig()[0].camera.HasDistortion());
+// The capture's stored 2D keypoints are its ground truth projected with its rig.
+void ExpectKeypointsAreTheProjectedGroundTruth(const CaptureReader& reader) {
   int visible = 0;
   for (int f = 0; f < reader.num_frames(); ++f) {
     const HandGroundTruth gt = reader.ReadGroundTruth(f);
@@ -77,6 +68,35 @@ TEST(SynthCapture, StoredKeypointsAreTheGroundTruthJointsProjectedWithTheStoredR
   EXPECT_GT(visible, 100);
 }
 
+// A random rig with lens distortion, which the projection must include.
+SynthCaptureOptions DistortedRigOptions() {
+  SynthCaptureOptions o = SmallOptions();
+  o.rig.preset = "random";
+  o.rig.distortion = true;
+  o.rig.num_cameras = 4;
+  return o;
+}
+
+TEST(SynthCapture, StoredKeypointsAreTheGroundTruthJointsProjectedWithTheStoredRig) {
+  const std::string dir = ScratchDir() + "/cap";
+  WriteSynthCapture(MakeCapsuleHand(HandSide::kRight), DistortedRigOptions(), dir,
+                    "builtin:capsule");
+  const CaptureReader reader(dir);
+  ASSERT_EQ(reader.num_frames(), 3);
+  ASSERT_EQ(reader.num_cameras(), 4);
+  EXPECT_TRUE(reader.rig()[0].camera.HasDistortion());
+  ExpectKeypointsAreTheProjectedGroundTruth(reader);
+}
+
+TEST(SynthCapture, SequenceKeypointsAreTheGroundTruthProjectedWithTheStoredRig) {
+  const std::string dir = ScratchDir() + "/cap";
+  SynthCaptureOptions o = DistortedRigOptions();
+  o.sequence.enabled = true;
+  o.sequence.fps = 10;  // a coarse rate: 3 frames reach further into the motion
+  WriteSynthCapture(MakeCapsuleHand(HandSide::kRight), o, dir, "builtin:capsule");
+  ExpectKeypointsAreTheProjectedGroundTruth(CaptureReader(dir));
+}
+
 // The capsule hand (no file needed) and the shipped open hand.
 class SynthCaptureModels : public ::testing::TestWithParam<std::string> {
  protected:
@@ -87,15 +107,10 @@ class SynthCaptureModels : public ::testing::TestWithParam<std::string> {
   }
 };
 
-TEST_P(SynthCaptureModels, MaskIsExactlyTheHandPixelsInFrontOfTheObjects) {
-  // Re-render hand and objects separately from the stored ground truth; the stored
-  // mask must be the pixels where the hand is drawn and no object is nearer.
-  const std::string dir = ScratchDir() + "/cap";
-  SynthCaptureOptions o = SmallOptions();
-  o.scene.max_objects = 3;
-  const HandModel model = Model();
-  WriteSynthCapture(model, o, dir, "builtin:capsule");
-  const CaptureReader reader(dir);
+// Re-renders hand and objects separately from the stored ground truth; the stored mask
+// must be the pixels where the hand is drawn and no object is nearer.
+void ExpectMasksAreTheHandPixelsInFrontOfTheObjects(const HandModel& model,
+                                                    const CaptureReader& reader) {
   int hidden_by_object = 0, hand_pixels = 0;
   for (int f = 0; f < reader.num_frames(); ++f) {
     const HandGroundTruth gt = reader.ReadGroundTruth(f);
@@ -138,6 +153,26 @@ TEST_P(SynthCaptureModels, MaskIsExactlyTheHandPixelsInFrontOfTheObjects) {
   }
   EXPECT_GT(hand_pixels, 1000);
   EXPECT_GT(hidden_by_object, 20) << "objects should hide some of the hand";
+}
+
+TEST_P(SynthCaptureModels, MaskIsExactlyTheHandPixelsInFrontOfTheObjects) {
+  const std::string dir = ScratchDir() + "/cap";
+  SynthCaptureOptions o = SmallOptions();
+  o.scene.max_objects = 3;
+  const HandModel model = Model();
+  WriteSynthCapture(model, o, dir, "builtin:capsule");
+  ExpectMasksAreTheHandPixelsInFrontOfTheObjects(model, CaptureReader(dir));
+}
+
+TEST_P(SynthCaptureModels, SequenceMaskIsExactlyTheHandPixelsInFrontOfTheObjects) {
+  const std::string dir = ScratchDir() + "/cap";
+  SynthCaptureOptions o = SmallOptions();
+  o.scene.max_objects = 3;
+  o.sequence.enabled = true;
+  o.sequence.fps = 2;  // frames 0, 1, 2 at 0, 0.5 and 1 s: reaching, then grasping
+  const HandModel model = Model();
+  WriteSynthCapture(model, o, dir, "builtin:capsule");
+  ExpectMasksAreTheHandPixelsInFrontOfTheObjects(model, CaptureReader(dir));
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, SynthCaptureModels,

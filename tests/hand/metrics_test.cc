@@ -4,8 +4,11 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
+#include <vector>
 
 #include "core/errors.h"
 #include "tests/hand/lbs_fixture.h"
@@ -128,6 +131,111 @@ TEST(MetricsTest, EvaluateHandFrameConsistent) {
   EXPECT_NEAR(m.rr_mpjpe, 0.0, 1e-15);
   EXPECT_NEAR(m.rr_mpvpe, 0.0, 1e-15);
   EXPECT_NEAR(m.pa_mpjpe, 0.0, 1e-12);
+}
+
+// Points moving with constant accelerations A_k: p_k(t) = p0_k + v_k t + A_k t^2 / 2, so
+// every second difference is A_k exactly (up to rounding).
+Points3d QuadraticTrajectoryAt(double t, const Points3d& p0, const Points3d& v,
+                               const Points3d& acceleration) {
+  return p0 + t * v + 0.5 * t * t * acceleration;
+}
+
+std::vector<MotionFrame> QuadraticFrames(int count, const Points3d& p0, const Points3d& v,
+                                         const Points3d& truth_acc,
+                                         const Points3d& predicted_acc) {
+  std::vector<MotionFrame> frames;
+  for (int t = 0; t < count; ++t) {
+    MotionFrame f;
+    f.number = 100 + t;
+    f.truth = QuadraticTrajectoryAt(t, p0, v, truth_acc);
+    // An offset does not accelerate: only the acceleration difference is an error.
+    f.predicted = QuadraticTrajectoryAt(t, p0, v, predicted_acc).array() + 0.01;
+    frames.push_back(f);
+  }
+  return frames;
+}
+
+TEST(MotionMetrics, QuadraticTrajectoriesHaveTheirConstantAcceleration) {
+  const Points3d p0 = Pts({{0.1, 0.2, 0.3}, {-0.2, 0.0, 0.5}});
+  const Points3d v = Pts({{0.01, -0.02, 0.0}, {0.0, 0.005, 0.003}});
+  const Points3d truth_acc = Pts({{0.003, 0.0, 0.004}, {0.0, -0.001, 0.0}});   // 5, 1 mm
+  const Points3d predicted_acc = Pts({{0.0, 0.0, 0.004}, {0.0, 0.001, 0.0}});  // 4, 1 mm
+  const MotionMetrics m =
+      ComputeMotionMetrics(QuadraticFrames(10, p0, v, truth_acc, predicted_acc));
+  EXPECT_EQ(m.triples, 8);
+  EXPECT_NEAR(m.truth_acceleration, (0.005 + 0.001) / 2, 1e-12);
+  EXPECT_NEAR(m.jitter, (0.004 + 0.001) / 2, 1e-12);
+  // |(0, 0, 4) - (3, 0, 4)| = 3 mm, |(0, 1, 0) - (0, -1, 0)| = 2 mm.
+  EXPECT_NEAR(m.acceleration_error, (0.003 + 0.002) / 2, 1e-12);
+}
+
+TEST(MotionMetrics, AlternatingNoiseOnAStraightLineIsFourTimesItsSize) {
+  // n_t = (-1)^t e: n_{t-1} - 2 n_t + n_{t+1} = 4 e in size; the line itself has no
+  // acceleration.
+  std::vector<MotionFrame> frames;
+  for (int t = 0; t < 7; ++t) {
+    MotionFrame f;
+    f.number = t;
+    f.truth = Pts({{0.01 * t, 0, 0}});
+    f.predicted = f.truth;
+    f.predicted(0, 1) += (t % 2 == 0 ? 1 : -1) * 0.002;
+    frames.push_back(f);
+  }
+  const MotionMetrics m = ComputeMotionMetrics(frames);
+  EXPECT_EQ(m.triples, 5);
+  EXPECT_NEAR(m.truth_acceleration, 0, 1e-15);
+  EXPECT_NEAR(m.acceleration_error, 0.008, 1e-12);
+  EXPECT_NEAR(m.jitter, 0.008, 1e-12);
+}
+
+TEST(MotionMetrics, GaussianNoiseMatchesItsExpectedAcceleration) {
+  // a = n1 - 2 n2 + n3 of i.i.d. N(0, s^2 I) noise is N(0, 6 s^2 I); the mean norm of
+  // a 3D Gaussian of per-axis sigma r is r * 2 sqrt(2 / pi).
+  const double sigma = 0.001;
+  std::mt19937_64 rng(45);
+  std::normal_distribution<double> noise(0.0, sigma);
+  std::vector<MotionFrame> frames;
+  for (int t = 0; t < 2000; ++t) {
+    MotionFrame f;
+    f.number = t;
+    f.truth = Points3d::Constant(21, 3, 0.2);
+    f.predicted = f.truth;
+    for (int i = 0; i < f.predicted.size(); ++i) f.predicted(i) += noise(rng);
+    frames.push_back(f);
+  }
+  const MotionMetrics m = ComputeMotionMetrics(frames);
+  const double expected = std::sqrt(6.0) * sigma * 2.0 * std::sqrt(2.0 / M_PI);
+  EXPECT_NEAR(m.acceleration_error, expected, 0.02 * expected);
+  EXPECT_NEAR(m.jitter, m.acceleration_error, 1e-12);  // the truth stands still
+}
+
+TEST(MotionMetrics, GapsAreNeverDifferencedAcross) {
+  // Frames 0-2 and 4-6 on two unrelated straight lines, frame 3 missing: the jump
+  // between them must not count, and only the two whole triples do.
+  std::vector<MotionFrame> frames;
+  for (int t : {0, 1, 2, 4, 5, 6}) {
+    MotionFrame f;
+    f.number = t;
+    f.predicted = Pts({{0.001 * t + (t > 3 ? 1.0 : 0.0), 0, 0}});
+    frames.push_back(f);
+  }
+  const MotionMetrics m = ComputeMotionMetrics(frames);
+  EXPECT_EQ(m.triples, 2);
+  EXPECT_NEAR(m.jitter, 0, 1e-12);
+  EXPECT_EQ(m.acceleration_error, 0);  // no truth
+  // Fewer than three consecutive frames: nothing to difference.
+  frames.resize(2);
+  EXPECT_EQ(ComputeMotionMetrics(frames).triples, 0);
+  EXPECT_EQ(ComputeMotionMetrics({}).triples, 0);
+}
+
+TEST(MotionMetrics, FramesOutOfOrderAreRefused) {
+  std::vector<MotionFrame> frames(3);
+  for (int t = 0; t < 3; ++t) {
+    frames[t].number = 2 - t;
+    frames[t].predicted = Pts({{0, 0, 0}});
+  }
+  EXPECT_ANY_THROW(ComputeMotionMetrics(frames));
 }
 
 }  // namespace

@@ -144,6 +144,34 @@ TEST(LabelJob, RefineOffWritesTheNetworkAnswerWithItsFlags) {
   EXPECT_FALSE(ReadLabelFile(LabelFilePath(out, "000001")).quality.Passed());
 }
 
+// The summary's motion metrics. The network's answer is 3 cm off on frame 5 alone
+// (refine off: the answer is the label), so the errors' second differences are 30, 60
+// and 30 mm on the triples centred on frames 4, 5 and 6 and 0 on the others; the
+// unreadable frame 9 takes the triples centred on 8, 9 and 10 out: 120 mm over 7.
+TEST(LabelJob, SummaryMotionMetricsCoverConsecutiveLabelledFramesOnly) {
+  Stages s;
+  s.predictor.shifted = {"000005"};
+  s.capture.unreadable = {"000009"};
+  const std::string out = testing::ScratchDir() + "/out";
+  const JobConfig job = MakeJob(out, RefineMode::kOff);
+  const LabelSummary summary = RunLabelJob(job, s.Set(), {});
+  EXPECT_EQ(summary.failed, 1);
+  for (const char* group : {"labels", "network", "network_raw"}) {
+    const auto& metrics = summary.metrics.at(group);
+    EXPECT_EQ(metrics.at("accel_error_mm").count, 7) << group;
+    EXPECT_NEAR(metrics.at("accel_error_mm").Mean(), 120.0 / 7, 0.005) << group;
+    // The test capture's poses are drawn independently per frame: they jump.
+    EXPECT_GT(metrics.at("jitter_mm").Mean(), 10.0) << group;
+  }
+  EXPECT_THAT(summary.ToText(), HasSubstr("accel. error mm/f^2 17.14"));
+  // The merge computes them again from the logs' keypoints.
+  const LabelSummary merged = MergeLabelOutputs(
+      out, "test", JobHash(job, s.predictor.weights_sha256), s.capture.FrameIds());
+  EXPECT_NEAR(merged.metrics.at("labels").at("accel_error_mm").Mean(), 120.0 / 7, 0.005);
+  EXPECT_EQ(merged.metrics.at("labels").at("jitter_mm").Mean(),
+            summary.metrics.at("labels").at("jitter_mm").Mean());
+}
+
 TEST(LabelJob, AFailingFrameIsRecordedWithItsReasonAndTheJobGoesOn) {
   Stages s;
   s.capture.unreadable = {"000001"};
