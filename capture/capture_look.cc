@@ -102,11 +102,11 @@ std::vector<ImageU8> EmptySceneBackgrounds(const FrameSource& source,
 }
 
 Eigen::Vector3d RigUp(const Rig& rig) {
+  if (rig.empty()) return Eigen::Vector3d::UnitZ();
   Eigen::Vector3d mean_view = Eigen::Vector3d::Zero();
   for (const RigCamera& c : rig.cameras()) {
     mean_view += c.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitZ();
   }
-  if (rig.empty()) return Eigen::Vector3d::UnitZ();
   mean_view /= static_cast<double>(rig.size());
   // Below a third of a unit the cameras look from all sides.
   constexpr double kMinAgreement = 0.3;

@@ -67,14 +67,15 @@ void TrainStage(AdaptRun* run);
 void ExportStage(const AdaptRun& run);
 void HeldoutStage(const AdaptRun& run);
 
-// The training plan checked once on the way (plan.json): after the first tenth of its
-// steps (at least 100; ReplanStep, 0 for a plan too short for a check) the seconds
-// per step measured since the timing run replace the timing run's estimate (10 steps:
-// with synthetic hands a step's cost varies by a third from one batch to the next),
-// and Replan plans the steps again for what is left of the budget, `seconds` having
-// passed since the plan was made (its seconds_before_training counts the timing run).
-// The check comes before the learning rate's decay (70 %): only where it starts moves.
-int64_t ReplanStep(const nlohmann::json& plan);
+// The training plan checked on the way (plan.json): after every tenth of its steps
+// (at least 100; NextPlanCheck gives the first check after `step`, 0 when none is left
+// before the learning rate's decay at 70 %: only where the decay starts moves) the
+// seconds per step measured since the previous check (or the timing run: 10 steps say
+// little, with synthetic hands a step's cost varies by a third from batch to batch)
+// replace the estimate, and Replan plans the steps again for what is left of the
+// budget, `seconds` having passed since the previous check or the plan (whose
+// seconds_before_training counts the timing run). Each check is kept in `checks`.
+int64_t NextPlanCheck(const nlohmann::json& plan, int64_t step);
 void Replan(int64_t step, double seconds_per_step, double seconds, nlohmann::json* plan);
 
 // The label job file for new recordings of the rig (new_recordings.yaml): the adapted
@@ -83,9 +84,10 @@ void Replan(int64_t step, double seconds_per_step, double seconds, nlohmann::jso
 constexpr int kNewRecordingsDetectorEvery = 10;
 std::string JobForNewRecordings(const AdaptRun& run);
 
-// Synthetic training samples in the capture's look (adapt_training.cc, capture/capture_look.h): hands rendered
-// with `capture`'s cameras over the backgrounds stage's pictures, placed where the
-// training `labels` put the hand, realistic look, half of them holding objects.
+// Synthetic training samples in the capture's look (adapt_training.cc,
+// capture/capture_look.h): hands rendered with `capture`'s cameras over the backgrounds
+// stage's pictures, placed where the training `labels` put the hand, realistic look, half
+// of them holding objects.
 std::unique_ptr<SynthTrainingSamples> CaptureLookSynthSamples(
     const AdaptRun& run, const FrameSource& capture, const HandModel& hand,
     const std::vector<LabeledFrame>& labels, const TrainingSampleOptions& samples);

@@ -289,24 +289,78 @@ std::unique_ptr<SynthTrainingSamples> CaptureLookSynthSamples(
       hand, rig, CaptureLookSynthOptions(rig, hands, photos, run.o.seed), samples);
 }
 
-int64_t ReplanStep(const nlohmann::json& plan) {
+namespace {
+
+// The plan's checks so far: `checks` (an older run's single `replanned` counts as one).
+nlohmann::json PlanChecks(const nlohmann::json& plan) {
+  if (plan.contains("checks")) return plan["checks"];
+  if (plan.contains("replanned")) return nlohmann::json::array({plan["replanned"]});
+  return nlohmann::json::array();
+}
+
+}  // namespace
+
+int64_t NextPlanCheck(const nlohmann::json& plan, int64_t step) {
   const int64_t steps = plan["steps"].get<int64_t>();
-  const int64_t at = std::max<int64_t>(5 * kTimingSteps, steps / 10);
-  return 2 * at <= steps ? at : 0;
+  const int64_t interval = std::max<int64_t>(5 * kTimingSteps, steps / 10);
+  const nlohmann::json checks = PlanChecks(plan);
+  int64_t next =
+      (checks.empty() ? kTimingSteps : checks.back()["at_step"].get<int64_t>()) +
+      interval;
+  // A continued run past a check, or too near one to measure its speed: the next.
+  while (next < step + interval / 2) next += interval;
+  return next <= kDecayAt * steps ? next : 0;
 }
 
 void Replan(int64_t step, double seconds_per_step, double seconds, nlohmann::json* plan) {
-  const double spent = (*plan)["seconds_before_training"].get<double>() + seconds;
+  nlohmann::json checks = PlanChecks(*plan);
+  const double spent = (checks.empty() ? (*plan)["seconds_before_training"]
+                                       : checks.back()["seconds_spent"])
+                           .get<double>() +
+                       seconds;
   const double left = (*plan)["budget_seconds"].get<double>() - spent -
                       (*plan)["reserve_seconds"].get<double>();
   const int64_t extra =
       left > 0 ? static_cast<int64_t>(0.95 * left / seconds_per_step) : kTimingSteps;
-  (*plan)["first_plan_steps"] = (*plan)["steps"];
+  if (!plan->contains("first_plan_steps")) (*plan)["first_plan_steps"] = (*plan)["steps"];
   (*plan)["steps"] = step + std::max<int64_t>(extra, kTimingSteps);
-  (*plan)["replanned"] = {{"at_step", step},
-                          {"seconds_per_step", seconds_per_step},
-                          {"seconds_spent", spent}};
+  checks.push_back({{"at_step", step},
+                    {"seconds_per_step", seconds_per_step},
+                    {"seconds_spent", spent},
+                    {"steps", (*plan)["steps"]}});
+  (*plan)["checks"] = checks;
+  plan->erase("replanned");
 }
+
+namespace {
+
+// Trains to the end of the plan, checking it on the way (NextPlanCheck): each check
+// plans the rest on the seconds per step since the previous one, so other work that
+// arrives on the machine mid-run shortens the training instead of overrunning the budget.
+void TrainChecked(AdaptRun* run, TrainConfig* c, const HandModel& hand,
+                  const AdaptSamples& samples, const std::string& plan_path,
+                  nlohmann::json* plan) {
+  int64_t from =
+      std::max<int64_t>(kTimingSteps, LatestPoemCheckpointStep(c->trainer.out_dir));
+  for (int64_t at = NextPlanCheck(*plan, from); at > 0; at = NextPlanCheck(*plan, from)) {
+    const Clock::time_point t0 = Clock::now();
+    TrainUntil(*run, *c, hand, samples, at);
+    const double seconds = SecondsSince(t0);
+    const int64_t steps_before = (*plan)["steps"].get<int64_t>();
+    Replan(at, seconds / static_cast<double>(at - from), seconds, plan);
+    WriteFileAtomically(plan_path, plan->dump(1) + "\n");
+    run->Say("train: steps " + std::to_string(from) + "-" + std::to_string(at) +
+             " took " +
+             FormatNumber((*plan)["checks"].back()["seconds_per_step"].get<double>()) +
+             " s/step: " + (*plan)["steps"].dump() + " steps in all (planned " +
+             std::to_string(steps_before) + ")");
+    ApplyPlan(*plan, c);
+    from = at;
+  }
+  TrainUntil(*run, *c, hand, samples, -1);
+}
+
+}  // namespace
 
 void TrainStage(AdaptRun* run) {
   TrainConfig c = AdaptTrainConfig(*run);
@@ -349,24 +403,7 @@ void TrainStage(AdaptRun* run) {
            FormatNumber(plan["seconds_per_step"].get<double>()) + " s/step (" +
            plan_path + ")");
   ApplyPlan(plan, &c);
-  const int64_t check_at = ReplanStep(plan);
-  const int64_t from =
-      std::max<int64_t>(kTimingSteps, LatestPoemCheckpointStep(c.trainer.out_dir));
-  // A run continued past the check (killed before it wrote the new plan) keeps the first.
-  if (check_at > 0 && !plan.contains("replanned") && from < check_at) {
-    const Clock::time_point t0 = Clock::now();
-    TrainUntil(*run, c, hand, samples, check_at);
-    const double seconds = SecondsSince(t0);
-    Replan(check_at, seconds / static_cast<double>(check_at - from), seconds, &plan);
-    WriteFileAtomically(plan_path, plan.dump(1) + "\n");
-    run->Say("train: steps " + std::to_string(from) + "-" + std::to_string(check_at) +
-             " took " +
-             FormatNumber(plan["replanned"]["seconds_per_step"].get<double>()) +
-             " s/step: " + plan["steps"].dump() + " steps in all (first plan " +
-             plan["first_plan_steps"].dump() + ")");
-    ApplyPlan(plan, &c);
-  }
-  TrainUntil(*run, c, hand, samples, -1);
+  TrainChecked(run, &c, hand, samples, plan_path, &plan);
 }
 
 void ExportStage(const AdaptRun& run) {
