@@ -57,6 +57,16 @@ void ExpectSameNumbers(const nlohmann::json& row, const nlohmann::json& summary,
     EXPECT_TRUE(m.at("mpvpe_mm").is_null());
   }
   EXPECT_EQ(m.at("frames").get<int>(), s.at("frames").get<int>());
+  // Motion columns: the capture's frames are consecutive, so both have them. The
+  // summary's come from the shard logs' keypoints, rounded to 1 um
+  // (KeypointsToMillimetres): a second difference of three rounded points is off by at
+  // most 2 um per axis, 3.5 um in length.
+  ASSERT_TRUE(s.contains("accel_error_mm")) << group;
+  constexpr double kRoundingMm = 3.5e-3;
+  EXPECT_NEAR(m.at("accel_error_mm").get<double>(), s.at("accel_error_mm").get<double>(),
+              kRoundingMm);
+  EXPECT_NEAR(m.at("jitter_mm").get<double>(), s.at("jitter_mm").get<double>(),
+              kRoundingMm);
 }
 
 class CompareCommand : public ::testing::Test {
@@ -87,8 +97,9 @@ testing::CommandResult* CompareCommand::result_ = nullptr;
 
 TEST_F(CompareCommand, PrintsTheTableAndWritesTheReport) {
   ASSERT_EQ(result_->status, 0) << result_->err;
-  for (const char* column : {"MPVPE", "RR-V", "PA-V", "AUC-V", "MPJPE", "RR-J", "PA-J",
-                             "AUC-J", "s/frame", "threads", "params"}) {
+  for (const char* column :
+       {"MPVPE", "RR-V", "PA-V", "AUC-V", "MPJPE", "RR-J", "PA-J", "AUC-J", "Accel-J",
+        "Jitter-J", "s/frame", "threads", "params"}) {
     EXPECT_THAT(result_->out, HasSubstr(column));
   }
   for (const char* file :
