@@ -295,9 +295,12 @@ TEST(DetectCommand, VideoModeTracksTheHandThroughASequence) {
     EXPECT_FALSE(one.contains("tracking"));  // per-frame records are as before
     const std::string tracking = video["tracking"];
     // --palm-every 0: only the first frame starts a run.
-    if (f == 0) EXPECT_EQ(tracking, "start");
-    if (f > 0) EXPECT_NE(tracking, "start") << id;
-    if (f == 0) EXPECT_EQ(ViewKeypointsText(video), ViewKeypointsText(one));
+    if (f == 0) {
+      EXPECT_EQ(tracking, "start");
+      EXPECT_EQ(ViewKeypointsText(video), ViewKeypointsText(one));
+    } else {
+      EXPECT_NE(tracking, "start") << id;
+    }
     tracked_frames += tracking == "track";
     const auto truth = capture.ReadKeypoints(f);
     const auto views = capture.ReadDetections(f);
@@ -310,7 +313,9 @@ TEST(DetectCommand, VideoModeTracksTheHandThroughASequence) {
                     v["region"] == "outside")
             << v["region"];
         // Palm detection runs only where the track did not hold.
-        if (v["region"] != "palm") EXPECT_EQ(v["palm_candidates"], 0);
+        if (v["region"] != "palm") {
+          EXPECT_EQ(v["palm_candidates"], 0);
+        }
       } else {
         EXPECT_EQ(v["region"], "palm");
       }
