@@ -45,6 +45,13 @@ int RunDetect(int argc, char** argv) {
   app.add_option("--min-presence-from-3d", dc.multiview.min_presence_from_3d,
                  "with --capture: presence needed in ROIs placed from the other views")
       ->capture_default_str();
+  app.add_flag("--video", dc.video,
+               "with --capture: video mode, each frame's regions from the previous "
+               "frame's 3D hand; palm detection where the track is lost");
+  app.add_option("--palm-every", dc.palm_every,
+                 "with --video: palm detection on every view of every K-th frame "
+                 "(0 = only where the track is lost)")
+      ->capture_default_str();
   app.add_option("--min-palm-views", dc.multiview.min_palm_views,
                  "with --capture: views whose palms must agree")
       ->capture_default_str();
@@ -93,9 +100,13 @@ int RunDetect(int argc, char** argv) {
       if (progress) progress->Finish();
       std::printf(
           "frames %d, hand found in %d; views with a detection %d of %d (%d from "
-          "their own palm); %.1f s\n",
-          s.frames, s.frames_with_hand, s.views_detected, s.views, s.views_from_palm,
-          s.seconds);
+          "their own palm",
+          s.frames, s.frames_with_hand, s.views_detected, s.views, s.views_from_palm);
+      if (dc.video) {
+        std::printf(", %d tracked from the previous frame; %d frames tracked",
+                    s.views_tracked, s.frames_tracked);
+      }
+      std::printf("); %.1f s\n", s.seconds);
       std::cout << "detections: " << capture_dir << "/detections\n";
       return 0;
     });

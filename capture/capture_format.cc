@@ -163,9 +163,9 @@ json ViewKeypointsToJson(const std::string& frame,
 
 std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
                                                  const std::string& source) {
-  // "detector" and "hand" (and the per-view fields after "hand_pixels") are what
-  // `handlabel detect` records beside the keypoints (docs/detector.md).
-  RejectUnknownKeys(j, {"frame", "views", "detector", "hand"}, source);
+  // "detector", "hand" and "tracking" (and the per-view fields after "hand_pixels")
+  // are what `handlabel detect` records beside the keypoints (docs/detector.md).
+  RejectUnknownKeys(j, {"frame", "views", "detector", "hand", "tracking"}, source);
   const json& views = JsonMember(j, "views", source);
   if (!views.is_array()) throw InputError(source, "views", "an array", views.dump());
   std::vector<ViewKeypoints> out;
@@ -175,7 +175,7 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
     RejectUnknownKeys(jv,
                       {"camera", "keypoints", "visibility", "confidence", "status",
                        "hand_pixels", "detected", "palm_candidates", "source", "presence",
-                       "handedness", "median_reprojection_px", "reason"},
+                       "handedness", "median_reprojection_px", "reason", "region"},
                       source, where);
     ViewKeypoints v;
     v.camera = JsonString(jv, "camera", source, where);
@@ -266,8 +266,8 @@ bool SameFrame(const std::string& a, const std::string& b) {
 std::vector<std::optional<ViewKeypoints>> FrameKeypointsFromJson(
     const json& j, const std::string& source, const std::string& frame, const Rig& rig) {
   const std::vector<ViewKeypoints> views = ViewKeypointsFromJson(j, source);
-  if (j.contains("frame") && !(j["frame"].is_string() &&
-                               SameFrame(j["frame"].get<std::string>(), frame))) {
+  if (j.contains("frame") &&
+      !(j["frame"].is_string() && SameFrame(j["frame"].get<std::string>(), frame))) {
     throw InputError(source, "frame",
                      "'" + frame +
                          "' (the frame this file is read for; a file of another "

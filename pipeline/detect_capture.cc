@@ -4,7 +4,9 @@
 #include <filesystem>
 #include <limits>
 #include <mutex>
+#include <optional>
 
+#include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -53,6 +55,8 @@ void DetectCaptureOptions::Check(const std::string& source) const {
   hands.Check(source);
   multiview.Check(source);
   RequireAtLeast(source, "threads", threads, 0, ">= 0 (0 = one frame per core)");
+  RequireAtLeast(source, "palm_every", palm_every, 0,
+                 ">= 0 (0 = palm detection only where the track is lost)");
 }
 
 void DetectCaptureSummary::Add(const DetectCaptureSummary& other) {
@@ -60,7 +64,18 @@ void DetectCaptureSummary::Add(const DetectCaptureSummary& other) {
   views += other.views;
   views_detected += other.views_detected;
   views_from_palm += other.views_from_palm;
+  views_tracked += other.views_tracked;
+  frames_tracked += other.frames_tracked;
   frames_with_hand += other.frames_with_hand;
+}
+
+std::vector<FrameRun> FrameRuns(int total, int palm_every) {
+  std::vector<FrameRun> runs;
+  for (int f = 0; f < total; ++f) {
+    if (runs.empty() || (palm_every > 0 && f % palm_every == 0)) runs.push_back({f, f});
+    runs.back().end = f + 1;
+  }
+  return runs;
 }
 
 nlohmann::json FrameDetectionsJson(const std::string& frame,
@@ -94,25 +109,35 @@ nlohmann::json FrameDetectionsJson(const std::string& frame,
       jv["reason"] = r.reason;
       if (r.reason == "low_presence") jv["presence"] = r.hand.presence;
     }
+    if (!r.region.empty()) jv["region"] = r.region;  // video mode only
   }
   out["detector"] = "mediapipe_hands";
   out["hand"] = {{"found", result.found},
                  {"side", HandSideName(result.side)},
                  {"side_score", result.side_score},
                  {"palm_views", result.palm_views}};
+  if (!result.tracking.empty()) out["tracking"] = result.tracking;  // video mode only
   return out;
 }
 
 namespace {
 
 // Detects one frame and writes its detections (and overlays); adds it to `summary`.
-void DetectFrame(const CaptureReader& capture, int f, const MediapipeHands& detector,
-                 const DetectCaptureOptions& options, DetectCaptureSummary* summary) {
+// Video mode: `previous` is the run's previous frame's result (nullptr on its first
+// frame); per-frame mode: ignored. Returns the frame's result.
+FrameHandResult DetectFrame(const CaptureReader& capture, int f,
+                            const MediapipeHands& detector,
+                            const DetectCaptureOptions& options,
+                            const FrameHandResult* previous,
+                            DetectCaptureSummary* summary) {
   const int n = capture.num_cameras();
   std::vector<ImageU8> images;
   for (int c = 0; c < n; ++c) images.push_back(capture.ReadImage(f, c));
-  const FrameHandResult result =
-      DetectHandMultiView(detector, capture.rig(), images, options.multiview);
+  FrameHandResult result =
+      options.video
+          ? DetectHandInVideo(detector, capture.rig(), images, previous,
+                              options.multiview)
+          : DetectHandMultiView(detector, capture.rig(), images, options.multiview);
   const std::string id = capture.frame_id(f);
   if (!options.overlays_dir.empty()) {
     WriteDetectionOverlays(options.overlays_dir, id, capture.manifest().cameras, result,
@@ -124,10 +149,13 @@ void DetectFrame(const CaptureReader& capture, int f, const MediapipeHands& dete
   summary->frames += 1;
   summary->views += n;
   summary->frames_with_hand += result.found ? 1 : 0;
+  summary->frames_tracked += result.tracking == "track" ? 1 : 0;
   for (const ViewHandResult& r : result.views) {
     summary->views_detected += r.detected ? 1 : 0;
     summary->views_from_palm += (r.detected && r.source == "palm") ? 1 : 0;
+    summary->views_tracked += (r.detected && r.source == "track") ? 1 : 0;
   }
+  return result;
 }
 
 }  // namespace
@@ -138,8 +166,9 @@ DetectCaptureSummary DetectCapture(const std::string& capture_dir,
   options.Check("detect");
   // A folder that is not a capture is named before any lock file is made in it (an
   // import beside may not have listed a frame yet: the lock names it below).
-  ReadCaptureManifest(capture_dir, "a native capture: `handlabel synth` or `capture "
-                                   "init` + `capture import` make one");
+  ReadCaptureManifest(capture_dir,
+                      "a native capture: `handlabel synth` or `capture "
+                      "init` + `capture import` make one");
   const FileLock writer =
       LockFolderForWriting(capture_dir, "detect --capture", "--capture", "");
   // Read under the lock: as the last writer (an import) left it.
@@ -152,21 +181,33 @@ DetectCaptureSummary DetectCapture(const std::string& capture_dir,
   const auto t0 = std::chrono::steady_clock::now();
   const MediapipeHands detector(options.hands);
   std::filesystem::create_directories(capture_dir + "/detections");
-  // Frames in parallel, each on one thread (options.hands.num_threads): a frame's
-  // result does not depend on the others, so the files are the same at any count.
+  // Runs in parallel (per-frame mode: runs of one frame), a run's frames in order, each
+  // model call on one thread (options.hands.num_threads): a frame's result depends on
+  // its run's earlier frames only, so the files are the same at any count.
   DetectCaptureSummary summary;
   std::mutex mutex;  // summary and on_frame
   const int total = capture.num_frames();
+  const std::vector<FrameRun> runs =
+      FrameRuns(total, options.video ? options.palm_every : 1);
   tbb::task_arena arena(options.threads > 0 ? options.threads
                                             : tbb::info::default_concurrency());
   arena.execute([&] {
-    tbb::parallel_for(0, total, [&](int f) {
-      DetectCaptureSummary frame;
-      DetectFrame(capture, f, detector, options, &frame);
-      const std::lock_guard<std::mutex> lock(mutex);
-      summary.Add(frame);
-      if (on_frame) on_frame(summary.frames, total);
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, runs.size(), 1),
+        [&](const tbb::blocked_range<size_t>& range) {
+          for (size_t k = range.begin(); k != range.end(); ++k) {
+            std::optional<FrameHandResult> previous;
+            for (int f = runs[k].begin; f < runs[k].end; ++f) {
+              DetectCaptureSummary frame;
+              previous = DetectFrame(capture, f, detector, options,
+                                     previous ? &*previous : nullptr, &frame);
+              const std::lock_guard<std::mutex> lock(mutex);
+              summary.Add(frame);
+              if (on_frame) on_frame(summary.frames, total);
+            }
+          }
+        },
+        tbb::simple_partitioner());
   });
   ListDetections(capture);
   summary.seconds = SecondsSince(t0);

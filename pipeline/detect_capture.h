@@ -29,6 +29,14 @@ struct DetectCaptureOptions {
   // Frames detected at once; 0 = one per core. Each runs its models on
   // hands.num_threads LibTorch threads (1 by default).
   int threads = 0;
+  // Video mode (docs/detector.md): the frames in runs of consecutive frames, each frame
+  // after a run's first with its regions from the previous frame's 3D hand
+  // (DetectHandInVideo); runs go in parallel, a run's frames in order, so the files are
+  // the same at any thread count. Off: every frame from scratch.
+  bool video = false;
+  // With video: a run (palm detection in every view) starts at every frame whose
+  // position in the capture is a multiple of this; 0 = at the first frame only.
+  int palm_every = 30;
   // Throws InputError naming `source` when a field is out of range.
   void Check(const std::string& source) const;
 };
@@ -38,11 +46,20 @@ struct DetectCaptureSummary {
   int views = 0;             // frames x cameras
   int views_detected = 0;    // views with a detection
   int views_from_palm = 0;   // ... whose ROI came from their own palm
+  int views_tracked = 0;     // ... whose ROI came from the previous frame (video mode)
+  int frames_tracked = 0;    // frames whose regions came from the previous frame
   int frames_with_hand = 0;  // frames where a 3D hand was established
   double seconds = 0;
   // Adds another part's counts (not its seconds).
   void Add(const DetectCaptureSummary& other);
 };
+
+// Consecutive frames [begin, end) of a capture, detected in order in video mode.
+struct FrameRun {
+  int begin = 0, end = 0;
+};
+// Frames 0 .. total - 1 cut before every multiple of `palm_every` (0: one run).
+std::vector<FrameRun> FrameRuns(int total, int palm_every);
 
 // Runs every frame (options.threads at once); `on_frame(done, total)` after each,
 // one call at a time. Holds the capture folder's

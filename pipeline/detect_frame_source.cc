@@ -67,17 +67,30 @@ FrameInput DetectorFrameSource::Load(const std::string& id) const {
   return frame;
 }
 
-void DetectorFrameSource::Detect(FrameInput* frame) const {
+FrameHandResult DetectorFrameSource::Detect(FrameInput* frame,
+                                            const FrameHandResult* previous) const {
   // Frames may be detected in parallel: the models keep no state between calls and
   // each call runs on options_.hands.num_threads threads (1 by default).
-  FrameHandResult result =
-      DetectHandMultiView(*detector_, frame->rig, frame->images, options_.multiview);
+  FrameHandResult result = options_.video
+                               ? DetectHandInVideo(*detector_, frame->rig, frame->images,
+                                                   previous, options_.multiview)
+                               : DetectHandMultiView(*detector_, frame->rig,
+                                                     frame->images, options_.multiview);
   frame->keypoints_2d = KeypointsFromDetection(result);
-  if (store_) store_->Put(frame->id, std::move(result));
+  if (store_) store_->Put(frame->id, result);
+  return result;
 }
 
 std::string DetectorFrameSource::KeypointsSource() const {
-  return "detector (MediaPipe Hands, model " + options_.hands.model + ")";
+  std::string text = "detector (MediaPipe Hands, model " + options_.hands.model;
+  if (options_.video) {
+    text += ", video mode: palm detection where a run starts (";
+    if (options_.palm_every > 0) {
+      text += "every " + std::to_string(options_.palm_every) + " frames, ";
+    }
+    text += "shard starts, gaps) and where the track is lost";
+  }
+  return text + ")";
 }
 
 }  // namespace handlabel

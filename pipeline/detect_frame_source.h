@@ -44,15 +44,18 @@ class DetectorFrameSource : public Replaced2dFrameSource {
   // Loads the models (InputError naming the file when one is missing). `store` may be
   // null (nothing kept). With `detect_on_load` false, Load only reads and decodes: the
   // caller detects the frames it needs with Detect (a job that tracks the hand,
-  // evidence.detector_every).
+  // evidence.detector_every, or detects in video mode, options.video).
   DetectorFrameSource(std::unique_ptr<FrameSource> inner,
                       const DetectCaptureOptions& options,
                       std::shared_ptr<DetectionStore> store, bool detect_on_load = true);
   // Reads the frame's images (InputError naming a file that cannot be read or does not
   // fit its camera) and detects unless told not to. Several frames may load at once.
   FrameInput Load(const std::string& id) const override;
-  // Detects the hand in a frame that Load read: sets frame->keypoints_2d.
-  void Detect(FrameInput* frame) const;
+  // Detects the hand in a frame that Load read: sets frame->keypoints_2d and returns
+  // the detector's answer. Video mode (options.video): `previous` is the answer on the
+  // previous frame of the run (nullptr on a run's first frame, DetectHandInVideo).
+  FrameHandResult Detect(FrameInput* frame,
+                         const FrameHandResult* previous = nullptr) const;
   std::string KeypointsSource() const override;
 
  private:

@@ -165,6 +165,14 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
   evidence.Read("detections", &job->detections);
   evidence.Read("detector_model", &job->detector_model);
   evidence.Read("detector_every", &job->detector_every);
+  std::string detector_mode = "frame";
+  evidence.Read("detector_mode", &detector_mode);
+  if (detector_mode != "frame" && detector_mode != "video") {
+    throw InputError(path, evidence.Name("detector_mode"), "frame | video",
+                     "'" + detector_mode + "'");
+  }
+  job->detector_video = detector_mode == "video";
+  evidence.Read("detector_palm_every", &job->detector_palm_every);
   if (job->detector_model != "full" && job->detector_model != "lite") {
     throw InputError(path, evidence.Name("detector_model"), "full | lite",
                      "'" + job->detector_model + "'");
@@ -249,6 +257,24 @@ void CheckTracking(const JobConfig& job, const std::string& source) {
   }
 }
 
+// evidence.detector_mode: video.
+void CheckDetectorVideo(const JobConfig& job, const std::string& source) {
+  RequireAtLeast(source, "evidence.detector_palm_every", job.detector_palm_every, 0,
+                 ">= 0 (0 = palm detection only where the track is lost)");
+  if (!job.detector_video) return;
+  const std::string why = " (evidence.detector_mode video detects every frame in order)";
+  if (!job.keypoints_from_detector) {
+    throw InputError(source, "evidence.keypoints_2d", "detector" + why,
+                     job.keypoints == KeypointSource::kNetwork ? "'network'"
+                     : job.keypoints == KeypointSource::kFiles ? "'files'"
+                                                               : "'both'");
+  }
+  if (job.detector_every != 1) {
+    throw InputError(source, "evidence.detector_every", "1" + why,
+                     std::to_string(job.detector_every));
+  }
+}
+
 }  // namespace
 
 void JobConfig::Check(const std::string& source) const {
@@ -283,6 +309,7 @@ void JobConfig::Check(const std::string& source) const {
     throw InputError(source, "evidence.keypoints_2d", "'files' when there is no network");
   }
   CheckTracking(*this, source);
+  CheckDetectorVideo(*this, source);
   RequireGreater(source, "refine.max_reprojection_px", quality.max_reprojection_px, 0);
   RequireGreater(source, "refine.max_view_disagreement_mm",
                  quality.max_view_disagreement_mm, 0);

@@ -145,6 +145,15 @@ struct JobConfig {
   // on frames whose network answer, cut around the previous frame's label, fails its
   // checks; 1 = on every frame.
   int detector_every = 1;
+  // evidence.detector_mode: video (with keypoints_2d: detector): the job's frames are
+  // detected in order, each frame's regions from the previous frame's 3D hand, palm
+  // detection only on a run's first frame, every detector_palm_every-th frame of the job
+  // and where the track is lost (DetectHandInVideo); "frame" (false): every frame
+  // from scratch.
+  bool detector_video = false;
+  // evidence.detector_palm_every: with detector_mode video, the job's frame positions
+  // (input.frames order) that start a run; 0 = only a shard's first frame and gaps.
+  int detector_palm_every = 30;
   // Camera names whose 2D keypoints and masks are not fitted to (a broken camera).
   std::vector<std::string> ignore_views;
   // Silhouette residual scale (pixels per unit) for the network's masks. In the file

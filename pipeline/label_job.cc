@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -153,7 +154,9 @@ class LabelJobRun {
     Progress progress(static_cast<int>(todo_.size()),
                       options_.log ? *options_.log : discard, options_.interactive);
     progress_ = &progress;
-    if (stages_.find_keypoints_2d) {
+    if (stages_.detect_in_video) {
+      LabelVideo();
+    } else if (stages_.find_keypoints_2d) {
       LabelTracked();
     } else if (in_order_) {
       LabelInOrder();
@@ -452,6 +455,64 @@ class LabelJobRun {
     }
   }
 
+  // Video mode (evidence.detector_mode: video): hand out frames (serial), read
+  // (parallel), detect (serial, in order: each frame from the previous one's answer),
+  // the network if any (one frame at a time), label and write (parallel; in order
+  // with fit.init previous).
+  void LabelVideo() {
+    using BatchPtr = std::shared_ptr<Batch>;
+    for (size_t i = 0; i < mine_.size(); ++i) position_[mine_[i]] = i;
+    const tbb::filter_mode finish =
+        in_order_ ? tbb::filter_mode::serial_in_order : tbb::filter_mode::parallel;
+    tbb::task_arena arena(threads_);
+    arena.execute([&] {
+      tbb::parallel_pipeline(
+          static_cast<size_t>(2 * threads_),
+          tbb::make_filter<void, BatchPtr>(tbb::filter_mode::serial_in_order,
+                                           [&](tbb::flow_control& control) {
+                                             BatchPtr batch = NextBatch(1);
+                                             if (!batch) control.stop();
+                                             return batch;
+                                           }) &
+              tbb::make_filter<BatchPtr, BatchPtr>(tbb::filter_mode::parallel,
+                                                   [&](BatchPtr batch) {
+                                                     Load(*batch, 0);
+                                                     return batch;
+                                                   }) &
+              tbb::make_filter<BatchPtr, BatchPtr>(tbb::filter_mode::serial_in_order,
+                                                   [&](BatchPtr batch) {
+                                                     DetectInVideo(*batch);
+                                                     return batch;
+                                                   }) &
+              tbb::make_filter<BatchPtr, BatchPtr>(tbb::filter_mode::serial_out_of_order,
+                                                   [&](BatchPtr batch) {
+                                                     Predict(*batch);
+                                                     return batch;
+                                                   }) &
+              tbb::make_filter<BatchPtr, void>(
+                  finish, [&](BatchPtr batch) { FinishFrame(*batch, 0); }));
+    });
+  }
+
+  // One frame of video mode, in the shard's frame order. A frame that failed to read
+  // breaks the run: the next one starts a new run.
+  void DetectInVideo(Batch& batch) {
+    const size_t i = position_.at(batch.ids[0]);
+    const bool follows = video_last_ + 1 == i && video_last_ != kNoFrame;
+    const size_t every = static_cast<size_t>(job_.detector_palm_every);
+    const bool starts_run = !follows || (every > 0 && (shard_begin_ + i) % every == 0);
+    video_last_ = kNoFrame;
+    if (!batch.errors[0].empty()) return;
+    const Clock::time_point t = Clock::now();
+    try {
+      stages_.detect_in_video(&*batch.inputs[0], starts_run);
+      video_last_ = i;
+    } catch (...) {
+      batch.errors[0] = "detect: " + Describe(std::current_exception());
+    }
+    batch.seconds[0] += SecondsSince(t);
+  }
+
   // A job that tracks the hand (evidence.detector_every): runs of frames in order, each
   // frame's crops from the previous frame's label; runs in parallel, one per network
   // lane (in order with fit.init previous).
@@ -613,6 +674,11 @@ class LabelJobRun {
   std::string weights_sha_, job_hash_, log_path_;
   std::vector<std::string> all_frames_, mine_, todo_;
   size_t shard_begin_ = 0;  // position of the shard's first frame in all_frames_
+  // Video mode: positions of the shard's frames in mine_, and the last frame detected
+  // (kNoFrame: none, or the last one failed).
+  static constexpr size_t kNoFrame = static_cast<size_t>(-1);
+  std::map<std::string, size_t> position_;
+  size_t video_last_ = kNoFrame;
   int done_before_ = 0;
   int threads_ = 1;
   bool in_order_ = false;

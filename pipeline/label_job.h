@@ -13,6 +13,14 @@
 // is detected and labelled as usual only when that answer fails its checks. Frames run
 // in order within runs that start at detected frames, the runs in parallel.
 //
+// Video mode (evidence.detector_mode: video, LabelStageSet::detect_in_video): frames
+// are read in parallel, detected one at a time in the job's frame order (each from the
+// previous frame's 3D hand; views in parallel inside) and fitted and written in
+// parallel, so fits overlap the detection of later frames. A run (palm detection in
+// every view) starts at the shard's first frame to do, at every detector_palm_every-th
+// frame of the job and after a gap (frames done before, or a frame that failed to
+// read), so shards and resumed runs differ from one whole run only at such starts.
+//
 //  - Resume: a frame is finished once its files are renamed into place and its record
 //    appended to the shard log (frame_log.h). A re-run with resume skips finished
 //    frames, so `kill -9` at any moment loses no finished frame; leftovers of
@@ -59,6 +67,11 @@ struct LabelStageSet {
   // A job that tracks the hand (evidence.detector_every > 1): the source loads frames
   // without their 2D and this finds it for the frames that need it; empty otherwise.
   std::function<void(FrameInput*)> find_keypoints_2d;
+  // Video mode (evidence.detector_mode: video): the source loads frames without their
+  // 2D and this finds it, called on the frames in order, one call at a time; a frame's
+  // regions come from the previous call's answer unless `starts_run` (then, and after
+  // a call that threw, palm detection in every view). Empty otherwise.
+  std::function<void(FrameInput* frame, bool starts_run)> detect_in_video;
 };
 
 struct LabelRunOptions {

@@ -64,6 +64,7 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   if (!job.detections.empty()) extra["detections"] = job.detections;
   if (job.keypoints_from_detector) extra["detector"] = job.detector_model;
   if (job.detector_every != 1) extra["detector_every"] = job.detector_every;
+  if (job.detector_video) extra["detector_video"] = job.detector_palm_every;
   // The requested arithmetic; what "auto" chose on each machine is in every label's
   // provenance (model name).
   if (!weights_sha256.empty() && job.network_precision != "fp32") {

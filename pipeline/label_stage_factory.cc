@@ -58,6 +58,7 @@ LabelStageSet BuiltLabelStages::Set() const {
   set.side = hand_model.side;
   set.faces = hand_model.faces;
   set.find_keypoints_2d = find_keypoints_2d;
+  set.detect_in_video = detect_in_video;
   return set;
 }
 
@@ -101,8 +102,11 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job,
   if (job.keypoints_from_detector) {
     DetectCaptureOptions detect;
     detect.hands.model = job.detector_model;
-    // A job that tracks detects only the frames that need it (label_job.h).
-    const bool detect_on_load = job.detector_every == 1;
+    detect.video = job.detector_video;
+    detect.palm_every = job.detector_palm_every;
+    // A job that tracks detects only the frames that need it, one in video mode its
+    // frames in order (label_job.h).
+    const bool detect_on_load = job.detector_every == 1 && !job.detector_video;
     auto on_images = std::make_unique<DetectorFrameSource>(
         std::move(source), detect, std::move(detections), detect_on_load);
     if (detector) *detector = on_images.get();
@@ -134,6 +138,16 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job,
   built.source = BuildFrameSource(job, detections, &detector);
   if (detector && job.detector_every > 1) {
     built.find_keypoints_2d = [detector](FrameInput* frame) { detector->Detect(frame); };
+  }
+  if (detector && job.detector_video) {
+    // The previous frame's answer, handed on from call to call (one caller at a
+    // time); emptied first, so that a frame whose detection fails starts no track.
+    auto previous = std::make_shared<std::optional<FrameHandResult>>();
+    built.detect_in_video = [detector, previous](FrameInput* frame, bool starts_run) {
+      std::optional<FrameHandResult> last = std::move(*previous);
+      previous->reset();
+      *previous = detector->Detect(frame, starts_run || !last ? nullptr : &*last);
+    };
   }
   const HandSide side = built.source->side().value_or(HandSide::kRight);
   ResolvedHandModel hand = ResolveHandModel(job.hand_model, side);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <tbb/parallel_for.h>
+
 #include "core/errors.h"
 #include "core/option_checks.h"
 #include "geometry/triangulation.h"
@@ -230,6 +232,83 @@ void RunLandmarks(const MediapipeHands& detector, const ImageU8& image,
   }
 }
 
+// Step 5: drop views that disagree with the triangulated hand.
+void DropInconsistentViews(const Rig& rig, const std::vector<ImageU8>& images,
+                           const MultiViewDetectorOptions& options,
+                           FrameHandResult* frame) {
+  for (int v = 0; v < static_cast<int>(frame->views.size()); ++v) {
+    ViewHandResult& r = frame->views[v];
+    if (!r.detected) continue;
+    r.median_reprojection_px = MedianReprojectionPx(rig[v], r.keypoints, *frame);
+    const double limit = options.max_reprojection *
+                         RoiSizePx(r.hand.roi, images[v].width, images[v].height);
+    if (r.median_reprojection_px > limit) {
+      r.detected = false;
+      r.reason = "inconsistent_with_3d_hand";
+      r.source.clear();
+      r.keypoints = Keypoints2d();
+    }
+  }
+}
+
+// Video mode, first pass: landmarks in every view on the ROI of the previous frame's 3D
+// hand (views in parallel: each writes its own result). Such a ROI is placed from 3D,
+// so its landmarks count from min_presence_from_3d, as 3d_palm and 3d_hand ROIs do.
+// Returns the views where the track holds (presence >= the detector's min_presence).
+int TrackViews(const MediapipeHands& detector, const Rig& rig,
+               const std::vector<ImageU8>& images, const FrameHandResult& previous,
+               const MultiViewDetectorOptions& options, FrameHandResult* frame) {
+  tbb::parallel_for(0, static_cast<int>(images.size()), [&](int v) {
+    ViewHandResult& r = frame->views[v];
+    const std::optional<NormalizedRect> roi =
+        RoiOfTrackedHand(rig[v], previous, options, images[v].width, images[v].height);
+    if (!roi) {
+      r.region = "outside";
+      r.reason = "hand_outside_view";
+      return;
+    }
+    r.region = "track";
+    RunLandmarks(detector, images[v], *roi, "track", options.min_presence_from_3d, &r);
+  });
+  int held = 0;
+  for (const ViewHandResult& r : frame->views) {
+    held += r.region == "track" && r.hand.presence >= detector.options().min_presence;
+  }
+  return held;
+}
+
+// Video mode: palm detection in a view where the track did not hold. The palm whose box
+// centre lies inside the tracked ROI (the nearest to its centre) gives landmarks; they
+// replace the tracked ones when they pass the detector's min_presence and are more
+// present (a palm elsewhere in the view is another hand or a false palm).
+void RedetectLostView(const MediapipeHands& detector, const ImageU8& image,
+                      ViewHandResult* r) {
+  r->region = "palm";
+  r->palms = detector.DetectPalms(image);
+  r->palm_candidates = static_cast<int>(r->palms.size());
+  const RotatedRect track = r->hand.roi.ToPixels(image.width, image.height);
+  const PalmDetection* nearest = nullptr;
+  double nearest_px = std::min(track.width, track.height) / 2;
+  for (const PalmDetection& palm : r->palms) {
+    const Eigen::Vector2d centre((palm.xmin + palm.width / 2) * image.width,
+                                 (palm.ymin + palm.height / 2) * image.height);
+    const double d = (centre - Eigen::Vector2d(track.x_center, track.y_center)).norm();
+    if (d < nearest_px) nearest_px = d, nearest = &palm;
+  }
+  if (!nearest) return;
+  const HandLandmarks from_palm = detector.LandmarksInRoi(
+      image, HandRoiFromPalm(*nearest, image.width, image.height));
+  if (from_palm.presence < detector.options().min_presence ||
+      from_palm.presence <= r->hand.presence) {
+    return;
+  }
+  r->hand = from_palm;
+  r->detected = true;
+  r->source = "palm";
+  r->reason.clear();
+  r->keypoints = r->hand.ToKeypoints(image.width, image.height);
+}
+
 void VoteSide(FrameHandResult* frame) {
   double weight = 0, right = 0;
   for (const ViewHandResult& r : frame->views) {
@@ -337,20 +416,56 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
     TriangulateKeypoints(rig, images, options, &frame);
   }
 
-  // Step 5: drop views that disagree with the triangulated hand.
-  for (int v = 0; v < n; ++v) {
-    ViewHandResult& r = frame.views[v];
-    if (!r.detected) continue;
-    r.median_reprojection_px = MedianReprojectionPx(rig[v], r.keypoints, frame);
-    const double limit = options.max_reprojection *
-                         RoiSizePx(r.hand.roi, images[v].width, images[v].height);
-    if (r.median_reprojection_px > limit) {
-      r.detected = false;
-      r.reason = "inconsistent_with_3d_hand";
-      r.source.clear();
-      r.keypoints = Keypoints2d();
+  DropInconsistentViews(rig, images, options, &frame);
+  VoteSide(&frame);
+  return frame;
+}
+
+std::optional<NormalizedRect> RoiOfTrackedHand(const RigCamera& camera,
+                                               const FrameHandResult& previous,
+                                               const MultiViewDetectorOptions& options,
+                                               int image_width, int image_height) {
+  KeypointPixels uv = KeypointPixels::Zero();
+  if (!ProjectHand(camera, previous, options, &uv)) return std::nullopt;
+  return RoiFromKeypoints(uv, image_width, image_height);
+}
+
+FrameHandResult DetectHandInVideo(const MediapipeHands& detector, const Rig& rig,
+                                  const std::vector<ImageU8>& images,
+                                  const FrameHandResult* previous,
+                                  const MultiViewDetectorOptions& options) {
+  const auto per_frame = [&](const char* why) {
+    FrameHandResult frame = DetectHandMultiView(detector, rig, images, options);
+    frame.tracking = why;
+    for (ViewHandResult& r : frame.views) r.region = "palm";
+    return frame;
+  };
+  if (!previous) return per_frame("start");
+  if (!previous->found) return per_frame("lost");
+  options.Check("MultiViewDetectorOptions");
+  HL_CHECK(images.size() == rig.size() && previous->views.size() == rig.size(),
+           "one image and one previous view result per rig camera");
+  FrameHandResult frame;
+  frame.views.resize(images.size());
+  frame.tracking = "track";
+  if (TrackViews(detector, rig, images, *previous, options, &frame) <
+      options.min_palm_views) {
+    return per_frame("lost");
+  }
+  std::vector<int> lost;
+  for (int v = 0; v < static_cast<int>(frame.views.size()); ++v) {
+    const ViewHandResult& r = frame.views[v];
+    if (r.region == "track" && r.hand.presence < detector.options().min_presence) {
+      lost.push_back(v);
     }
   }
+  tbb::parallel_for(size_t(0), lost.size(), [&](size_t i) {
+    RedetectLostView(detector, images[lost[i]], &frame.views[lost[i]]);
+  });
+  TriangulateKeypoints(rig, images, options, &frame);
+  frame.found = frame.keypoint3d_valid[0];
+  if (!frame.found) return per_frame("lost");
+  DropInconsistentViews(rig, images, options, &frame);
   VoteSide(&frame);
   return frame;
 }

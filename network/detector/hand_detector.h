@@ -64,8 +64,14 @@ struct MultiViewDetectorOptions {
 struct ViewHandResult {
   bool detected = false;
   // "palm" (ROI from this view's palm), "3d_palm" (from the projected 3D palm),
-  // "3d_hand" (from the projected 3D keypoints) or "second_pass"; empty without one.
+  // "3d_hand" (from the projected 3D keypoints), "second_pass", or in video mode
+  // "track" (from the previous frame's 3D hand); empty without one.
   std::string source;
+  // Video mode only (empty otherwise): which regions the view looked at. "palm": palm
+  // detection ran on the view (then as in per-frame mode); "track": only the ROI of the
+  // previous frame's 3D hand; "outside": the previous frame's hand projects mostly
+  // outside the view, nothing ran.
+  std::string region;
   // Why there is no detection: "no_hand_in_frame" (no palms agreed in enough views),
   // "hand_outside_view" (the 3D hand projects mostly outside the image or behind the
   // camera), "low_presence" (the landmark model found no hand in the ROI),
@@ -90,11 +96,42 @@ struct FrameHandResult {
   Eigen::Matrix<double, kNumHandKeypoints, 3, Eigen::RowMajor> keypoints3d =
       Eigen::Matrix<double, kNumHandKeypoints, 3, Eigen::RowMajor>::Zero();
   std::array<bool, kNumHandKeypoints> keypoint3d_valid{};
+  // Video mode only (empty otherwise): "start" (a run's first frame: palm detection on
+  // every view, as per-frame mode), "lost" (the previous frame had no hand, or fewer
+  // than min_palm_views views held the track: detected as per-frame mode), "track"
+  // (regions from the previous frame's 3D hand).
+  std::string tracking;
 };
 
 // Runs steps 1-5 on one frame: images[c] is the RGB image of rig camera c.
 FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& rig,
                                     const std::vector<ImageU8>& images,
                                     const MultiViewDetectorOptions& options = {});
+
+// Video mode: the ROI of a view from the previous frame's 3D hand (`previous`'s
+// triangulated keypoints projected through `camera`, a missing keypoint at the wrist's
+// projection; MediaPipe's tracking rule, RoiFromKeypoints). Nothing when the previous
+// frame has no wrist, a keypoint lies behind the camera or fewer than
+// min_keypoints_in_view of them land in the image.
+std::optional<NormalizedRect> RoiOfTrackedHand(const RigCamera& camera,
+                                               const FrameHandResult& previous,
+                                               const MultiViewDetectorOptions& options,
+                                               int image_width, int image_height);
+
+// Video mode: one frame of a run of consecutive frames. `previous` is the run's previous
+// frame's result (nullptr on the run's first frame: then exactly DetectHandMultiView).
+// When the previous frame has a 3D hand, every view's ROI is that hand's keypoints
+// projected into the view (RoiFromKeypoints, MediaPipe's tracking rule) and the landmark
+// model runs there, views in parallel; the track holds in a view when the presence is
+// >= the detector's min_presence. Views where it does not hold run palm detection and
+// take the landmarks of the palm inside the tracked ROI when they are more present;
+// failing that the tracked landmarks count from min_presence_from_3d, as other ROIs
+// placed from 3D do. Then triangulation and the consistency check (steps 4-5). When the
+// previous frame has no hand, or fewer than min_palm_views views hold the track, or no
+// 3D hand results, the frame is detected as per-frame mode ("lost").
+FrameHandResult DetectHandInVideo(const MediapipeHands& detector, const Rig& rig,
+                                  const std::vector<ImageU8>& images,
+                                  const FrameHandResult* previous,
+                                  const MultiViewDetectorOptions& options = {});
 
 }  // namespace handlabel

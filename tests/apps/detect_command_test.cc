@@ -233,7 +233,8 @@ TEST(DetectCommand, FramesInParallelGiveTheSameDetectionsAndLabels) {
         << "name: t\nseed: 3\ninput: {format: native, path: " << dir
         << "/cap}\nnetwork: {weights: \"\", threads: " << threads
         << "}\nrefine: {mode: always}\nevidence: {keypoints_2d: detector, masks: none}\n"
-        << "output: {dir: " << dir << "/labels" << threads << ", meshes: [], overlays: false}\n";
+        << "output: {dir: " << dir << "/labels" << threads
+        << ", meshes: [], overlays: false}\n";
     const testing::CommandResult job =
         RunHandlabelCommand({"label", "--job", dir + "/job" + threads + ".yaml"});
     ASSERT_EQ(job.status, 0) << job.err;
@@ -252,6 +253,139 @@ TEST(DetectCommand, FramesInParallelGiveTheSameDetectionsAndLabels) {
     ++frames;
   }
   EXPECT_EQ(frames, 3);
+}
+
+// The keypoints of every view of a detections record (NaN where unknown), as text.
+std::string ViewKeypointsText(const nlohmann::json& detections) {
+  std::string out;
+  for (const nlohmann::json& view : detections["views"]) out += view["keypoints"].dump();
+  return out;
+}
+
+// Video mode on a synthetic sequence (one motion, realistic look): after the first
+// frame the regions come from the previous frame's 3D hand; it finds the hand in at
+// least as many views as detecting every frame from scratch, on the hand (truth), and
+// its first frame is the per-frame detection.
+TEST(DetectCommand, VideoModeTracksTheHandThroughASequence) {
+  if (!ModelsPresent()) {
+    GTEST_SKIP() << "MediaPipe models absent: run scripts/fetch-mediapipe-models";
+  }
+  namespace fs = std::filesystem;
+  const std::string dir = testing::ScratchDir();
+  const int frames = 6;
+  ASSERT_EQ(RunHandlabelCommand({"synth", "--preset", "dexycb", "--sequence", "--frames",
+                                 std::to_string(frames), "--seed", "45", "--appearance",
+                                 "realistic", "--no-detections", "--out", dir + "/cap"})
+                .status,
+            0);
+  fs::copy(dir + "/cap", dir + "/video", fs::copy_options::recursive);
+  ASSERT_EQ(RunHandlabelCommand({"detect", "--capture", dir + "/cap"}).status, 0);
+  const testing::CommandResult r = RunHandlabelCommand(
+      {"detect", "--capture", dir + "/video", "--video", "--palm-every", "0"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("tracked from the previous frame"), std::string::npos) << r.out;
+
+  const CaptureReader capture(dir + "/video");
+  int per_frame_views = 0, video_views = 0, tracked_frames = 0, tracked_views = 0;
+  std::vector<double> errors;
+  for (int f = 0; f < frames; ++f) {
+    const std::string id = capture.frame_id(f);
+    const nlohmann::json one = ReadJson(dir + "/cap/detections/" + id + ".json");
+    const nlohmann::json video = ReadJson(dir + "/video/detections/" + id + ".json");
+    EXPECT_FALSE(one.contains("tracking"));  // per-frame records are as before
+    const std::string tracking = video["tracking"];
+    // --palm-every 0: only the first frame starts a run.
+    if (f == 0) {
+      EXPECT_EQ(tracking, "start");
+      EXPECT_EQ(ViewKeypointsText(video), ViewKeypointsText(one));
+    } else {
+      EXPECT_NE(tracking, "start") << id;
+    }
+    tracked_frames += tracking == "track";
+    const auto truth = capture.ReadKeypoints(f);
+    const auto views = capture.ReadDetections(f);
+    for (int c = 0; c < capture.num_cameras(); ++c) {
+      const nlohmann::json& v = video["views"][c];
+      per_frame_views += one["views"][c]["detected"].get<bool>();
+      video_views += v["detected"].get<bool>();
+      if (tracking == "track") {
+        EXPECT_TRUE(v["region"] == "track" || v["region"] == "palm" ||
+                    v["region"] == "outside")
+            << v["region"];
+        // Palm detection runs only where the track did not hold.
+        if (v["region"] != "palm") {
+          EXPECT_EQ(v["palm_candidates"], 0);
+        }
+      } else {
+        EXPECT_EQ(v["region"], "palm");
+      }
+      if (!v["detected"].get<bool>()) continue;
+      tracked_views += v["source"] == "track";
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        if (views[c].keypoints.confidence(k) <= 0 || truth[c].visibility[k] != 2)
+          continue;
+        errors.push_back(
+            (views[c].keypoints.uv_px.row(k) - truth[c].keypoints.uv_px.row(k)).norm());
+      }
+    }
+  }
+  EXPECT_GE(tracked_frames, frames - 2);
+  EXPECT_GE(tracked_views, 3 * tracked_frames);
+  EXPECT_GE(video_views, per_frame_views);
+  ASSERT_FALSE(errors.empty());
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 10.0);
+}
+
+// Video mode gives the same files at any thread count (runs in parallel, a run's frames
+// in order), and a label job in video mode the 2D and labels of `detect --video` +
+// `keypoints_2d: files`, bit for bit, on two threads against one.
+TEST(DetectCommand, VideoModeIsTheSameAtAnyThreadCountAndInAJob) {
+  if (!ModelsPresent()) {
+    GTEST_SKIP() << "MediaPipe models absent: run scripts/fetch-mediapipe-models";
+  }
+  namespace fs = std::filesystem;
+  const std::string dir = testing::ScratchDir();
+  ASSERT_EQ(RunHandlabelCommand({"synth", "--preset", "dexycb", "--sequence", "--frames",
+                                 "5", "--seed", "46", "--appearance", "realistic",
+                                 "--no-detections", "--out", dir + "/cap"})
+                .status,
+            0);
+  for (const std::string threads : {"1", "2"}) {
+    fs::copy(dir + "/cap", dir + "/cap" + threads, fs::copy_options::recursive);
+    const testing::CommandResult r =
+        RunHandlabelCommand({"detect", "--capture", dir + "/cap" + threads, "--video",
+                             "--palm-every", "3", "--threads", threads});
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  WriteFitOnlyJob(dir + "/files.yaml", dir + "/cap1", "files", dir + "/labels_files");
+  std::ofstream(dir + "/video.yaml")
+      << "name: t\nseed: 3\ninput: {format: native, path: " << dir
+      << "/cap}\nnetwork: {weights: \"\", threads: 2}\nrefine: {mode: always}\n"
+      << "evidence: {keypoints_2d: detector, detector_mode: video, "
+      << "detector_palm_every: 3, masks: none}\n"
+      << "output: {dir: " << dir << "/labels_video, meshes: [], overlays: false}\n";
+  for (const std::string job : {"files", "video"}) {
+    const testing::CommandResult r =
+        RunHandlabelCommand({"label", "--job", dir + "/" + job + ".yaml"});
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  int frames = 0;
+  for (const auto& entry : fs::directory_iterator(dir + "/cap1/detections")) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(testing::ReadFileBytes(entry.path().string()),
+              testing::ReadFileBytes(dir + "/cap2/detections/" + name))
+        << name;
+    const std::string stem = entry.path().stem().string();
+    const nlohmann::json a = ReadJson(dir + "/labels_files/labels/" + stem + ".json");
+    const nlohmann::json b = ReadJson(dir + "/labels_video/labels/" + stem + ".json");
+    EXPECT_EQ(a["keypoints_3d"].dump(), b["keypoints_3d"].dump()) << stem;
+    EXPECT_EQ(a["mano"].dump(), b["mano"].dump()) << stem;
+    ++frames;
+  }
+  EXPECT_EQ(frames, 5);
+  // Frames 0 and 3 start runs; the others follow the previous frame.
+  EXPECT_EQ(ReadJson(dir + "/cap1/detections/000003.json")["tracking"], "start");
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/errors.h"
+#include "pipeline/label_job.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -153,6 +154,38 @@ TEST(JobConfig, TrackingNeedsTheDetectorANetworkAndFallback) {
       "evidence: {keypoints_2d: detector, detector_every: 10}\n",
       "network.weights", "a network to track with");
   ExpectError(tracked + "refine: {mode: always}\n", "refine.mode", "fallback");
+}
+
+// evidence.detector_mode: video needs the detector on every frame; per-frame jobs keep
+// their hash (the field enters only when set).
+TEST(JobConfig, DetectorVideoModeNeedsTheDetectorOnEveryFrame) {
+  const std::string fit_only =
+      "input: {path: c}\noutput: {dir: o}\nrefine: {mode: always}\n";
+  const JobConfig video = LoadJobConfig(
+      WriteJob(fit_only + "evidence: {keypoints_2d: detector, detector_mode: video, "
+                          "detector_palm_every: 12}\n"));
+  EXPECT_TRUE(video.detector_video);
+  EXPECT_EQ(video.detector_palm_every, 12);
+  const JobConfig per_frame =
+      LoadJobConfig(WriteJob(fit_only + "evidence: {keypoints_2d: detector}\n"));
+  EXPECT_FALSE(per_frame.detector_video);
+  EXPECT_EQ(per_frame.detector_palm_every, 30);
+  EXPECT_NE(JobHash(video, ""), JobHash(per_frame, ""));
+  JobConfig explicit_frame = per_frame;
+  explicit_frame.detector_palm_every = 5;  // read only in video mode
+  EXPECT_EQ(JobHash(explicit_frame, ""), JobHash(per_frame, ""));
+  ExpectError(fit_only + "evidence: {keypoints_2d: detector, detector_mode: stream}\n",
+              "evidence.detector_mode", "frame | video");
+  ExpectError(fit_only + "evidence: {keypoints_2d: files, detector_mode: video}\n",
+              "evidence.keypoints_2d", "detector (evidence.detector_mode video");
+  ExpectError(fit_only +
+                  "evidence: {keypoints_2d: detector, detector_mode: video, "
+                  "detector_palm_every: -1}\n",
+              "evidence.detector_palm_every", ">= 0");
+  ExpectError(
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n"
+      "evidence: {keypoints_2d: detector, detector_every: 10, detector_mode: video}\n",
+      "evidence.detector_every", "1 (evidence.detector_mode video");
 }
 
 // The fields `handlabel fit` sets: unset fitter fields stay unset (the fitter's
