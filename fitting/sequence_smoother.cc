@@ -36,6 +36,7 @@ class BoneLengthResidual {
 
   template <typename T>
   bool operator()(const T* betas, T* residuals) const {
+    using std::sqrt;
     T orient[3] = {T(0), T(0), T(0)}, transl[3] = {T(0), T(0), T(0)};
     T pose[kNumPoseParams];
     for (int i = 0; i < kNumPoseParams; ++i) pose[i] = T(pose_[i]);

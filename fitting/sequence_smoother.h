@@ -31,7 +31,7 @@ struct SequenceSmoothOptions {
   // It is per frame^2: the same motion at twice the frame rate accelerates 4x less per
   // frame^2, so scale it with (30 / fps)^2. Chosen on synthetic sequences,
   // docs/fitting.md.
-  double acceleration_sigma_mm = 0.3;
+  double acceleration_sigma_mm = 1.0;
   // Ceres iterations per window (>= 1).
   int iterations = 50;
   // Frames whose poses the shape estimate evaluates the bone lengths at (>= 1; tips

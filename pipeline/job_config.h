@@ -92,7 +92,7 @@ struct SequenceSettings {
   int overlap = 16;
   // Keypoint acceleration per residual unit, mm/frame^2 (> 0; smaller smooths more;
   // fitting/sequence_smoother.h).
-  double acceleration_sigma_mm = 0.3;
+  double acceleration_sigma_mm = 1.0;
   // Ceres iterations per window (>= 1).
   int iterations = 50;
   // Throws InputError naming the file and the field.

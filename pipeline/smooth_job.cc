@@ -22,6 +22,7 @@
 #include "pipeline/frame_metrics.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/label_job.h"
+#include "pipeline/label_overlay.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/label_record.h"
 #include "pipeline/label_stage_factory.h"
@@ -114,6 +115,9 @@ class SmoothJobRun {
     smooth.acceleration_sigma_mm = job_.sequence.acceleration_sigma_mm;
     smooth.iterations = job_.sequence.iterations;
     smoother_.emplace(model_, fit.config, fit.fit, smooth);
+    if (job_.overlays) {
+      overlays_ = std::make_unique<RasterOverlayWriter>(model_, job_.overlay_format);
+    }
     job_hash_ = RecordedJobHash(job_.output_dir);
     ReadLabels();
     FindSegments();
@@ -294,6 +298,8 @@ class SmoothJobRun {
     label.fit["smoothing"] = {{"windows", window_ids},
                               {"shape", "sequence"},
                               {"moved_mm", std::round(moved_mm * 1000) / 1000}};
+    // Pictures first: a label on disk implies its overlays are complete.
+    if (overlays_) overlays_->Write(out_, source_->Load(label.frame), label);
     WriteLabelFiles(out_, label, model_.faces, job_.meshes);
   }
 
@@ -307,6 +313,7 @@ class SmoothJobRun {
   std::unique_ptr<FrameSource> source_;
   HandModel model_;
   std::optional<SequenceSmoother> smoother_;
+  std::unique_ptr<OverlayWriter> overlays_;  // output.overlays: the smoothed labels'
   std::string job_hash_;
   std::vector<std::string> ids_;
   std::vector<LabelledFrame> frames_;
