@@ -129,6 +129,11 @@ class SmoothJobRun {
     for (const LabelledFrame& f : frames_) {
       if (mine_.count(f.id) && !f.label) ++summary_.unlabelled;
     }
+    // --force: the shard's earlier smoothed labels go first, so that a forced run
+    // killed half-way resumes (without --force) to the new settings, not a mix.
+    if (options_.force) {
+      for (const std::string& id : mine_) fs::remove(LabelFilePath(out_, id));
+    }
   }
 
   void ReadLabels() {
@@ -193,8 +198,7 @@ class SmoothJobRun {
   }
 
   bool Todo(size_t frame) const {
-    if (!mine_.count(ids_[frame])) return false;
-    return options_.force || !fs::exists(LabelFilePath(out_, ids_[frame]));
+    return mine_.count(ids_[frame]) && !fs::exists(LabelFilePath(out_, ids_[frame]));
   }
 
   // Per segment: the windows covering frames to do, solved a batch at a time; after
