@@ -7,6 +7,7 @@
 #include "pipeline/smooth_job.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -120,13 +121,19 @@ std::map<std::string, std::string> SmoothedLabels(const std::string& out) {
 class SmoothJobTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    scratch_ = new std::string(testing::ScratchDir());
+    // The suite's own folder (ScratchDir needs a running test); removed at the end.
+    scratch_ = new std::string((fs::temp_directory_path() /
+                                ("handlabel_SmoothJobTest_" + std::to_string(::getpid())))
+                                   .string());
+    fs::remove_all(*scratch_);
+    fs::create_directories(*scratch_);
     const std::string capture = WriteSequenceCapture(*scratch_ + "/capture", 20);
     sequence_ = new LabelledSequence(LabelSequence(
         *scratch_, capture, "job",
         "sequence: {smooth: true, window: 8, overlap: 3, acceleration_sigma_mm: 0.3}\n"));
   }
   static void TearDownTestSuite() {
+    fs::remove_all(*scratch_);
     delete sequence_;
     delete scratch_;
   }
