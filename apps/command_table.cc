@@ -28,6 +28,7 @@ const std::vector<Command>& AllCommands() {
       {"model", "inspect and convert hand model files (MANO, smplx npz, own)", RunModel},
       {"label", "label a capture as a job (YAML), resumable, shardable", RunLabel},
       {"merge", "join the shards of a labeling job (manifest + summary)", RunMerge},
+      {"smooth", "smooth a labelled sequence over time (windows, one shape)", RunSmooth},
       {"export", "labels as npz / csv (MANO parameters), COCO, glTF, DexYCB or HO3D",
        RunExport},
       {"cameras", "convert and show camera rigs (COLMAP, JSON, DexYCB, HO3D, OakInk)",

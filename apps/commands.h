@@ -27,6 +27,7 @@ int RunModelRender(int argc, char** argv);
 int RunModelExport(int argc, char** argv);
 int RunLabel(int argc, char** argv);
 int RunMerge(int argc, char** argv);
+int RunSmooth(int argc, char** argv);
 int RunExport(int argc, char** argv);
 int RunCameras(int argc, char** argv);
 int RunCalib(int argc, char** argv);

@@ -9,6 +9,7 @@
 #include "pipeline/label_job.h"
 #include "pipeline/label_stage_factory.h"
 #include "pipeline/shard.h"
+#include "pipeline/smooth_job.h"
 
 namespace handlabel {
 
@@ -55,7 +56,16 @@ int RunLabel(int argc, char** argv) {
     if (!stages.hand_model_note.empty() && !quiet)
       std::cerr << "handlabel label: note: " << stages.hand_model_note << "\n";
     const LabelSummary summary = RunLabelJob(job, stages.Set(), options);
-    return summary.failed > 0 && summary.ok == 0 ? 1 : 0;
+    if (summary.failed > 0 && summary.ok == 0) return 1;
+    // A whole-job run smooths right away; shards smooth with `handlabel smooth` once
+    // every shard has labelled (windows read their neighbours' labels).
+    if (job.sequence.smooth && options.shard.count == 1) {
+      SmoothRunOptions smooth;
+      smooth.force = force;
+      smooth.log = options.log;
+      RunSmoothJob(job, smooth);
+    }
+    return 0;
   });
 }
 

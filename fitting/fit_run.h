@@ -2,7 +2,7 @@
 // The staged solve behind CeresHandFitter (fitting/ceres_hand_fitter.h): FitRun<P> runs
 // the stages the fitter's header describes (rigid, keypoints, silhouette rounds) over an
 // explicit FitState, and the 3D initialisation. Internal to fitting/: only
-// ceres_hand_fitter.cc includes it (it reaches Ceres).
+// ceres_hand_fitter.cc and sequence_smoother.cc include it (it reaches Ceres).
 
 #include <ceres/ceres.h>
 

@@ -6,6 +6,7 @@
 
 #include "core/errors.h"
 #include "core/option_checks.h"
+#include "hand/hand_skeleton.h"
 
 namespace handlabel {
 namespace {
@@ -168,6 +169,19 @@ MotionMetrics ComputeMotionMetrics(const std::vector<MotionFrame>& frames) {
   m.jitter = jitter / m.triples;
   m.truth_acceleration = truth / m.triples;
   return m;
+}
+
+Eigen::VectorXd BoneLengths(const Points3d& keypoints) {
+  HL_CHECK(keypoints.rows() == kNumHandKeypoints, "21 keypoints");
+  Eigen::VectorXd lengths(kNumHandKeypoints - 1);
+  for (int k = 1; k < kNumHandKeypoints; ++k) {
+    lengths[k - 1] = (keypoints.row(k) - keypoints.row(kSnapParents[k])).norm();
+  }
+  return lengths;
+}
+
+double MeanBoneLengthError(const Points3d& predicted, const Points3d& truth) {
+  return (BoneLengths(predicted) - BoneLengths(truth)).cwiseAbs().mean();
 }
 
 }  // namespace handlabel

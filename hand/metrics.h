@@ -111,4 +111,11 @@ struct MotionMetrics {
 // `frames` in increasing number order, every one with truth or none of them.
 MotionMetrics ComputeMotionMetrics(const std::vector<MotionFrame>& frames);
 
+// Lengths of the 20 bones of the 21-keypoint skeleton (SNAP order): entry k - 1 is the
+// distance from keypoint k to its parent kSnapParents[k] (hand/hand_skeleton.h).
+Eigen::VectorXd BoneLengths(const Points3d& keypoints);
+// Mean over the 20 bones of |length - the truth's length|: how far a hand's proportions
+// are from the truth's, whatever its pose and place (same units as the inputs).
+double MeanBoneLengthError(const Points3d& predicted, const Points3d& truth);
+
 }  // namespace handlabel

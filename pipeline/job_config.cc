@@ -125,6 +125,17 @@ void ReadFitSection(Section& top, JobConfig* job) {
   fit.RejectUnknownKeys();
 }
 
+void ReadSequenceSection(Section& top, JobConfig* job) {
+  Section sequence = top.Child("sequence");
+  SequenceSettings& s = job->sequence;
+  sequence.Read("smooth", &s.smooth);
+  sequence.Read("window", &s.window);
+  sequence.Read("overlap", &s.overlap);
+  sequence.Read("acceleration_sigma_mm", &s.acceleration_sigma_mm);
+  sequence.Read("iterations", &s.iterations);
+  sequence.RejectUnknownKeys();
+}
+
 void ReadRefineSection(Section& top, const std::string& path, JobConfig* job) {
   Section refine = top.Child("refine");
   std::string mode = "fallback";
@@ -335,6 +346,19 @@ void JobConfig::Check(const std::string& source) const {
   RequireAtLeast(source, "input.max_frames", max_frames, 0);
   CheckFileEvidence(*this, source);
   CheckFitSettings(fit, source);
+  sequence.Check(source);
+}
+
+void SequenceSettings::Check(const std::string& source) const {
+  RequireAtLeast(source, "sequence.window", window, 3);
+  RequireAtLeast(source, "sequence.overlap", overlap, 1);
+  if (2 * overlap > window) {
+    throw InputError(source, "sequence.overlap",
+                     "at most half of sequence.window (" + std::to_string(window) + ")",
+                     std::to_string(overlap));
+  }
+  RequireGreater(source, "sequence.acceleration_sigma_mm", acceleration_sigma_mm, 0);
+  RequireAtLeast(source, "sequence.iterations", iterations, 1);
 }
 
 JobConfig LoadJobConfig(const std::string& path) {
@@ -394,6 +418,7 @@ JobConfig LoadJobConfig(const std::string& path) {
   output.Read("baseline", &job.baseline);
   output.RejectUnknownKeys();
   ReadFitSection(top, &job);
+  ReadSequenceSection(top, &job);
   top.RejectUnknownKeys();
 
   job.input_path = Resolve(job.input_path, base);

@@ -77,6 +77,28 @@ struct FitSettings {
   bool IsDefault() const;
 };
 
+// Section `sequence` (docs/labeling-jobs.md "Sequences"): the job's frames are a
+// recording, and a smoothing pass (pipeline/smooth_job.h) refits the per-frame labels
+// over time into <output.dir>/smoothed/: one shape for the whole sequence, windows of
+// consecutive frames solved jointly with a keypoint acceleration prior, blended on
+// their overlaps. It never changes the per-frame labels (nor the job hash).
+struct SequenceSettings {
+  // Run the smoothing pass: `label` runs it after a whole-job run (no --shard),
+  // `handlabel smooth --job` at any time after the per-frame labels exist.
+  bool smooth = false;
+  // Frames per window (>= 3) and frames shared by neighbouring windows (>= 1, at most
+  // half a window, so every frame lies in at most two windows' blend).
+  int window = 48;
+  int overlap = 16;
+  // Keypoint acceleration per residual unit, mm/frame^2 (> 0; smaller smooths more;
+  // fitting/sequence_smoother.h).
+  double acceleration_sigma_mm = 1.0;
+  // Ceres iterations per window (>= 1).
+  int iterations = 50;
+  // Throws InputError naming the file and the field.
+  void Check(const std::string& source) const;
+};
+
 struct JobConfig {
   std::string source_file;  // the YAML file (for error messages)
   std::string name = "job";
@@ -174,6 +196,7 @@ struct JobConfig {
   bool baseline = false;  // also run the fit-only baseline for comparison
 
   FitSettings fit;
+  SequenceSettings sequence;
 
   // Throws InputError naming the file and field.
   void Check(const std::string& source) const;

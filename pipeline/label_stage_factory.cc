@@ -13,10 +13,7 @@
 #include "pipeline/network_stage.h"
 
 namespace handlabel {
-namespace {
 
-// The fitter's settings from the job: fields of section `fit` that are set replace
-// the fitter's defaults.
 CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
   const FitSettings& s = job.fit;
   CeresLabelFitterOptions o;
@@ -45,8 +42,6 @@ CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
   }
   return o;
 }
-
-}  // namespace
 
 LabelStageSet BuiltLabelStages::Set() const {
   LabelStageSet set;

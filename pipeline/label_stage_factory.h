@@ -8,6 +8,7 @@
 #include <string>
 
 #include "hand/hand_model.h"
+#include "pipeline/ceres_label_fitter.h"
 #include "pipeline/detect_frame_source.h"
 #include "pipeline/job_config.h"
 #include "pipeline/label_job.h"
@@ -30,6 +31,10 @@ struct BuiltLabelStages {
   // Views of the above for RunLabelJob.
   LabelStageSet Set() const;
 };
+
+// The fitter's settings from the job: fields of section `fit` that are set replace
+// the fitter's defaults (the smoothing pass fits with the same, smooth_job.h).
+CeresLabelFitterOptions FitterOptions(const JobConfig& job);
 
 // Throws InputError naming the job file and the field whose stage cannot be built.
 // `memo`: the network's answers shared with other jobs (network_stage.h).

@@ -240,3 +240,34 @@ TEST(MotionMetrics, FramesOutOfOrderAreRefused) {
 
 }  // namespace
 }  // namespace handlabel
+
+namespace handlabel {
+namespace {
+
+// Bone lengths do not change with a rigid motion of the hand; stretching one bone
+// shows up in its entry only, and the mean error is that stretch / 20.
+TEST(BoneLengths, RigidMotionKeepsThemAndAStretchedBoneShows) {
+  std::mt19937_64 rng(45);
+  std::normal_distribution<double> g(0.0, 0.05);
+  Points3d keypoints(kNumHandKeypoints, 3);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    keypoints.row(k) << g(rng), g(rng), g(rng);
+  }
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  Points3d moved =
+      (keypoints * r.transpose()).rowwise() + Eigen::RowVector3d(0.1, -0.2, 0.3);
+  EXPECT_LT((BoneLengths(moved) - BoneLengths(keypoints)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT(MeanBoneLengthError(moved, keypoints), 1e-12);
+  // Move the index tip (keypoint 8, child of 7) 6 mm further along its bone.
+  Points3d stretched = keypoints;
+  const Eigen::RowVector3d bone = keypoints.row(8) - keypoints.row(7);
+  stretched.row(8) += 0.006 * bone.normalized();
+  const Eigen::VectorXd difference = BoneLengths(stretched) - BoneLengths(keypoints);
+  EXPECT_NEAR(difference[7], 0.006, 1e-12);
+  EXPECT_NEAR(difference.cwiseAbs().sum(), 0.006, 1e-12);
+  EXPECT_NEAR(MeanBoneLengthError(stretched, keypoints), 0.006 / 20, 1e-12);
+}
+
+}  // namespace
+}  // namespace handlabel

@@ -111,6 +111,31 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
               "evidence.network_mask_sigma_px", "> 0 pixels");
 }
 
+// Section sequence: read, defaults without it, and errors naming the field.
+TEST(JobConfig, SequenceSection) {
+  const std::string base = "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n";
+  const JobConfig plain = LoadJobConfig(WriteJob(base));
+  EXPECT_FALSE(plain.sequence.smooth);
+  EXPECT_EQ(plain.sequence.window, 48);
+  const JobConfig job = LoadJobConfig(
+      WriteJob(base +
+               "sequence: {smooth: true, window: 32, overlap: 8, acceleration_sigma_mm: "
+               "0.5, iterations: 20}\n"));
+  EXPECT_TRUE(job.sequence.smooth);
+  EXPECT_EQ(job.sequence.window, 32);
+  EXPECT_EQ(job.sequence.overlap, 8);
+  EXPECT_DOUBLE_EQ(job.sequence.acceleration_sigma_mm, 0.5);
+  EXPECT_EQ(job.sequence.iterations, 20);
+  ExpectError(base + "sequence: {window: 32, overlap: 20}\n", "sequence.overlap",
+              "at most half of sequence.window");
+  ExpectError(base + "sequence: {window: 2, overlap: 1}\n", "sequence.window", "3");
+  ExpectError(base + "sequence: {acceleration_sigma_mm: 0}\n",
+              "sequence.acceleration_sigma_mm", "0");
+  ExpectError(base + "sequence: {smoth: true}\n", "sequence.smoth", "a known key");
+  // The section does not enter the job hash: per-frame labels stay where they were.
+  EXPECT_EQ(JobHash(plain, ""), JobHash(job, ""));
+}
+
 // evidence.keypoints_2d: detector: the detector's 2D counts as file evidence, with the
 // model size; it cannot be combined with a detections folder.
 TEST(JobConfig, KeypointsFromTheDetector) {
