@@ -213,6 +213,27 @@ TEST(DetectCommand, LabelJobWithDetectorGivesTheSame2dAsDetectThenFiles) {
 // Frames detected at once (`detect --threads 2`, and a detector job's frames on two
 // threads) give what one at a time gives, bit for bit: each frame's detection depends
 // on its own images only, whichever thread runs it.
+// Expects the two captures' detection files equal byte for byte and the two label
+// folders' labels equal (keypoints and parameters) for every frame; returns the frames.
+int CompareDetectionsAndLabels(const std::string& capture_a, const std::string& capture_b,
+                               const std::string& labels_a, const std::string& labels_b) {
+  namespace fs = std::filesystem;
+  int frames = 0;
+  for (const auto& entry : fs::directory_iterator(capture_a + "/detections")) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(testing::ReadFileBytes(entry.path().string()),
+              testing::ReadFileBytes(capture_b + "/detections/" + name))
+        << name;
+    const std::string stem = entry.path().stem().string();
+    const nlohmann::json a = ReadJson(labels_a + "/labels/" + stem + ".json");
+    const nlohmann::json b = ReadJson(labels_b + "/labels/" + stem + ".json");
+    EXPECT_EQ(a["keypoints_3d"].dump(), b["keypoints_3d"].dump()) << stem;
+    EXPECT_EQ(a["mano"].dump(), b["mano"].dump()) << stem;
+    ++frames;
+  }
+  return frames;
+}
+
 TEST(DetectCommand, FramesInParallelGiveTheSameDetectionsAndLabels) {
   if (!ModelsPresent()) {
     GTEST_SKIP() << "MediaPipe models absent: run scripts/fetch-mediapipe-models";
@@ -239,20 +260,9 @@ TEST(DetectCommand, FramesInParallelGiveTheSameDetectionsAndLabels) {
         RunHandlabelCommand({"label", "--job", dir + "/job" + threads + ".yaml"});
     ASSERT_EQ(job.status, 0) << job.err;
   }
-  int frames = 0;
-  for (const auto& entry : fs::directory_iterator(dir + "/cap1/detections")) {
-    const std::string name = entry.path().filename().string();
-    EXPECT_EQ(testing::ReadFileBytes(entry.path().string()),
-              testing::ReadFileBytes(dir + "/cap2/detections/" + name))
-        << name;
-    const std::string stem = entry.path().stem().string();
-    const nlohmann::json one = ReadJson(dir + "/labels1/labels/" + stem + ".json");
-    const nlohmann::json two = ReadJson(dir + "/labels2/labels/" + stem + ".json");
-    EXPECT_EQ(one["keypoints_3d"].dump(), two["keypoints_3d"].dump()) << stem;
-    EXPECT_EQ(one["mano"].dump(), two["mano"].dump()) << stem;
-    ++frames;
-  }
-  EXPECT_EQ(frames, 3);
+  EXPECT_EQ(CompareDetectionsAndLabels(dir + "/cap1", dir + "/cap2", dir + "/labels1",
+                                       dir + "/labels2"),
+            3);
 }
 
 // The keypoints of every view of a detections record (NaN where unknown), as text.
@@ -370,20 +380,9 @@ TEST(DetectCommand, VideoModeIsTheSameAtAnyThreadCountAndInAJob) {
         RunHandlabelCommand({"label", "--job", dir + "/" + job + ".yaml"});
     ASSERT_EQ(r.status, 0) << r.err;
   }
-  int frames = 0;
-  for (const auto& entry : fs::directory_iterator(dir + "/cap1/detections")) {
-    const std::string name = entry.path().filename().string();
-    EXPECT_EQ(testing::ReadFileBytes(entry.path().string()),
-              testing::ReadFileBytes(dir + "/cap2/detections/" + name))
-        << name;
-    const std::string stem = entry.path().stem().string();
-    const nlohmann::json a = ReadJson(dir + "/labels_files/labels/" + stem + ".json");
-    const nlohmann::json b = ReadJson(dir + "/labels_video/labels/" + stem + ".json");
-    EXPECT_EQ(a["keypoints_3d"].dump(), b["keypoints_3d"].dump()) << stem;
-    EXPECT_EQ(a["mano"].dump(), b["mano"].dump()) << stem;
-    ++frames;
-  }
-  EXPECT_EQ(frames, 5);
+  EXPECT_EQ(CompareDetectionsAndLabels(dir + "/cap1", dir + "/cap2",
+                                       dir + "/labels_files", dir + "/labels_video"),
+            5);
   // Frames 0 and 3 start runs; the others follow the previous frame.
   EXPECT_EQ(ReadJson(dir + "/cap1/detections/000003.json")["tracking"], "start");
 }
