@@ -154,7 +154,7 @@ class LabelJobRun {
     Progress progress(static_cast<int>(todo_.size()),
                       options_.log ? *options_.log : discard, options_.interactive);
     progress_ = &progress;
-    if (stages_.start_video_track) {
+    if (stages_.detect_in_video) {
       LabelVideo();
     } else if (stages_.find_keypoints_2d) {
       LabelTracked();
@@ -460,10 +460,6 @@ class LabelJobRun {
   // the network if any (one frame at a time), label and write (parallel; in order
   // with fit.init previous).
   void LabelVideo() {
-    if (!in_order_ && !stages_.predictor) {
-      LabelVideoRuns();
-      return;
-    }
     using BatchPtr = std::shared_ptr<Batch>;
     for (size_t i = 0; i < mine_.size(); ++i) position_[mine_[i]] = i;
     const tbb::filter_mode finish =
@@ -509,69 +505,12 @@ class LabelJobRun {
     if (!batch.errors[0].empty()) return;
     const Clock::time_point t = Clock::now();
     try {
-      if (starts_run) video_track_ = stages_.start_video_track();
-      video_track_(&*batch.inputs[0]);
+      stages_.detect_in_video(&*batch.inputs[0], starts_run);
       video_last_ = i;
     } catch (...) {
       batch.errors[0] = "detect: " + Describe(std::current_exception());
     }
     batch.seconds[0] += SecondsSince(t);
-  }
-
-  // Video mode without a network or fit.init previous: the runs (VideoRuns) in
-  // parallel, each on its own track, as `detect --video` does; a frame is fitted and
-  // written as soon as it is detected.
-  void LabelVideoRuns() {
-    const std::vector<std::vector<size_t>> runs = VideoRuns();
-    tbb::task_arena arena(threads_);
-    arena.execute([&] {
-      tbb::parallel_for(
-          tbb::blocked_range<size_t>(0, runs.size(), 1),
-          [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t k = r.begin(); k != r.end(); ++k) LabelVideoRun(runs[k]);
-          },
-          tbb::simple_partitioner());
-    });
-  }
-
-  // One run of video mode. A frame that fails to read or to detect breaks the run: the
-  // next one starts a new track, as in DetectInVideo.
-  void LabelVideoRun(const std::vector<size_t>& run) {
-    std::function<void(FrameInput*)> track = stages_.start_video_track();
-    for (const size_t i : run) {
-      std::shared_ptr<Batch> batch = MakeBatch(0, {mine_[i]});
-      Load(*batch, 0);
-      if (batch->errors[0].empty()) {
-        const Clock::time_point t = Clock::now();
-        try {
-          track(&*batch->inputs[0]);
-        } catch (...) {
-          batch->errors[0] = "detect: " + Describe(std::current_exception());
-        }
-        batch->seconds[0] += SecondsSince(t);
-      }
-      if (!batch->errors[0].empty()) track = stages_.start_video_track();
-      FinishFrame(*batch, 0);
-    }
-  }
-
-  // The shard's frames to do (positions in mine_) in video-mode runs: a run starts at
-  // the first frame to do, after a gap and at every detector_palm_every-th frame of the
-  // job (positions in the job's frame order: shards and resumed runs choose the same).
-  std::vector<std::vector<size_t>> VideoRuns() const {
-    const size_t every = static_cast<size_t>(job_.detector_palm_every);
-    std::vector<std::vector<size_t>> runs;
-    size_t t = 0;
-    for (size_t i = 0; i < mine_.size() && t < todo_.size(); ++i) {
-      if (mine_[i] != todo_[t]) continue;
-      ++t;
-      if (runs.empty() || runs.back().back() != i - 1 ||
-          (every > 0 && (shard_begin_ + i) % every == 0)) {
-        runs.emplace_back();
-      }
-      runs.back().push_back(i);
-    }
-    return runs;
   }
 
   // A job that tracks the hand (evidence.detector_every): runs of frames in order, each
@@ -740,7 +679,6 @@ class LabelJobRun {
   static constexpr size_t kNoFrame = static_cast<size_t>(-1);
   std::map<std::string, size_t> position_;
   size_t video_last_ = kNoFrame;
-  std::function<void(FrameInput*)> video_track_;  // the run's track (DetectInVideo)
   int done_before_ = 0;
   int threads_ = 1;
   bool in_order_ = false;
