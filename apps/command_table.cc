@@ -1,8 +1,11 @@
+#include <algorithm>
 #include <cstring>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "apps/commands.h"
+#include "core/blas_library.h"
 
 namespace handlabel {
 namespace {
@@ -64,6 +67,17 @@ int RunHandlabel(int argc, char** argv) {
     return 0;
   }
   if (name == "--version") return RunVersion(argc - 1, argv + 1);
+  // Before any command computes (help and version print only).
+  const bool computes =
+      name != "version" && std::none_of(argv + 2, argv + argc, [](const char* a) {
+        return std::strcmp(a, "--help") == 0 || std::strcmp(a, "-h") == 0;
+      });
+  if (computes) {
+    if (const std::optional<std::string> problem = PrepareBlasForThreads()) {
+      std::cerr << "handlabel: " << *problem << "\n";
+      return 2;
+    }
+  }
   for (const Command& c : AllCommands()) {
     if (name == c.name) return c.run(argc - 1, argv + 1);
   }

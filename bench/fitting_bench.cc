@@ -134,5 +134,3 @@ BENCHMARK(BM_FitFramesParallel)
 
 }  // namespace
 }  // namespace handlabel
-
-BENCHMARK_MAIN();

@@ -192,5 +192,3 @@ BENCHMARK_TEMPLATE(BM_AllVertices, Jet61)->Arg(4)->Arg(16)->Unit(benchmark::kMic
 
 }  // namespace
 }  // namespace handlabel
-
-BENCHMARK_MAIN();

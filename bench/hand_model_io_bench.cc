@@ -69,5 +69,3 @@ BENCHMARK(BM_SaveOwnNpz)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace handlabel
-
-BENCHMARK_MAIN();

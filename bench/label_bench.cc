@@ -63,5 +63,3 @@ BENCHMARK(BM_LabelFitOnly)
 
 }  // namespace
 }  // namespace handlabel
-
-BENCHMARK_MAIN();

@@ -329,5 +329,3 @@ BENCHMARK_CAPTURE(BM_PoemStages, Shipped, std::string("models/poem_small_dexycb.
 
 }  // namespace
 }  // namespace handlabel
-
-BENCHMARK_MAIN();

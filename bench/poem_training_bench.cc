@@ -101,5 +101,3 @@ BENCHMARK(BM_TrainingSample)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Min
 
 }  // namespace
 }  // namespace handlabel
-
-BENCHMARK_MAIN();

@@ -98,5 +98,3 @@ BENCHMARK(BM_WriteFrame)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace handlabel
-
-BENCHMARK_MAIN();

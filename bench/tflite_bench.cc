@@ -63,5 +63,3 @@ BENCHMARK_CAPTURE(BM_Tflite, palm_lite, std::string("palm_detection_lite.tflite"
 
 }  // namespace
 }  // namespace handlabel
-
-BENCHMARK_MAIN();

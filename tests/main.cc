@@ -12,6 +12,7 @@
 #include <iostream>
 #include <iterator>
 
+#include "core/blas_library.h"
 #include "core/random.h"
 #include "tests/test_util.h"
 
@@ -81,6 +82,11 @@ std::map<std::string, std::string> FilesUnder(const std::string& dir) {
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleMock(&argc, argv);
+  // As the program does (apps/command_table.cc); ConcurrentProducts.* fail on such a
+  // BLAS, the other tests run so that the rest of the picture is seen.
+  if (const auto problem = handlabel::PrepareBlasForThreads()) {
+    std::cerr << "warning: " << *problem << "\n";
+  }
   ::testing::UnitTest::GetInstance()->listeners().Append(
       new handlabel::testing::SeedPerTest);
   return RUN_ALL_TESTS();

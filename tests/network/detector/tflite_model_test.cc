@@ -4,10 +4,14 @@
 
 #include <ATen/Parallel.h>
 #include <gtest/gtest.h>
+#include <torch/torch.h>
 
+#include <array>
 #include <cmath>
+#include <optional>
 #include <thread>
 
+#include "core/blas_library.h"
 #include "core/errors.h"
 #include "network/detector/tflite_model.h"
 #include "network/detector/tflite_reader.h"
@@ -130,6 +134,30 @@ TEST(TfliteModel, RunsOnItsThreadCountWithoutChangingAnyoneElses) {
   for (std::thread& caller : callers) caller.join();
   for (const auto& answer : answers) EXPECT_EQ(answer, alone);
   at::set_num_threads(before);
+}
+
+// The models' 1x1 convolutions and fully connected layers are BLAS products (sgemm),
+// called from every thread that detects a frame while other threads fit (LAPACK). With
+// OpenBLAS's serial build such calls made at once returned wrong products (with this
+// test's small products, which spend the most of their time where the threads' buffers
+// collide: 1100-1300 wrong of 2 x 20000 in every run), so a detector job's labels
+// changed from run to run. The program refuses such a BLAS (core/blas_library.h).
+TEST(ConcurrentProducts, ProductsFromTwoThreadsAtOnceAreExact) {
+  EXPECT_EQ(PrepareBlasForThreads(), std::nullopt) << LoadedBlasLibrary().name;
+  torch::manual_seed(5);
+  const torch::Tensor a = torch::randn({64, 64});
+  const torch::Tensor b = torch::randn({64, 32});
+  const torch::Tensor alone = torch::mm(a, b);
+  std::array<int, 2> wrong{0, 0};
+  std::vector<std::thread> callers;
+  for (int t = 0; t < 2; ++t) {
+    callers.emplace_back([&, t] {
+      for (int i = 0; i < 20000; ++i) wrong[t] += !torch::equal(torch::mm(a, b), alone);
+    });
+  }
+  for (std::thread& caller : callers) caller.join();
+  EXPECT_EQ(wrong[0] + wrong[1], 0)
+      << "of 2 x 20000 products, with " << LoadedBlasLibrary().name;
 }
 
 TEST(TfliteModel, NamesUnsupportedOperators) {
