@@ -154,7 +154,7 @@ class LabelJobRun {
     Progress progress(static_cast<int>(todo_.size()),
                       options_.log ? *options_.log : discard, options_.interactive);
     progress_ = &progress;
-    if (stages_.detect_in_video) {
+    if (stages_.start_video_track) {
       LabelVideo();
     } else if (stages_.find_keypoints_2d) {
       LabelTracked();
@@ -460,6 +460,10 @@ class LabelJobRun {
   // the network if any (one frame at a time), label and write (parallel; in order
   // with fit.init previous).
   void LabelVideo() {
+    if (!in_order_ && !stages_.predictor) {
+      LabelVideoRuns();
+      return;
+    }
     using BatchPtr = std::shared_ptr<Batch>;
     for (size_t i = 0; i < mine_.size(); ++i) position_[mine_[i]] = i;
     const tbb::filter_mode finish =
@@ -505,12 +509,83 @@ class LabelJobRun {
     if (!batch.errors[0].empty()) return;
     const Clock::time_point t = Clock::now();
     try {
-      stages_.detect_in_video(&*batch.inputs[0], starts_run);
+      if (starts_run) video_track_ = stages_.start_video_track();
+      video_track_(&*batch.inputs[0]);
       video_last_ = i;
     } catch (...) {
       batch.errors[0] = "detect: " + Describe(std::current_exception());
     }
     batch.seconds[0] += SecondsSince(t);
+  }
+
+  // Video mode without a network or fit.init previous: the runs (VideoRuns) in
+  // parallel, each on its own track, as `detect --video` does; a frame is fitted and
+  // written as soon as it is detected.
+  void LabelVideoRuns() {
+    LabelRunsInParallel(VideoRuns(), threads_,
+                        [this](const std::vector<size_t>& run) { LabelVideoRun(run); });
+  }
+
+  // `label_run` on every run, `threads` runs at once; one run per task, so that a long
+  // run does not hold back the runs queued behind it.
+  template <typename LabelRun>
+  static void LabelRunsInParallel(const std::vector<std::vector<size_t>>& runs,
+                                  int threads, LabelRun label_run) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      tbb::parallel_for(
+          tbb::blocked_range<size_t>(0, runs.size(), 1),
+          [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t k = r.begin(); k != r.end(); ++k) label_run(runs[k]);
+          },
+          tbb::simple_partitioner());
+    });
+  }
+
+  // One run of video mode. A frame that fails to read or to detect breaks the run: the
+  // next one starts a new track, as in DetectInVideo.
+  void LabelVideoRun(const std::vector<size_t>& run) {
+    std::function<void(FrameInput*)> track = stages_.start_video_track();
+    for (const size_t i : run) {
+      std::shared_ptr<Batch> batch = MakeBatch(0, {mine_[i]});
+      Load(*batch, 0);
+      if (batch->errors[0].empty()) {
+        const Clock::time_point t = Clock::now();
+        try {
+          track(&*batch->inputs[0]);
+        } catch (...) {
+          batch->errors[0] = "detect: " + Describe(std::current_exception());
+        }
+        batch->seconds[0] += SecondsSince(t);
+      }
+      if (!batch->errors[0].empty()) track = stages_.start_video_track();
+      FinishFrame(*batch, 0);
+    }
+  }
+
+  // The shard's frames to do (positions in mine_) in video-mode runs: a run starts at
+  // the first frame to do, after a gap and at every detector_palm_every-th frame of the
+  // job (positions in the job's frame order: shards and resumed runs choose the same).
+  std::vector<std::vector<size_t>> VideoRuns() const {
+    const size_t every = static_cast<size_t>(job_.detector_palm_every);
+    return RunsOfFramesToDo(
+        [&](size_t i) { return every > 0 && (shard_begin_ + i) % every == 0; });
+  }
+
+  // The shard's frames to do (positions in mine_) in runs of consecutive frames: a run
+  // starts at the first frame to do, after a gap and where `starts_run(i)`.
+  template <typename StartsRun>
+  std::vector<std::vector<size_t>> RunsOfFramesToDo(StartsRun starts_run) const {
+    std::vector<std::vector<size_t>> runs;
+    size_t t = 0;
+    for (size_t i = 0; i < mine_.size() && t < todo_.size(); ++i) {
+      if (mine_[i] != todo_[t]) continue;
+      ++t;
+      if (runs.empty() || runs.back().back() != i - 1 || starts_run(i))
+        runs.emplace_back();
+      runs.back().push_back(i);
+    }
+    return runs;
   }
 
   // A job that tracks the hand (evidence.detector_every): runs of frames in order, each
@@ -525,32 +600,14 @@ class LabelJobRun {
       for (const auto& run : runs) label_run(run);
       return;
     }
-    tbb::task_arena arena(std::max(1, stages_.predictor->lanes));
-    arena.execute([&] {
-      tbb::parallel_for(
-          tbb::blocked_range<size_t>(0, runs.size(), 1),
-          [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t k = r.begin(); k != r.end(); ++k) label_run(runs[k]);
-          },
-          tbb::simple_partitioner());
-    });
+    LabelRunsInParallel(runs, std::max(1, stages_.predictor->lanes), label_run);
   }
 
   // The shard's frames to do (positions in mine_) in runs that depend on nothing
   // another run labels: a run starts at a frame the detector runs on anyway
   // (TrackPrior) or after a gap (its prior then is a label of an earlier run).
   std::vector<std::vector<size_t>> TrackRuns() const {
-    std::vector<std::vector<size_t>> runs;
-    size_t t = 0;
-    for (size_t i = 0; i < mine_.size() && t < todo_.size(); ++i) {
-      if (mine_[i] != todo_[t]) continue;
-      ++t;
-      if (runs.empty() || runs.back().back() != i - 1 || IsTrackAnchor(i)) {
-        runs.emplace_back();
-      }
-      runs.back().push_back(i);
-    }
-    return runs;
+    return RunsOfFramesToDo([&](size_t i) { return IsTrackAnchor(i); });
   }
 
   // The detector runs on every N-th frame of the job (positions in the job's frame
@@ -679,6 +736,7 @@ class LabelJobRun {
   static constexpr size_t kNoFrame = static_cast<size_t>(-1);
   std::map<std::string, size_t> position_;
   size_t video_last_ = kNoFrame;
+  std::function<void(FrameInput*)> video_track_;  // the run's track (DetectInVideo)
   int done_before_ = 0;
   int threads_ = 1;
   bool in_order_ = false;

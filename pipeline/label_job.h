@@ -13,13 +13,14 @@
 // is detected and labelled as usual only when that answer fails its checks. Frames run
 // in order within runs that start at detected frames, the runs in parallel.
 //
-// Video mode (evidence.detector_mode: video, LabelStageSet::detect_in_video): frames
-// are read in parallel, detected one at a time in the job's frame order (each from the
-// previous frame's 3D hand; views in parallel inside) and fitted and written in
-// parallel, so fits overlap the detection of later frames. A run (palm detection in
-// every view) starts at the shard's first frame to do, at every detector_palm_every-th
-// frame of the job and after a gap (frames done before, or a frame that failed to
-// read), so shards and resumed runs differ from one whole run only at such starts.
+// Video mode (evidence.detector_mode: video, LabelStageSet::start_video_track): a run
+// (palm detection in every view) starts at the shard's first frame to do, at every
+// detector_palm_every-th frame of the job and after a gap (frames done before, or a
+// frame that failed to read), so shards and resumed runs differ from one whole run only
+// at such starts. A run's frames are detected in order, each from the previous frame's
+// 3D hand (views in parallel inside); runs go in parallel, each frame fitted and
+// written after its detection. With a network or fit.init previous, frames are read in
+// parallel and detected one at a time in the job's frame order instead.
 //
 //  - Resume: a frame is finished once its files are renamed into place and its record
 //    appended to the shard log (frame_log.h). A re-run with resume skips finished
@@ -68,10 +69,11 @@ struct LabelStageSet {
   // without their 2D and this finds it for the frames that need it; empty otherwise.
   std::function<void(FrameInput*)> find_keypoints_2d;
   // Video mode (evidence.detector_mode: video): the source loads frames without their
-  // 2D and this finds it, called on the frames in order, one call at a time; a frame's
-  // regions come from the previous call's answer unless `starts_run` (then, and after
-  // a call that threw, palm detection in every view). Empty otherwise.
-  std::function<void(FrameInput* frame, bool starts_run)> detect_in_video;
+  // 2D; each call starts a track that finds it for the frames handed to it in order,
+  // one call at a time: palm detection in every view on its first frame, then each
+  // frame's regions from the previous frame's answer. Tracks share nothing, so runs
+  // of frames can go in parallel. Empty otherwise.
+  std::function<std::function<void(FrameInput*)>()> start_video_track;
 };
 
 struct LabelRunOptions {

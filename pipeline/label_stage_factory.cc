@@ -53,7 +53,7 @@ LabelStageSet BuiltLabelStages::Set() const {
   set.side = hand_model.side;
   set.faces = hand_model.faces;
   set.find_keypoints_2d = find_keypoints_2d;
-  set.detect_in_video = detect_in_video;
+  set.start_video_track = start_video_track;
   return set;
 }
 
@@ -135,13 +135,15 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job,
     built.find_keypoints_2d = [detector](FrameInput* frame) { detector->Detect(frame); };
   }
   if (detector && job.detector_video) {
-    // The previous frame's answer, handed on from call to call (one caller at a
-    // time); emptied first, so that a frame whose detection fails starts no track.
-    auto previous = std::make_shared<std::optional<FrameHandResult>>();
-    built.detect_in_video = [detector, previous](FrameInput* frame, bool starts_run) {
-      std::optional<FrameHandResult> last = std::move(*previous);
-      previous->reset();
-      *previous = detector->Detect(frame, starts_run || !last ? nullptr : &*last);
+    built.start_video_track = [detector] {
+      // The previous frame's answer, handed on from call to call (one caller at a
+      // time); emptied first, so that a frame whose detection throws starts anew.
+      auto previous = std::make_shared<std::optional<FrameHandResult>>();
+      return std::function<void(FrameInput*)>([detector, previous](FrameInput* frame) {
+        std::optional<FrameHandResult> last = std::move(*previous);
+        previous->reset();
+        *previous = detector->Detect(frame, last ? &*last : nullptr);
+      });
     };
   }
   const HandSide side = built.source->side().value_or(HandSide::kRight);

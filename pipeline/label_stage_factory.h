@@ -26,8 +26,8 @@ struct BuiltLabelStages {
   std::string hand_model_note;
   // The detector on demand of a job that tracks (LabelStageSet::find_keypoints_2d).
   std::function<void(FrameInput*)> find_keypoints_2d;
-  // The detector in video mode (LabelStageSet::detect_in_video).
-  std::function<void(FrameInput*, bool)> detect_in_video;
+  // The detector's tracks in video mode (LabelStageSet::start_video_track).
+  std::function<std::function<void(FrameInput*)>()> start_video_track;
   // Views of the above for RunLabelJob.
   LabelStageSet Set() const;
 };
