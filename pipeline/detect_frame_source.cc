@@ -19,6 +19,13 @@ std::optional<FrameHandResult> DetectionStore::Take(const std::string& frame) {
   return result;
 }
 
+std::optional<FrameHandResult> DetectionStore::Find(const std::string& frame) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = results_.find(frame);
+  if (it == results_.end()) return std::nullopt;
+  return it->second;
+}
+
 std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
     const FrameHandResult& result) {
   std::vector<std::optional<Keypoints2d>> out;

@@ -4,8 +4,9 @@
 // images as it is loaded (multi-view hand finding, network/detector/hand_detector.h),
 // exactly as `handlabel detect --capture` would write them (pipeline/detect_capture.h): a
 // keypoint with confidence 0 is unknown (position 0), a view without a detection has
-// none. The detector's full answer per frame stays available to the overlay writer
-// (DetectionStore), which draws it (network/detector/detector_overlay.h).
+// none. The detector's full answer per frame stays available (DetectionStore) to the
+// overlay writer, which draws it (network/detector/detector_overlay.h), and to the job,
+// which writes it beside the labels (label_outputs.h: detections/<frame>.json).
 
 #include <map>
 #include <memory>
@@ -24,12 +25,15 @@ namespace handlabel {
 class DetectionStore {
  public:
   void Put(const std::string& frame, FrameHandResult result);
-  // The frame's answer, removed from the store (each is drawn once: a long job does
-  // not keep them all); nullopt when the frame was not detected (yet).
+  // The frame's answer, removed from the store (each is written once: a long job
+  // does not keep them all); nullopt when the frame was not detected (yet).
   std::optional<FrameHandResult> Take(const std::string& frame);
+  // A copy of the frame's answer, left in the store (for the overlays, drawn before the
+  // answer is written and taken).
+  std::optional<FrameHandResult> Find(const std::string& frame) const;
 
  private:
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::map<std::string, FrameHandResult> results_;
 };
 

@@ -347,6 +347,21 @@ void JobConfig::Check(const std::string& source) const {
   CheckFileEvidence(*this, source);
   CheckFitSettings(fit, source);
   sequence.Check(source);
+  if (sequence.smooth) CheckSmoothable();
+}
+
+void JobConfig::CheckSmoothable() const {
+  if (keypoints == KeypointSource::kFiles &&
+      (!keypoints_from_detector || detector_every == 1)) {
+    return;
+  }
+  throw InputError(source_file, "evidence.keypoints_2d",
+                   "2D that a smoothing pass can refit: files, or detector with "
+                   "detector_every 1 (its answers are kept in <output.dir>/detections/)",
+                   keypoints_from_detector
+                       ? "detector with detector_every " + std::to_string(detector_every)
+                   : keypoints == KeypointSource::kNetwork ? "network"
+                                                           : "both");
 }
 
 void SequenceSettings::Check(const std::string& source) const {

@@ -200,6 +200,11 @@ struct JobConfig {
 
   // Throws InputError naming the file and field.
   void Check(const std::string& source) const;
+  // Throws InputError naming evidence.keypoints_2d unless a smoothing pass can refit
+  // the job's 2D from disk: files, or the in-job detector on every frame (its answers
+  // are written beside the labels); not the network's own 2D. Checked on loading a job
+  // with sequence.smooth and by `handlabel smooth`.
+  void CheckSmoothable() const;
 };
 
 // Reads and validates a job file. Unknown keys are errors (they are usually typos).

@@ -354,6 +354,14 @@ class LabelJobRun {
         if (!network_error.empty()) error = network_error + "; fallback fit: " + error;
       }
     }
+    if (stages_.write_detections && batch.inputs[i]) {
+      try {  // before the record: a finished frame has its detections file
+        stages_.write_detections(out_, *batch.inputs[i]);
+      } catch (...) {
+        if (error.empty())
+          error = "detections file: " + Describe(std::current_exception());
+      }
+    }
     if (!error.empty()) {
       record.status = "failed";
       record.reason = error;

@@ -74,6 +74,11 @@ struct LabelStageSet {
   // frame's regions from the previous frame's answer. Tracks share nothing, so runs
   // of frames can go in parallel. Empty otherwise.
   std::function<std::function<void(FrameInput*)>()> start_video_track;
+  // Writes the in-job detector's answer on a frame into the output folder
+  // (label_outputs.h: detections/<frame>.json), once the frame is labelled or has
+  // failed; nothing for a frame the detector did not run on. Empty: no detector.
+  std::function<void(const std::string& output_dir, const FrameInput& frame)>
+      write_detections;
 };
 
 struct LabelRunOptions {

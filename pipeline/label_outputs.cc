@@ -74,6 +74,14 @@ std::string OverlayPath(const std::string& output_dir, const std::string& frame,
          FrameFileStem(camera, "camera name") + "." + format;
 }
 
+std::string JobDetectionsDir(const std::string& output_dir) {
+  return output_dir + "/detections";
+}
+
+std::string JobDetectionsPath(const std::string& output_dir, const std::string& frame) {
+  return JobDetectionsDir(output_dir) + "/" + FrameFileStem(frame, "frame id") + ".json";
+}
+
 std::map<std::string, FrameRecord> ReadShardLogs(const std::string& output_dir) {
   std::map<std::string, FrameRecord> latest;
   const fs::path dir = fs::path(output_dir) / "shards";

@@ -4,6 +4,9 @@
 //   labels/<frame>.json               one label per frame (label_record.h)
 //   meshes/<frame>.ply|.obj           optional meshes
 //   overlays/<frame>/<camera>.jpg     optional overlay pictures (or .png)
+//   detections/<frame>.json           the in-job detector's answers
+//   (evidence.keypoints_2d:
+//                                     detector), in the format `handlabel detect` writes
 //   shards/shard-<i>-of-<N>.jsonl     resume log of shard i (frame_log.h)
 //   shards/shard-<i>-of-<N>.summary.json   what that shard's last run did
 //   manifest.json, summary.json, summary.md   written by merge (and by a 1-shard run)
@@ -27,6 +30,9 @@ std::string SummaryMarkdownPath(const std::string& output_dir);
 // `format`: the job's output.overlay_format, the file's extension (jpg | png).
 std::string OverlayPath(const std::string& output_dir, const std::string& frame,
                         const std::string& camera, const std::string& format);
+// The folder of the in-job detector's answers, and one frame's file in it.
+std::string JobDetectionsDir(const std::string& output_dir);
+std::string JobDetectionsPath(const std::string& output_dir, const std::string& frame);
 
 // The latest record per frame over every shard log in the folder (logs of any shard
 // count, so a job may be re-sharded between runs). An ok record wins over a failed

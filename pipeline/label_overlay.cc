@@ -54,7 +54,7 @@ void DrawLabelOverlay(const RigCamera& camera, const PixelRays& rays,
 void RasterOverlayWriter::Write(const std::string& output_dir, const FrameInput& frame,
                                 const LabelRecord& label) const {
   const std::optional<FrameHandResult> detection =
-      detections_ ? detections_->Take(frame.id) : std::nullopt;
+      detections_ ? detections_->Find(frame.id) : std::nullopt;
   for (size_t v = 0; v < frame.rig.size(); ++v) {
     const RigCamera& camera = frame.rig[v];
     // Grey only for a view without an image file; a file that cannot be read or does

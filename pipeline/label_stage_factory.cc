@@ -5,10 +5,12 @@
 #include "capture/ho3d_frame_source.h"
 #include "capture/native_frame_source.h"
 #include "capture/oakink_frame_source.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "pipeline/ceres_label_fitter.h"
 #include "pipeline/detect_frame_source.h"
 #include "pipeline/hand_model_source.h"
+#include "pipeline/label_outputs.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/network_stage.h"
 
@@ -54,6 +56,7 @@ LabelStageSet BuiltLabelStages::Set() const {
   set.faces = hand_model.faces;
   set.find_keypoints_2d = find_keypoints_2d;
   set.start_video_track = start_video_track;
+  set.write_detections = write_detections;
   return set;
 }
 
@@ -123,11 +126,21 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job,
 BuiltLabelStages BuildLabelStages(const JobConfig& job,
                                   std::shared_ptr<PredictionMemo> memo) {
   BuiltLabelStages built;
-  // The detector's answers, for overlays that show them (evidence.keypoints_2d:
-  // detector).
+  // The detector's answers (evidence.keypoints_2d: detector), written beside the
+  // labels (the 2D a smoothing pass refits, docs/labeling-jobs.md) and drawn on the
+  // overlays.
   std::shared_ptr<DetectionStore> detections;
-  if (job.keypoints_from_detector && job.overlays) {
+  if (job.keypoints_from_detector) {
     detections = std::make_shared<DetectionStore>();
+    built.write_detections = [detections](const std::string& output_dir,
+                                          const FrameInput& frame) {
+      const std::optional<FrameHandResult> result = detections->Take(frame.id);
+      if (!result) return;
+      std::vector<std::string> cameras;
+      for (const RigCamera& camera : frame.rig.cameras()) cameras.push_back(camera.name);
+      WriteFileAtomically(JobDetectionsPath(output_dir, frame.id),
+                          FrameDetectionsJson(frame.id, cameras, *result).dump(1) + "\n");
+    };
   }
   const DetectorFrameSource* detector = nullptr;
   built.source = BuildFrameSource(job, detections, &detector);

@@ -28,6 +28,8 @@ struct BuiltLabelStages {
   std::function<void(FrameInput*)> find_keypoints_2d;
   // The detector's tracks in video mode (LabelStageSet::start_video_track).
   std::function<std::function<void(FrameInput*)>()> start_video_track;
+  // The detector's answers into the output (LabelStageSet::write_detections).
+  std::function<void(const std::string&, const FrameInput&)> write_detections;
   // Views of the above for RunLabelJob.
   LabelStageSet Set() const;
 };

@@ -22,6 +22,7 @@
 #include "pipeline/frame_metrics.h"
 #include "pipeline/hand_model_source.h"
 #include "pipeline/label_job.h"
+#include "pipeline/label_outputs.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/label_record.h"
@@ -76,15 +77,15 @@ std::string RecordedJobHash(const std::string& output_dir) {
   }
 }
 
-void RequireEvidenceOnDisk(const JobConfig& job) {
-  if (job.keypoints != KeypointSource::kFiles || job.keypoints_from_detector) {
-    throw InputError(job.source_file, "evidence.keypoints_2d",
-                     "files (smoothing refits the 2D on disk; run `handlabel detect` "
-                     "first for a detector's)",
-                     job.keypoints_from_detector                 ? "detector"
-                     : job.keypoints == KeypointSource::kNetwork ? "network"
-                                                                 : "both");
-  }
+// The job's frames with the 2D the per-frame labels were fitted to: the job's own
+// source, or for the in-job detector its answers written beside the labels.
+std::unique_ptr<FrameSource> EvidenceOnDisk(const JobConfig& job) {
+  job.CheckSmoothable();
+  if (!job.keypoints_from_detector) return BuildFrameSource(job);
+  JobConfig from_files = job;
+  from_files.keypoints_from_detector = false;
+  from_files.detections = JobDetectionsDir(job.output_dir);
+  return BuildFrameSource(from_files);
 }
 
 std::string ReportText(const json& report);
@@ -95,7 +96,6 @@ class SmoothJobRun {
       : job_(job), options_(options), out_(SmoothedOutputDir(job.output_dir)) {}
 
   SmoothSummary Run() {
-    RequireEvidenceOnDisk(job_);
     Plan();
     SolveAndWrite();
     summary_.report = Report();
@@ -108,7 +108,7 @@ class SmoothJobRun {
  private:
   // The job's frames and labels, the segments, the sequence's shape, the stamp.
   void Plan() {
-    source_ = BuildFrameSource(job_);
+    source_ = EvidenceOnDisk(job_);
     model_ = ResolveHandModel(job_.hand_model, source_->side()).model;
     const CeresLabelFitterOptions fit = FitterOptions(job_);
     SequenceSmoothOptions smooth;

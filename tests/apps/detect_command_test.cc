@@ -142,13 +142,15 @@ TEST(DetectCommand, CaptureViewsGetDetectionsOrReasons) {
 
 // A job file for the capture in `capture` whose 2D is `keypoints_2d` (fit-only).
 void WriteFitOnlyJob(const std::string& path, const std::string& capture,
-                     const std::string& keypoints_2d, const std::string& out) {
+                     const std::string& keypoints_2d, const std::string& out,
+                     const std::string& more_sections = "") {
   std::ofstream(path) << "name: t\nseed: 3\ninput:\n  format: native\n  path: " << capture
                       << "\nnetwork:\n  weights: \"\"\nrefine:\n  mode: always\n"
                       << "evidence:\n  keypoints_2d: " << keypoints_2d
                       << "\n  masks: none\noutput:\n  dir: " << out
                       << "\n  meshes: []\n  overlays: true\n  overlay_format: png"
-                      << "\n  evaluate: true\n";
+                      << "\n  evaluate: true\n"
+                      << more_sections;
 }
 
 // `evidence.keypoints_2d: detector` runs the detector inside the job: its 2D is what
@@ -213,10 +215,12 @@ TEST(DetectCommand, LabelJobWithDetectorGivesTheSame2dAsDetectThenFiles) {
 // Frames detected at once (`detect --threads 2`, and a detector job's frames on two
 // threads) give what one at a time gives, bit for bit: each frame's detection depends
 // on its own images only, whichever thread runs it.
-// Expects the two captures' detection files equal byte for byte and the two label
+// Expects the two captures' detection files equal byte for byte, and the two label
 // folders' labels equal (keypoints and parameters) for every frame; returns the frames.
+// `subfolder`: labels/ (the per-frame labels) or smoothed/labels/.
 int CompareDetectionsAndLabels(const std::string& capture_a, const std::string& capture_b,
-                               const std::string& labels_a, const std::string& labels_b) {
+                               const std::string& labels_a, const std::string& labels_b,
+                               const std::string& subfolder = "labels") {
   namespace fs = std::filesystem;
   int frames = 0;
   for (const auto& entry : fs::directory_iterator(capture_a + "/detections")) {
@@ -225,8 +229,8 @@ int CompareDetectionsAndLabels(const std::string& capture_a, const std::string& 
               testing::ReadFileBytes(capture_b + "/detections/" + name))
         << name;
     const std::string stem = entry.path().stem().string();
-    const nlohmann::json a = ReadJson(labels_a + "/labels/" + stem + ".json");
-    const nlohmann::json b = ReadJson(labels_b + "/labels/" + stem + ".json");
+    const nlohmann::json a = ReadJson(labels_a + "/" + subfolder + "/" + stem + ".json");
+    const nlohmann::json b = ReadJson(labels_b + "/" + subfolder + "/" + stem + ".json");
     EXPECT_EQ(a["keypoints_3d"].dump(), b["keypoints_3d"].dump()) << stem;
     EXPECT_EQ(a["mano"].dump(), b["mano"].dump()) << stem;
     ++frames;
@@ -261,6 +265,10 @@ TEST(DetectCommand, FramesInParallelGiveTheSameDetectionsAndLabels) {
     ASSERT_EQ(job.status, 0) << job.err;
   }
   EXPECT_EQ(CompareDetectionsAndLabels(dir + "/cap1", dir + "/cap2", dir + "/labels1",
+                                       dir + "/labels2"),
+            3);
+  // The job keeps its detector's answers: the files `detect` writes.
+  EXPECT_EQ(CompareDetectionsAndLabels(dir + "/cap1", dir + "/labels2", dir + "/labels1",
                                        dir + "/labels2"),
             3);
 }
@@ -368,13 +376,17 @@ TEST(DetectCommand, VideoModeIsTheSameAtAnyThreadCountAndInAJob) {
                              "--palm-every", "3", "--threads", threads});
     ASSERT_EQ(r.status, 0) << r.err;
   }
-  WriteFitOnlyJob(dir + "/files.yaml", dir + "/cap1", "files", dir + "/labels_files");
+  // Both jobs smooth (sequence): the detector job from the answers it kept.
+  const std::string smooth = "sequence: {smooth: true, window: 4, overlap: 2}\n";
+  WriteFitOnlyJob(dir + "/files.yaml", dir + "/cap1", "files", dir + "/labels_files",
+                  smooth);
   std::ofstream(dir + "/video.yaml")
       << "name: t\nseed: 3\ninput: {format: native, path: " << dir
       << "/cap}\nnetwork: {weights: \"\", threads: 2}\nrefine: {mode: always}\n"
       << "evidence: {keypoints_2d: detector, detector_mode: video, "
       << "detector_palm_every: 3, masks: none}\n"
-      << "output: {dir: " << dir << "/labels_video, meshes: [], overlays: false}\n";
+      << "output: {dir: " << dir << "/labels_video, meshes: [], overlays: false}\n"
+      << smooth;
   for (const std::string job : {"files", "video"}) {
     const testing::CommandResult r =
         RunHandlabelCommand({"label", "--job", dir + "/" + job + ".yaml"});
@@ -382,6 +394,10 @@ TEST(DetectCommand, VideoModeIsTheSameAtAnyThreadCountAndInAJob) {
   }
   EXPECT_EQ(CompareDetectionsAndLabels(dir + "/cap1", dir + "/cap2",
                                        dir + "/labels_files", dir + "/labels_video"),
+            5);
+  EXPECT_EQ(CompareDetectionsAndLabels(dir + "/cap1", dir + "/labels_video",
+                                       dir + "/labels_files", dir + "/labels_video",
+                                       "smoothed/labels"),
             5);
   // Frames 0 and 3 start runs; the others follow the previous frame.
   EXPECT_EQ(ReadJson(dir + "/cap1/detections/000003.json")["tracking"], "start");

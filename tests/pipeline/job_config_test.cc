@@ -113,7 +113,9 @@ TEST(JobConfig, ErrorsNameTheFieldAndWhatWasExpected) {
 
 // Section sequence: read, defaults without it, and errors naming the field.
 TEST(JobConfig, SequenceSection) {
-  const std::string base = "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n";
+  const std::string base =
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n"
+      "evidence: {keypoints_2d: files}\n";
   const JobConfig plain = LoadJobConfig(WriteJob(base));
   EXPECT_FALSE(plain.sequence.smooth);
   EXPECT_EQ(plain.sequence.window, 48);
@@ -132,6 +134,16 @@ TEST(JobConfig, SequenceSection) {
   ExpectError(base + "sequence: {acceleration_sigma_mm: 0}\n",
               "sequence.acceleration_sigma_mm", "0");
   ExpectError(base + "sequence: {smoth: true}\n", "sequence.smoth", "a known key");
+  // Smoothing refits 2D kept on disk: refused on loading for the network's own 2D and
+  // for a detector that skips frames; the detector on every frame keeps its answers.
+  const std::string other = "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n";
+  const std::string smooth = "sequence: {smooth: true}\n";
+  ExpectError(other + smooth, "evidence.keypoints_2d", "network");
+  ExpectError(other + "evidence: {keypoints_2d: detector, detector_every: 10}\n" + smooth,
+              "evidence.keypoints_2d", "detector with detector_every 10");
+  EXPECT_TRUE(
+      LoadJobConfig(WriteJob(other + "evidence: {keypoints_2d: detector}\n" + smooth))
+          .sequence.smooth);
   // The section does not enter the job hash: per-frame labels stay where they were.
   EXPECT_EQ(JobHash(plain, ""), JobHash(job, ""));
 }
