@@ -15,6 +15,11 @@ std::string ShardLockPath(const std::string& output_dir, const ShardSpec& shard)
   return log.substr(0, log.size() - std::string(".jsonl").size()) + ".lock";
 }
 
+std::string SmoothingLockPath(const std::string& output_dir, const ShardSpec& shard) {
+  return output_dir + "/smoothed/" +
+         fs::path(ShardLockPath(output_dir, shard)).filename().string();
+}
+
 std::string OutputFolderLock::DescribeHolders(const std::string& output_dir) {
   std::string holders;
   const auto add = [&](const std::string& path) {
@@ -24,10 +29,11 @@ std::string OutputFolderLock::DescribeHolders(const std::string& output_dir) {
   };
   add(FolderLockPath(output_dir));
   std::error_code ignored;
-  const fs::path shards = fs::path(output_dir) / "shards";
   std::vector<std::string> locks;
-  for (const auto& e : fs::directory_iterator(shards, ignored)) {
-    if (e.path().extension() == ".lock") locks.push_back(e.path().string());
+  for (const char* folder : {"shards", "smoothed"}) {
+    for (const auto& e : fs::directory_iterator(fs::path(output_dir) / folder, ignored)) {
+      if (e.path().extension() == ".lock") locks.push_back(e.path().string());
+    }
   }
   std::sort(locks.begin(), locks.end());
   for (const std::string& path : locks) add(path);
@@ -39,7 +45,22 @@ std::string OutputFolderLock::DescribeHolders(const std::string& output_dir) {
 OutputFolderLock OutputFolderLock::ForShard(const std::string& output_dir,
                                             const ShardSpec& shard,
                                             const std::string& source) {
-  fs::create_directories(fs::path(output_dir) / "shards");
+  return ForPartOfFolder(output_dir, ShardLockPath(output_dir, shard),
+                         "label shard " + shard.ToString(), source);
+}
+
+OutputFolderLock OutputFolderLock::ForSmoothing(const std::string& output_dir,
+                                                const ShardSpec& shard,
+                                                const std::string& source) {
+  return ForPartOfFolder(output_dir, SmoothingLockPath(output_dir, shard),
+                         "smooth shard " + shard.ToString(), source);
+}
+
+OutputFolderLock OutputFolderLock::ForPartOfFolder(const std::string& output_dir,
+                                                   const std::string& shard_lock,
+                                                   const std::string& what,
+                                                   const std::string& source) {
+  fs::create_directories(fs::path(shard_lock).parent_path());
   OutputFolderLock lock;
   lock.output_dir_ = output_dir;
   lock.source_ = source;
@@ -50,15 +71,13 @@ OutputFolderLock OutputFolderLock::ForShard(const std::string& output_dir,
                      "an output folder no other process is writing (" + output_dir + ")",
                      "in use by " + DescribeHolders(output_dir));
   }
-  const std::string shard_path = ShardLockPath(output_dir, shard);
-  lock.shard_ = FileLock::TryAcquire(shard_path, FileLock::Mode::kExclusive);
+  lock.shard_ = FileLock::TryAcquire(shard_lock, FileLock::Mode::kExclusive);
   if (!lock.shard_.held()) {
     throw InputError(source, "output.dir",
-                     "shard " + shard.ToString() + " of " + output_dir +
-                         " not being labelled by another process",
-                     "being labelled by " + ReadLockHolder(shard_path));
+                     "no other process running " + what + " of " + output_dir,
+                     "held by " + ReadLockHolder(shard_lock));
   }
-  lock.shard_.RecordHolder("label shard " + shard.ToString());
+  lock.shard_.RecordHolder(what);
   return lock;
 }
 

@@ -5,9 +5,12 @@
 //                                                 shard, exclusive for `merge` and
 //                                                 for rewriting job.json (--force)
 //   <output.dir>/shards/shard-<i>-of-<N>.lock     one shard: exclusive for its run
+//   <output.dir>/smoothed/shard-<i>-of-<N>.lock   one shard's smoothing pass
+//                                                 (`smooth`, the folder shared)
 // Shards of one job therefore run in parallel (each locks its own shard), while the
-// same shard twice, `merge` during a run, or another job's --force during a run are
-// refused with an InputError naming the holders' pid, host and start time.
+// same shard twice, `merge` during a run, or another job's --force during a run or a
+// smoothing pass are refused with an InputError naming the holders' pid, host and
+// start time.
 
 #include <string>
 #include <vector>
@@ -18,6 +21,7 @@
 namespace handlabel {
 
 std::string ShardLockPath(const std::string& output_dir, const ShardSpec& shard);
+std::string SmoothingLockPath(const std::string& output_dir, const ShardSpec& shard);
 
 // The locks of one writer of an output folder.
 class OutputFolderLock {
@@ -27,6 +31,11 @@ class OutputFolderLock {
   // job file) is named in errors.
   static OutputFolderLock ForShard(const std::string& output_dir, const ShardSpec& shard,
                                    const std::string& source);
+  // A smoothing pass of one shard (pipeline/smooth_job.h): the folder shared (the
+  // per-frame labels it reads cannot be replaced by a --force run meanwhile), its
+  // shard's smoothing exclusive.
+  static OutputFolderLock ForSmoothing(const std::string& output_dir,
+                                       const ShardSpec& shard, const std::string& source);
   // `merge` (or anything rewriting the whole folder): the folder exclusive.
   static OutputFolderLock Whole(const std::string& output_dir, const std::string& command,
                                 const std::string& source);
@@ -35,6 +44,11 @@ class OutputFolderLock {
   void MakeWhole(const std::string& why);
 
  private:
+  // The folder shared and `shard_lock` (a shard's label run or smoothing) exclusive.
+  static OutputFolderLock ForPartOfFolder(const std::string& output_dir,
+                                          const std::string& shard_lock,
+                                          const std::string& what,
+                                          const std::string& source);
   // "shard 0/2: label, pid 123 on host h since ...; ..." for every running holder.
   static std::string DescribeHolders(const std::string& output_dir);
 

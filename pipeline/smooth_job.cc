@@ -27,6 +27,7 @@
 #include "pipeline/label_policy.h"
 #include "pipeline/label_record.h"
 #include "pipeline/label_stage_factory.h"
+#include "pipeline/output_lock.h"
 
 namespace handlabel {
 namespace {
@@ -96,6 +97,8 @@ class SmoothJobRun {
       : job_(job), options_(options), out_(SmoothedOutputDir(job.output_dir)) {}
 
   SmoothSummary Run() {
+    lock_ =
+        OutputFolderLock::ForSmoothing(job_.output_dir, options_.shard, job_.source_file);
     Plan();
     SolveAndWrite();
     summary_.report = Report();
@@ -317,6 +320,7 @@ class SmoothJobRun {
   std::unique_ptr<FrameSource> source_;
   HandModel model_;
   std::optional<SequenceSmoother> smoother_;
+  OutputFolderLock lock_;                    // held for the whole pass
   std::unique_ptr<OverlayWriter> overlays_;  // output.overlays: the smoothed labels'
   std::string job_hash_;
   std::vector<std::string> ids_;

@@ -37,6 +37,25 @@ TEST(OutputLock, ShardsOfOneFolderLockTheirOwnShardOnly) {
   EXPECT_THAT(merge_error, HasSubstr("label shard 1/2"));
 }
 
+// A smoothing pass locks its shard's smoothing and shares the folder: beside a label
+// run and another shard's smoothing, never twice the same shard, never with a merge.
+TEST(OutputLock, SmoothingLocksItsShardAndSharesTheFolder) {
+  const std::string out = testing::ScratchDir() + "/out";
+  const OutputFolderLock smoothing =
+      OutputFolderLock::ForSmoothing(out, {0, 2}, "s.yaml");
+  EXPECT_NO_THROW(OutputFolderLock::ForSmoothing(out, {1, 2}, "t.yaml"));
+  EXPECT_NO_THROW(OutputFolderLock::ForShard(out, {0, 2}, "j.yaml"));
+  const std::string error = testing::InputErrorOf([&] {
+    OutputFolderLock::ForSmoothing(out, {0, 2}, "u.yaml");
+  });
+  EXPECT_THAT(error, HasSubstr("u.yaml"));
+  EXPECT_THAT(error,
+              HasSubstr("held by smooth shard 0/2, pid " + std::to_string(::getpid())));
+  const std::string merge_error =
+      testing::InputErrorOf([&] { OutputFolderLock::Whole(out, "merge", "m.yaml"); });
+  EXPECT_THAT(merge_error, HasSubstr("smooth shard 0/2"));
+}
+
 TEST(OutputLock, MergeKeepsLabelOutAndRecordsItself) {
   const std::string out = testing::ScratchDir() + "/out";
   {
