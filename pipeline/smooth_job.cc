@@ -191,6 +191,12 @@ class SmoothJobRun {
     if (fs::exists(path) && !options_.force) {
       std::ifstream in(path);
       const json recorded = json::parse(in, nullptr, false);
+      // A stamp that does not parse is not this job's either (nlohmann's != is false
+      // for a discarded value, so it is checked first).
+      if (recorded.is_discarded()) {
+        throw InputError(path, "", "the smoothing stamp of this job (or --force)",
+                         "a file that is not valid JSON");
+      }
       if (recorded != stamp) {
         throw InputError(path, "", "the smoothing settings of this job (or --force)",
                          "smoothed labels of other settings or per-frame labels");

@@ -6,6 +6,7 @@
 
 #include "pipeline/smooth_job.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -22,6 +23,8 @@
 
 namespace handlabel {
 namespace {
+
+using ::testing::HasSubstr;
 
 namespace fs = std::filesystem;
 
@@ -217,6 +220,24 @@ TEST_F(SmoothJobTest, PerFrameLabelsDoNotDependOnTheSequenceSection) {
               testing::ReadFileBytes(LabelFilePath(sequence_->out, frame)));
   }
   EXPECT_FALSE(fs::exists(SmoothedOutputDir(plain.out)));
+}
+
+// smoothed/ holds one smoothing: other settings, or a stamp that does not parse, are
+// refused naming smoothing.json (--force replaces them), before anything is solved.
+TEST_F(SmoothJobTest, RefusesOtherSettingsAndABrokenStampUnlessForced) {
+  RunSmoothJob(Job(1), {});  // done (or resumed) with the fixture's settings
+  const std::string stamp_path = SmoothedOutputDir(sequence_->out) + "/smoothing.json";
+  const std::string stamp = testing::ReadFileBytes(stamp_path);
+  ASSERT_FALSE(stamp.empty());
+  JobConfig other = Job(1);
+  other.sequence.acceleration_sigma_mm = 2.0;
+  EXPECT_THAT(testing::InputErrorOf([&] { RunSmoothJob(other, {}); }),
+              HasSubstr("smoothing.json"));
+  std::ofstream(stamp_path) << "{bad";
+  EXPECT_THAT(testing::InputErrorOf([&] { RunSmoothJob(Job(1), {}); }),
+              HasSubstr("not valid JSON"));
+  std::ofstream(stamp_path) << stamp;         // as the fixture left it
+  EXPECT_NO_THROW(RunSmoothJob(Job(1), {}));  // the fixture's stamp is accepted again
 }
 
 TEST_F(SmoothJobTest, RefusesEvidenceThatIsNotOnDisk) {
