@@ -51,6 +51,7 @@ int RunDetect(int argc, char** argv) {
   app.add_option("--palm-every", dc.palm_every,
                  "with --video: palm detection on every view of every K-th frame "
                  "(0 = only where the track is lost)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--min-palm-views", dc.multiview.min_palm_views,
                  "with --capture: views whose palms must agree")
@@ -81,6 +82,30 @@ int RunDetect(int argc, char** argv) {
   }
   if (!images.empty() && out_dir.empty()) {
     std::cerr << "detect: --images needs --out\n";
+    return 2;
+  }
+  // A flag of the other mode would be ignored (--video on images would still detect
+  // every image from scratch): refused, named.
+  const char* capture_only[] = {"--overwrite",
+                                "--overlays",
+                                "--second-pass",
+                                "--video",
+                                "--min-presence-from-3d",
+                                "--palm-every",
+                                "--min-palm-views"};
+  for (const char* flag : capture_only) {
+    if (!images.empty() && app.count(flag) > 0) {
+      std::cerr << "detect: " << flag << " works with --capture only\n";
+      return 2;
+    }
+  }
+  if (!capture_dir.empty() && app.count("--out") > 0) {
+    std::cerr << "detect: --out works with --images only (a capture's detections go to "
+                 "its detections/ folder)\n";
+    return 2;
+  }
+  if (app.count("--palm-every") > 0 && !dc.video) {
+    std::cerr << "detect: --palm-every needs --video\n";
     return 2;
   }
   UseOneMallocArena();

@@ -36,6 +36,22 @@ TEST(DetectCommand, UsageErrors) {
       RunHandlabelCommand({"detect", "--capture", "c", "--images", "a.png", "--out", "o"})
           .status,
       2);
+  // A flag of the other mode is refused, named, not ignored.
+  const testing::CommandResult video_on_images =
+      RunHandlabelCommand({"detect", "--images", "a.png", "--out", "o", "--video"});
+  EXPECT_EQ(video_on_images.status, 2);
+  EXPECT_NE(video_on_images.err.find("--video works with --capture only"),
+            std::string::npos)
+      << video_on_images.err;
+  EXPECT_EQ(RunHandlabelCommand({"detect", "--capture", "c", "--out", "o"}).status, 2);
+  const testing::CommandResult palm_every =
+      RunHandlabelCommand({"detect", "--capture", "c", "--palm-every", "5"});
+  EXPECT_EQ(palm_every.status, 2);
+  EXPECT_NE(palm_every.err.find("--palm-every needs --video"), std::string::npos);
+  EXPECT_EQ(
+      RunHandlabelCommand({"detect", "--capture", "c", "--video", "--palm-every", "-1"})
+          .status,
+      2);
   const testing::CommandResult bad = RunHandlabelCommand(
       {"detect", "--images", "a.png", "--out", testing::ScratchDir(), "--model", "huge"});
   EXPECT_EQ(bad.status, 1);
