@@ -66,6 +66,20 @@ int RunDetect(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--min-palm-score", o.min_palm_score, "palm detection threshold")
       ->capture_default_str();
+  std::string palm_tiles = PalmTilesText(o.palm_tiles);
+  app.add_option("--palm-tiles", palm_tiles,
+                 "palm detection also on N overlapping square tiles across the image's "
+                 "shorter side, for small hands; off = the whole image only; auto = "
+                 "4 across on images larger than 1280 px, else off")
+      ->capture_default_str()
+      ->check([](const std::string& text) -> std::string {
+        try {
+          ParsePalmTiles(text, "detect", "--palm-tiles");
+          return "";
+        } catch (const InputError& e) {
+          return e.what();
+        }
+      });
   app.add_option("--min-presence", o.min_presence, "hand presence threshold")
       ->capture_default_str();
   app.add_option("--threads", dc.threads,
@@ -109,6 +123,7 @@ int RunDetect(int argc, char** argv) {
     return 2;
   }
   UseOneMallocArena();
+  o.palm_tiles = ParsePalmTiles(palm_tiles, "detect", "--palm-tiles");  // checked
   if (!capture_dir.empty()) {
     return RunReportingErrors("detect", [&] {
       // Made at the first frame: the capture is read under DetectCapture's writer

@@ -28,9 +28,9 @@ struct SynthFlags {
 void AddRigAndSceneFlags(CLI::App& app, SynthFlags* f) {
   SynthCaptureOptions& o = f->options;
   app.add_option("--out", f->out_dir, "output folder (created)")->required();
-  app.add_option(
-         "--preset", o.rig.preset,
-         "rig: dexycb (8 cams 640x480), oakink (4, 848x480), ho3d (5, 640x480), random")
+  app.add_option("--preset", o.rig.preset,
+                 "rig: dexycb (8 cams 640x480), oakink (4, 848x480), ho3d (5, 640x480), "
+                 "studio (5, 1920x1080, distorted, small hands), random")
       ->capture_default_str();
   app.add_option("--frames", o.num_frames, "number of frames")->capture_default_str();
   app.add_option("--seed", o.seed, "random seed")->capture_default_str();

@@ -39,11 +39,13 @@ std::string CameraName(size_t i) {
   return buf;
 }
 
-// A preset: native size, per-camera (fx, fy, cx, cy) and placements.
+// A preset: native size, per-camera (fx, fy, cx, cy) and placements; with
+// `distortion` (k1, k2, p1, p2 per camera) OPENCV cameras, else PINHOLE.
 struct Preset {
   int width, height;
   std::vector<std::array<double, 4>> intrinsics;
   std::vector<Placement> placements;
+  std::vector<std::array<double, 4>> distortion;
 };
 
 Preset DexYcb() {
@@ -88,13 +90,45 @@ Preset Ho3d() {
   return p;
 }
 
-Camera ScaledCamera(const std::array<double, 4>& k, int native_w, int native_h, int w,
-                    int h) {
-  const double sx = static_cast<double>(w) / native_w;
-  const double sy = static_cast<double>(h) / native_h;
+// A full-body studio (Panoptic-style dome, mocap stage): five HD cameras around a
+// standing person, 2.6-4 m from the hand, aimed at the body rather than at the hand
+// (the hand lands off the image centre), wide lenses with barrel distortion. An
+// open hand (~19 cm) spans 65-105 px, a grasping one 30-60 px, as in the full-body
+// captures where whole-image palm detection misses hands (docs/detector.md).
+Preset Studio() {
+  Preset p{1920, 1080, {}, {}, {}};
+  const double az[5] = {0, 75, 140, 215, 290};
+  const double el[5] = {12, 25, 8, 30, 18};
+  const double dist[5] = {2.6, 3.2, 4.0, 3.6, 2.9};
+  const double fx[5] = {1395.0, 1442.5, 1468.3, 1410.8, 1428.1};
+  // Where each camera aims, relative to the hand: the body's centre seen from there.
+  const Eigen::Vector3d target[5] = {{0.15, 0.45, 0.4},
+                                     {-0.4, 0.1, 0.5},
+                                     {0.45, -0.3, 0.15},
+                                     {0.2, 0.5, 0.6},
+                                     {-0.45, -0.35, 0.3}};
+  const double k1[5] = {-0.21, -0.17, -0.24, -0.12, -0.19};
+  const double k2[5] = {0.06, 0.04, 0.08, 0.02, 0.05};
+  for (int i = 0; i < 5; ++i) {
+    p.intrinsics.push_back({fx[i], fx[i] + 0.6, 959.5 + 4.0 * (i - 2), 539.5 - 3.0 * i});
+    p.placements.push_back({az[i], el[i], dist[i], target[i]});
+    p.distortion.push_back({k1[i], k2[i], 0.0004 * (i - 2), -0.0003 * (i % 2)});
+  }
+  return p;
+}
+
+Camera ScaledCamera(const Preset& p, size_t i, int w, int h) {
+  const std::array<double, 4>& k = p.intrinsics[i];
+  const double sx = static_cast<double>(w) / p.width;
+  const double sy = static_cast<double>(h) / p.height;
   // Pixel centres at integers: x' + 0.5 = s (x + 0.5).
-  return Camera::Pinhole(k[0] * sx, k[1] * sy, (k[2] + 0.5) * sx - 0.5,
-                         (k[3] + 0.5) * sy - 0.5, w, h);
+  const double fx = k[0] * sx, fy = k[1] * sy;
+  const double cx = (k[2] + 0.5) * sx - 0.5, cy = (k[3] + 0.5) * sy - 0.5;
+  if (p.distortion.empty()) return Camera::Pinhole(fx, fy, cx, cy, w, h);
+  // Distortion acts on normalised coordinates, so scaling keeps it.
+  const std::array<double, 4>& d = p.distortion[i];
+  return Camera(CameraModelId::kOpenCV, w, h, {fx, fy, cx, cy, d[0], d[1], d[2], d[3]},
+                "rig preset");
 }
 
 Rig RandomRig(const RigPresetOptions& o, uint64_t seed) {
@@ -137,7 +171,8 @@ void RigPresetOptions::Check(const std::string& source) const {
   bool known = false;
   for (const std::string& n : RigPresetNames()) known |= n == preset;
   if (!known) {
-    throw InputError(source, "preset", "one of dexycb, oakink, ho3d, random", preset);
+    throw InputError(source, "preset", "one of dexycb, oakink, ho3d, studio, random",
+                     preset);
   }
   if (width < 0 || height < 0 || (width == 0) != (height == 0) || width > 16384 ||
       height > 16384) {
@@ -161,7 +196,7 @@ void RigPresetOptions::Check(const std::string& source) const {
 }
 
 std::vector<std::string> RigPresetNames() {
-  return {"dexycb", "oakink", "ho3d", "random"};
+  return {"dexycb", "oakink", "ho3d", "studio", "random"};
 }
 
 Rig MakePresetRig(const RigPresetOptions& options, uint64_t seed) {
@@ -169,13 +204,13 @@ Rig MakePresetRig(const RigPresetOptions& options, uint64_t seed) {
   if (options.preset == "random") return RandomRig(options, seed);
   const Preset p = options.preset == "dexycb"   ? DexYcb()
                    : options.preset == "oakink" ? OakInk()
+                   : options.preset == "studio" ? Studio()
                                                 : Ho3d();
   const int w = options.width > 0 ? options.width : p.width;
   const int h = options.height > 0 ? options.height : p.height;
   Rig rig;
   for (size_t i = 0; i < p.placements.size(); ++i) {
-    rig.Add({CameraName(i), ScaledCamera(p.intrinsics[i], p.width, p.height, w, h),
-             CamFromWorld(p.placements[i])});
+    rig.Add({CameraName(i), ScaledCamera(p, i, w, h), CamFromWorld(p.placements[i])});
   }
   return rig;
 }

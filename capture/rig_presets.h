@@ -9,6 +9,8 @@
 //   dexycb   8        640x480   ~615        0.75-1.0 m PINHOLE  (RealSense D415 colour)
 //   oakink   4        848x480   ~610        0.5-0.65 m PINHOLE  (RealSense D435 colour)
 //   ho3d     5        640x480   ~614        0.5-0.75 m PINHOLE  (RealSense D415 colour)
+//   studio   5        1920x1080 ~1400-1470  2.6-4.0 m  OPENCV   (full-body studio, small
+//                                                               hands, barrel distortion)
 //   random   n        size      from FOV    sphere     PINHOLE or OPENCV (distortion)
 // Preset rigs are fixed (independent of the seed); random rigs depend only on the seed.
 

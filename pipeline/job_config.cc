@@ -7,6 +7,7 @@
 
 #include "core/errors.h"
 #include "core/option_checks.h"
+#include "network/detector/mediapipe_hands.h"
 #include "pipeline/yaml_section.h"
 
 namespace handlabel {
@@ -175,6 +176,8 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
   evidence.Read("ignore_views", &job->ignore_views);
   evidence.Read("detections", &job->detections);
   evidence.Read("detector_model", &job->detector_model);
+  evidence.Read("detector_palm_tiles", &job->detector_palm_tiles);
+  ParsePalmTiles(job->detector_palm_tiles, path, evidence.Name("detector_palm_tiles"));
   evidence.Read("detector_every", &job->detector_every);
   std::string detector_mode = "frame";
   evidence.Read("detector_mode", &detector_mode);

@@ -161,6 +161,10 @@ struct JobConfig {
   bool keypoints_from_detector = false;
   // evidence.detector_model: full | lite (MediaPipe's two model sizes).
   std::string detector_model = "full";
+  // evidence.detector_palm_tiles: auto | off | N, palm detection also over N overlapping
+  // tiles across each view's shorter side, for small hands
+  // (MediapipeHandsOptions::palm_tiles; auto: tiles only on views wider than 1280 px).
+  std::string detector_palm_tiles = "auto";
   // evidence.detector_every: N > 1 tracks the hand (with keypoints_2d: detector, a
   // network and refine fallback; pipeline/label_job.h): the detector runs on every
   // N-th frame of the job, on a shard's first frame, after a frame without a label and

@@ -63,6 +63,9 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   if (!job.object_masks) extra["object_masks"] = "none";
   if (!job.detections.empty()) extra["detections"] = job.detections;
   if (job.keypoints_from_detector) extra["detector"] = job.detector_model;
+  if (job.keypoints_from_detector && job.detector_palm_tiles != "auto") {
+    extra["detector_palm_tiles"] = job.detector_palm_tiles;
+  }
   if (job.detector_every != 1) extra["detector_every"] = job.detector_every;
   if (job.detector_video) extra["detector_video"] = job.detector_palm_every;
   // The requested arithmetic; what "auto" chose on each machine is in every label's

@@ -100,6 +100,8 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job,
   if (job.keypoints_from_detector) {
     DetectCaptureOptions detect;
     detect.hands.model = job.detector_model;
+    detect.hands.palm_tiles = ParsePalmTiles(job.detector_palm_tiles, job.source_file,
+                                             "evidence.detector_palm_tiles");
     detect.video = job.detector_video;
     detect.palm_every = job.detector_palm_every;
     // A job that tracks detects only the frames that need it, one in video mode its

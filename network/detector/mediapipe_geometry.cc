@@ -195,6 +195,57 @@ PalmDetection RemoveLetterbox(const PalmDetection& detection,
   return d;
 }
 
+namespace {
+
+// Starts of `count` tiles of `side` spread evenly over [0, length].
+std::vector<double> TileStarts(double length, double side, int count) {
+  std::vector<double> starts;
+  for (int i = 0; i < count; ++i) {
+    starts.push_back(count == 1 ? (length - side) / 2
+                                : i * (length - side) / (count - 1));
+  }
+  return starts;
+}
+
+// Tiles of `side` needed to cover `length` with neighbours overlapping by `overlap`.
+int TilesToCover(double length, double side, double overlap) {
+  if (length <= side) return 1;
+  return 1 + static_cast<int>(std::ceil((length - side) / (side * (1 - overlap)) - 1e-9));
+}
+
+}  // namespace
+
+std::vector<PalmTile> MakePalmTiles(int image_width, int image_height, int across,
+                                    double overlap) {
+  HL_CHECK(image_width > 0 && image_height > 0 && across >= 1,
+           "palm tiles need an image and at least one tile across");
+  HL_CHECK(overlap >= 0 && overlap < 1, "tile overlap must be in [0, 1)");
+  const double shorter = std::min(image_width, image_height);
+  const double side = shorter / (across - (across - 1) * overlap);
+  const auto xs = TileStarts(image_width, side, TilesToCover(image_width, side, overlap));
+  const auto ys =
+      TileStarts(image_height, side, TilesToCover(image_height, side, overlap));
+  std::vector<PalmTile> tiles;
+  for (double y : ys) {
+    for (double x : xs) tiles.push_back({x, y, side});
+  }
+  return tiles;
+}
+
+PalmDetection TileToImage(const PalmDetection& detection, const PalmTile& tile,
+                          int image_width, int image_height) {
+  const double w = image_width, h = image_height;
+  const auto x = [&](double u) { return (tile.left + u * tile.side) / w; };
+  const auto y = [&](double v) { return (tile.top + v * tile.side) / h; };
+  PalmDetection d = detection;
+  d.xmin = x(detection.xmin);
+  d.ymin = y(detection.ymin);
+  d.width = detection.width * tile.side / w;
+  d.height = detection.height * tile.side / h;
+  for (auto& k : d.keypoints) k = Eigen::Vector2d(x(k.x()), y(k.y()));
+  return d;
+}
+
 void HandRoiOptions::Check(const std::string& source) const {
   const auto valid = [](int k) { return k >= 0 && k < kPalmKeypoints; };
   if (!valid(rotation_start_keypoint) || !valid(rotation_end_keypoint)) {

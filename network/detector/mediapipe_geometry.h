@@ -106,6 +106,27 @@ struct NormalizedRect {
 PalmDetection RemoveLetterbox(const PalmDetection& detection,
                               const LetterboxPadding& pad);
 
+// A square tile of an image for palm detection over tiles: left and top edge and side,
+// in MediaPipe's continuous pixel coordinates (0 = the image's left edge).
+struct PalmTile {
+  double left = 0, top = 0, side = 0;
+  RotatedRect ToRect() const {
+    return {left + side / 2, top + side / 2, side, side, 0.0};
+  }
+};
+
+// `across` square tiles along the image's shorter side and as many along the longer
+// side as it takes, covering the image, neighbours overlapping by at least `overlap`
+// of a tile side (spread evenly, so the first and last tiles touch the image edges).
+// A palm smaller than the overlap lies whole in some tile. across >= 1; one tile when
+// the image is square and across is 1.
+std::vector<PalmTile> MakePalmTiles(int image_width, int image_height, int across,
+                                    double overlap = 0.25);
+
+// A detection normalised to `tile` mapped to the image's normalised coordinates.
+PalmDetection TileToImage(const PalmDetection& detection, const PalmTile& tile,
+                          int image_width, int image_height);
+
 // DetectionsToRects + RectTransformation of palm_detection_detection_to_roi: the hand ROI
 // from a palm (normalised to the full image).
 struct HandRoiOptions {

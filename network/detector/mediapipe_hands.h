@@ -30,6 +30,9 @@ namespace handlabel {
 
 class TfliteModel;
 
+// MediapipeHandsOptions::palm_tiles: tiles chosen from the image size.
+inline constexpr int kPalmTilesAuto = -1;
+
 struct MediapipeHandsOptions {
   // "full" or "lite": which pair of models (palm detection + hand landmark).
   std::string model = "full";
@@ -44,6 +47,15 @@ struct MediapipeHandsOptions {
   double min_presence = 0.5;
   // At most this many palms (the best) go on to landmarks (MediaPipe's maxNumHands).
   int max_hands = 2;
+  // Palm detection also over overlapping square tiles, for hands too small for the
+  // whole image letterboxed into 192x192 (a 40 px hand of a 1920x1080 view is 4 px
+  // there). N >= 1: N tiles across the image's shorter side (and as many as it takes
+  // along the longer one, neighbours overlapping by a quarter tile), each tile's palms
+  // mapped to the image and merged with the whole image's by weighted NMS; 0: the
+  // whole image only (MediaPipe's own pipeline); kPalmTilesAuto: the whole image only
+  // up to 1280 px on the longer side (table-top rigs: as before), 4 tiles across above
+  // (PalmTilesAcross). Text form: "auto", "off" or N (ParsePalmTiles).
+  int palm_tiles = kPalmTilesAuto;
   // LibTorch threads of each model call (set for the calling thread only); 0 = the
   // calling thread's setting. 1 by default: callers run frames or views in parallel
   // instead. The models are small, so most of a call split over threads is spent
@@ -109,8 +121,8 @@ class MediapipeHands {
   const MediapipeHandsOptions& options() const { return options_; }
 
   // All three take RGB images (3 channels) and throw InputError otherwise.
-  // Palm detection on the whole image (letterboxed to 192x192): every palm after NMS,
-  // normalised to the image, best first.
+  // Palm detection on the whole image (letterboxed to 192x192) and on the tiles of
+  // options().palm_tiles: every palm after NMS, normalised to the image, best first.
   std::vector<PalmDetection> DetectPalms(const ImageU8& rgb) const;
   // Landmarks in one ROI (normalised to the image; square in pixels for an undistorted
   // crop), whatever the presence score.
@@ -123,10 +135,27 @@ class MediapipeHands {
 
  private:
   MediapipeHandsOptions options_;
+  // Palms in one square-ish region of the image (the whole image, letterboxed, or a
+  // tile), after NMS, normalised to that region.
+  std::vector<PalmDetection> PalmsInRegion(const ImageU8& rgb,
+                                           const RotatedRect& region) const;
+
   std::unique_ptr<TfliteModel> palm_model_;
   std::unique_ptr<TfliteModel> landmark_model_;
   std::vector<Eigen::Vector2d> anchors_;
 };
+
+// Tiles across the shorter side that palm detection uses on an image of this size: the
+// option's N, 0 for off, and for auto the rule of the .cc (measured in
+// docs/detector.md, "Small hands").
+int PalmTilesAcross(const MediapipeHandsOptions& options, int image_width,
+                    int image_height);
+
+// "auto" -> kPalmTilesAuto, "off" -> 0, "N" (1..16) -> N; anything else throws
+// InputError(source, field, ...). PalmTilesText is the inverse.
+int ParsePalmTiles(const std::string& text, const std::string& source,
+                   const std::string& field);
+std::string PalmTilesText(int palm_tiles);
 
 // <model_dir or data folder>/models/mediapipe/<kind>_<model>.tflite, kind =
 // palm_detection or hand_landmark.

@@ -39,6 +39,34 @@ TEST(RigPresets, PresetsMimicTheDatasets) {
   }
 }
 
+// The full-body studio: HD views with lens distortion, cameras metres away, so a hand
+// at the workspace centre is small (docs/detector.md, "Small hands"), off the image
+// centre (the cameras aim at the body) and inside every view.
+TEST(RigPresets, StudioFilmsASmallHandInDistortedHdViews) {
+  RigPresetOptions o;
+  o.preset = "studio";
+  const Rig rig = MakePresetRig(o, 0);
+  ASSERT_EQ(rig.size(), 5u);
+  for (const RigCamera& cam : rig.cameras()) {
+    EXPECT_EQ(cam.camera.width(), 1920);
+    EXPECT_EQ(cam.camera.height(), 1080);
+    EXPECT_EQ(cam.camera.model(), CameraModelId::kOpenCV);
+    const double distance = cam.CenterInWorld().norm();
+    EXPECT_GE(distance, 2.5) << cam.name;
+    EXPECT_LE(distance, 4.0) << cam.name;
+    // An 18 cm hand across the view direction at the workspace centre.
+    Eigen::Vector2d a, b;
+    const Eigen::Vector3d across =
+        0.09 * (cam.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitX());
+    ASSERT_TRUE(cam.ProjectWorld(-across, &a));
+    ASSERT_TRUE(cam.ProjectWorld(across, &b));
+    EXPECT_GT((b - a).norm(), 55) << cam.name;
+    EXPECT_LT((b - a).norm(), 110) << cam.name;
+    EXPECT_TRUE(cam.camera.InImage((a + b) / 2)) << cam.name;
+    EXPECT_GT(((a + b) / 2 - Eigen::Vector2d(960, 540)).norm(), 50) << cam.name;
+  }
+}
+
 TEST(RigPresets, SizeScalesIntrinsicsAndKeepsTheFieldOfView) {
   RigPresetOptions o;
   const Rig native = MakePresetRig(o, 0);

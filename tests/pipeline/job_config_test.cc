@@ -193,6 +193,29 @@ TEST(JobConfig, TrackingNeedsTheDetectorANetworkAndFallback) {
   ExpectError(tracked + "refine: {mode: always}\n", "refine.mode", "fallback");
 }
 
+// evidence.detector_palm_tiles: auto (the default, out of the job hash so that jobs
+// written before the field keep theirs), off or a count; anything else names the field.
+TEST(JobConfig, DetectorPalmTilesAreAutoOffOrACount) {
+  const std::string job =
+      "input: {path: c}\noutput: {dir: o}\nrefine: {mode: always}\nevidence: "
+      "{keypoints_2d: detector";
+  const JobConfig by_default = LoadJobConfig(WriteJob(job + "}\n"));
+  EXPECT_EQ(by_default.detector_palm_tiles, "auto");
+  const JobConfig automatic =
+      LoadJobConfig(WriteJob(job + ", detector_palm_tiles: auto}\n"));
+  EXPECT_EQ(JobHash(automatic, ""), JobHash(by_default, ""));
+  const JobConfig off = LoadJobConfig(WriteJob(job + ", detector_palm_tiles: off}\n"));
+  const JobConfig three = LoadJobConfig(WriteJob(job + ", detector_palm_tiles: 3}\n"));
+  EXPECT_EQ(off.detector_palm_tiles, "off");
+  EXPECT_EQ(three.detector_palm_tiles, "3");
+  EXPECT_NE(JobHash(off, ""), JobHash(by_default, ""));
+  EXPECT_NE(JobHash(three, ""), JobHash(off, ""));
+  for (const char* bad : {"0", "17", "many", "3.5"}) {
+    ExpectError(job + ", detector_palm_tiles: " + bad + "}\n",
+                "evidence.detector_palm_tiles", "auto, off or 1..16");
+  }
+}
+
 // evidence.detector_mode: video needs the detector on every frame; per-frame jobs keep
 // their hash (the field enters only when set).
 TEST(JobConfig, DetectorVideoModeNeedsTheDetectorOnEveryFrame) {

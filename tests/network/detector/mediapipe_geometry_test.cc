@@ -127,6 +127,96 @@ TEST(MediapipeGeometry, LetterboxRemovalInvertsThePadding) {
   EXPECT_NEAR(r.keypoints[0].y(), 0.4, 1e-12);
 }
 
+TEST(MediapipeGeometry, PalmTilesCoverTheImageAndOverlapByAQuarterTile) {
+  const int w = 1920, h = 1080;
+  const std::vector<PalmTile> tiles = MakePalmTiles(w, h, 3);
+  // Three across the 1080 px side: 1080 = 3 s - 2 (s / 4), s = 432; along 1920 px:
+  // ceil((1920 - 432) / 324) + 1 = 6 tiles.
+  ASSERT_EQ(tiles.size(), 18u);
+  const double side = tiles[0].side;
+  EXPECT_NEAR(side, 432, 1e-9);
+  for (const PalmTile& t : tiles) {
+    EXPECT_GE(t.left, -1e-9);
+    EXPECT_GE(t.top, -1e-9);
+    EXPECT_LE(t.left + t.side, w + 1e-9);
+    EXPECT_LE(t.top + t.side, h + 1e-9);
+  }
+  // A palm box a quarter tile wide lies whole in some tile wherever it is.
+  const double palm = side / 4;
+  for (double y = 0; y + palm <= h; y += 7.3) {
+    for (double x = 0; x + palm <= w; x += 11.1) {
+      bool inside = false;
+      for (const PalmTile& t : tiles) {
+        inside |= x >= t.left - 1e-9 && y >= t.top - 1e-9 &&
+                  x + palm <= t.left + t.side + 1e-9 && y + palm <= t.top + t.side + 1e-9;
+      }
+      ASSERT_TRUE(inside) << "a " << palm << " px palm at " << x << ", " << y;
+    }
+  }
+  // A square image one tile across is one tile: the image itself.
+  const std::vector<PalmTile> one = MakePalmTiles(500, 500, 1);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_DOUBLE_EQ(one[0].side, 500);
+  EXPECT_DOUBLE_EQ(one[0].left, 0);
+  // Portrait images count the tiles across their width.
+  EXPECT_NEAR(MakePalmTiles(1080, 1920, 3)[0].side, 432, 1e-9);
+}
+
+TEST(MediapipeGeometry, TileCoordinatesMapToWhereTheTileCropSampled) {
+  // Each tensor pixel of a tile's crop holds the linear image function at the image
+  // point that TileToImage gives for that pixel's centre (in the tile's [0, 1] frame).
+  const ImageU8 image = LinearImage(80, 60);
+  const std::vector<PalmTile> tiles = MakePalmTiles(80, 60, 2);
+  ASSERT_GT(tiles.size(), 2u);
+  const PalmTile& tile = tiles[1];
+  const int n = 16;
+  const TensorCrop crop =
+      CropToTensor(image, tile.ToRect(), n, n, true, BorderMode::kZero);
+  EXPECT_DOUBLE_EQ(crop.padding.left + crop.padding.top, 0.0);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      PalmDetection d = Box((i + 0.5) / n, (j + 0.5) / n, 0.1, 0.2, 1.0);
+      d.keypoints[3] = Eigen::Vector2d((i + 0.5) / n, (j + 0.5) / n);
+      const PalmDetection m = TileToImage(d, tile, 80, 60);
+      const Eigen::Vector2d corner = NormToPixel({m.xmin, m.ymin}, 80, 60);
+      const Eigen::Vector2d kp = NormToPixel(m.keypoints[3], 80, 60);
+      const float* v = &crop.values[(j * n + i) * 3];
+      ASSERT_NEAR(v[0] * 255.0, 3 * corner.x(), 1e-3) << i << "," << j;
+      ASSERT_NEAR(v[1] * 255.0, 4 * corner.y(), 1e-3) << i << "," << j;
+      ASSERT_NEAR((kp - corner).norm(), 0, 1e-9);
+      // Sizes scale by the tile side over the image size, per axis.
+      ASSERT_NEAR(m.width * 80, 0.1 * tile.side, 1e-9);
+      ASSERT_NEAR(m.height * 60, 0.2 * tile.side, 1e-9);
+    }
+  }
+}
+
+TEST(MediapipeGeometry, APalmSeenInTwoOverlappingTilesMergesIntoOne) {
+  const int w = 1920, h = 1080;
+  const std::vector<PalmTile> tiles = MakePalmTiles(w, h, 3);
+  const PalmTile& a = tiles[0];
+  const PalmTile& b = tiles[1];  // its right neighbour
+  ASSERT_LT(b.left, a.left + a.side);
+  // A 30 px palm in the overlap of a and b, in image pixels (continuous coordinates).
+  const double x = (b.left + a.left + a.side) / 2 - 15, y = 200, size = 30;
+  const auto in_tile = [&](const PalmTile& t, double dx, double score) {
+    PalmDetection d = Box((x + dx - t.left) / t.side, (y - t.top) / t.side, size / t.side,
+                          size / t.side, score);
+    return TileToImage(d, t, w, h);
+  };
+  // The two tiles see it 2 px apart; a palm elsewhere (tile 10) stays its own.
+  PalmDetection far = Box(0.4, 0.4, 0.1, 0.1, 0.7);
+  const std::vector<PalmDetection> merged = WeightedNonMaxSuppression(
+      {in_tile(a, -1, 0.6), in_tile(b, 1, 0.9), TileToImage(far, tiles[10], w, h)});
+  ASSERT_EQ(merged.size(), 2u);
+  EXPECT_DOUBLE_EQ(merged[0].score, 0.9);
+  // The score-weighted mean: (0.6 (x - 1) + 0.9 (x + 1)) / 1.5 = x + 0.2.
+  EXPECT_NEAR(merged[0].xmin * w, x + 0.2, 1e-9);
+  EXPECT_NEAR(merged[0].ymin * h, y, 1e-9);
+  EXPECT_NEAR(merged[0].width * w, size, 1e-9);
+  EXPECT_DOUBLE_EQ(merged[1].score, 0.7);
+}
+
 TEST(MediapipeGeometry, UprightPalmGivesAnUnrotatedSquareRoiShiftedToTheFingers) {
   // 640x480 image; palm box 64x48 px centred at (320, 240); middle MCP straight above
   // the wrist.

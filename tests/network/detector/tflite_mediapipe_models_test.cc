@@ -201,6 +201,71 @@ TEST(TfliteMediapipeModels, PalmDetectorFindsTheRenderedPalm) {
   }
 }
 
+// The rendered hand shrunk by `factor` (mean of factor x factor pixels) and pasted
+// into a grey width x height image at `left`, `top`; its keypoints follow (handlabel's
+// pixel convention: pixel centres at integers).
+RenderedHand SmallHandInLargeImage(int width, int height, int factor, int left, int top) {
+  const RenderedHand hand = RenderHandCrop();
+  RenderedHand out{ImageU8(width, height, 3, 128), {}};
+  const int size = hand.image.width / factor;
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        int sum = 0;
+        for (int j = 0; j < factor; ++j) {
+          for (int i = 0; i < factor; ++i)
+            sum += hand.image.at(factor * x + i, factor * y + j, c);
+        }
+        out.image.at(left + x, top + y, c) =
+            static_cast<uint8_t>(sum / (factor * factor));
+      }
+    }
+  }
+  for (const Eigen::Vector2d& k : hand.keypoints) {
+    out.keypoints.push_back(Eigen::Vector2d(left, top) +
+                            (k.array() + 0.5).matrix() / factor -
+                            Eigen::Vector2d(0.5, 0.5));
+  }
+  return out;
+}
+
+// Palm detection over tiles (MediapipeHandsOptions::palm_tiles): a hand about 60 px
+// long in a 1920x1080 view is 6 px in the whole image letterboxed to 192x192, where the
+// palm model sees nothing; in tiles it is found, at the drawn palm, and the landmarks
+// of its ROI lie on the drawn keypoints.
+TEST(TfliteMediapipeModels, PalmTilesFindASmallHandTheWholeImageMisses) {
+  REQUIRE_MEDIAPIPE_MODELS();
+  const RenderedHand hand = SmallHandInLargeImage(1920, 1080, 2, 1350, 610);
+  Eigen::AlignedBox2d palm;
+  for (int k : {0, 5, 9, 13, 17}) palm.extend(hand.keypoints[k]);
+  const auto near_palm = [&](const std::vector<PalmDetection>& palms) {
+    for (const PalmDetection& p : palms) {
+      const Eigen::Vector2d centre =
+          NormToPixel({p.xmin + p.width / 2, p.ymin + p.height / 2}, 1920, 1080);
+      if (palm.contains(centre)) return true;
+    }
+    return false;
+  };
+  ASSERT_EQ(PalmTilesAcross(MediapipeHandsOptions(), 1920, 1080), 4);  // auto
+  ASSERT_EQ(PalmTilesAcross(MediapipeHandsOptions(), 1280, 720), 0);
+  MediapipeHandsOptions options;
+  options.palm_tiles = 0;
+  MediapipeTrace trace;
+  EXPECT_TRUE(MediapipeHands(options).Detect(hand.image, &trace).empty());
+  EXPECT_FALSE(near_palm(trace.palms));
+  options.palm_tiles = 3;  // 18 tiles: fewer model runs than auto's 32, as conclusive
+  const std::vector<HandDetection> found =
+      MediapipeHands(options).Detect(hand.image, &trace);
+  EXPECT_TRUE(near_palm(trace.palms));
+  ASSERT_EQ(found.size(), 1u);
+  double sum = 0;
+  for (int k = 0; k < 21; ++k) {
+    sum += (found[0].hand.image_px.row(k).transpose() - hand.keypoints[k]).norm();
+  }
+  EXPECT_LT(sum / 21, 4.0) << "mean landmark error (px) on a hand "
+                           << (palm.max() - palm.min()).transpose() << " px palm";
+}
+
 // Not a test: writes inputs and our outputs for the peer check against TFLite's own
 // runtime (tests/network/detector/tflite_peer_parity.mjs;
 // docs/model-card-mediapipe-hands.md):
