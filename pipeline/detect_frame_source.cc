@@ -1,7 +1,9 @@
 #include "pipeline/detect_frame_source.h"
 
 #include "capture/frame_images.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
+#include "pipeline/label_outputs.h"
 
 namespace handlabel {
 
@@ -24,6 +26,16 @@ std::optional<FrameHandResult> DetectionStore::Find(const std::string& frame) co
   const auto it = results_.find(frame);
   if (it == results_.end()) return std::nullopt;
   return it->second;
+}
+
+void DetectionStore::TakeAndWrite(const std::string& output_dir,
+                                  const FrameInput& frame) {
+  const std::optional<FrameHandResult> result = Take(frame.id);
+  if (!result) return;
+  std::vector<std::string> cameras;
+  for (const RigCamera& camera : frame.rig.cameras()) cameras.push_back(camera.name);
+  WriteFileAtomically(JobDetectionsPath(output_dir, frame.id),
+                      FrameDetectionsJson(frame.id, cameras, *result).dump(1) + "\n");
 }
 
 std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(

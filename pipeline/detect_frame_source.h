@@ -31,6 +31,10 @@ class DetectionStore {
   // A copy of the frame's answer, left in the store (for the overlays, drawn before the
   // answer is written and taken).
   std::optional<FrameHandResult> Find(const std::string& frame) const;
+  // Takes the frame's answer and writes it as `handlabel detect` would, to
+  // <output_dir>/detections/<frame>.json (label_outputs.h); nothing when the frame was
+  // not detected.
+  void TakeAndWrite(const std::string& output_dir, const FrameInput& frame);
 
  private:
   mutable std::mutex mutex_;

@@ -130,6 +130,12 @@ void ClaimOutputFolder(const JobConfig& job, const std::string& job_hash, bool f
 
 // One run of one shard of a job: plan (frames, resume, folder), label every frame to
 // do through the stages, then summarise and, for a whole-job run, merge.
+// Reading order: Run -> Plan / FindFramesToDo; the per-frame steps Load, Predict,
+// FinishFrame (-> WriteFrame); then one scheduler per kind of job, each driving those
+// steps: LabelPipelined (the default: batches through a TBB pipeline with the
+// network's lanes), LabelInOrder (fit.init previous), LabelVideo / LabelVideoRuns
+// (evidence.detector_mode: video), LabelTracked (evidence.detector_every > 1); the
+// runs of consecutive frames the last two share (RunsOfFramesToDo); Finish.
 class LabelJobRun {
  public:
   LabelJobRun(const JobConfig& job, const LabelStageSet& stages,
@@ -432,12 +438,7 @@ class LabelJobRun {
     arena.execute([&] {
       tbb::parallel_pipeline(
           static_cast<size_t>(2 * threads_),
-          tbb::make_filter<void, BatchPtr>(tbb::filter_mode::serial_in_order,
-                                           [&](tbb::flow_control& control) {
-                                             BatchPtr batch = NextBatch(batch_size);
-                                             if (!batch) control.stop();
-                                             return batch;
-                                           }) &
+          HandOutBatches(batch_size) &
               tbb::make_filter<BatchPtr, BatchPtr>(
                   tbb::filter_mode::parallel,
                   [&](BatchPtr batch) {
@@ -452,6 +453,17 @@ class LabelJobRun {
                                       [&](size_t i) { FinishFrame(*batch, i); });
                   }));
     });
+  }
+
+  // The first filter of a job's pipeline: the frames to do in batches of `size`, in
+  // the job's frame order (serial), until none is left.
+  tbb::filter<void, std::shared_ptr<Batch>> HandOutBatches(size_t size) {
+    return tbb::make_filter<void, std::shared_ptr<Batch>>(
+        tbb::filter_mode::serial_in_order, [this, size](tbb::flow_control& control) {
+          std::shared_ptr<Batch> batch = NextBatch(size);
+          if (!batch) control.stop();
+          return batch;
+        });
   }
 
   // The same steps one frame at a time, in the job's frame order.
@@ -480,12 +492,7 @@ class LabelJobRun {
     arena.execute([&] {
       tbb::parallel_pipeline(
           static_cast<size_t>(2 * threads_),
-          tbb::make_filter<void, BatchPtr>(tbb::filter_mode::serial_in_order,
-                                           [&](tbb::flow_control& control) {
-                                             BatchPtr batch = NextBatch(1);
-                                             if (!batch) control.stop();
-                                             return batch;
-                                           }) &
+          HandOutBatches(1) &
               tbb::make_filter<BatchPtr, BatchPtr>(tbb::filter_mode::parallel,
                                                    [&](BatchPtr batch) {
                                                      Load(*batch, 0);

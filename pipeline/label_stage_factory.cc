@@ -5,12 +5,10 @@
 #include "capture/ho3d_frame_source.h"
 #include "capture/native_frame_source.h"
 #include "capture/oakink_frame_source.h"
-#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "pipeline/ceres_label_fitter.h"
 #include "pipeline/detect_frame_source.h"
 #include "pipeline/hand_model_source.h"
-#include "pipeline/label_outputs.h"
 #include "pipeline/label_overlay.h"
 #include "pipeline/network_stage.h"
 
@@ -136,12 +134,7 @@ BuiltLabelStages BuildLabelStages(const JobConfig& job,
     detections = std::make_shared<DetectionStore>();
     built.write_detections = [detections](const std::string& output_dir,
                                           const FrameInput& frame) {
-      const std::optional<FrameHandResult> result = detections->Take(frame.id);
-      if (!result) return;
-      std::vector<std::string> cameras;
-      for (const RigCamera& camera : frame.rig.cameras()) cameras.push_back(camera.name);
-      WriteFileAtomically(JobDetectionsPath(output_dir, frame.id),
-                          FrameDetectionsJson(frame.id, cameras, *result).dump(1) + "\n");
+      detections->TakeAndWrite(output_dir, frame);
     };
   }
   const DetectorFrameSource* detector = nullptr;
