@@ -53,6 +53,18 @@ torch::Tensor SampleViewsSum(const torch::Tensor& features, const torch::Tensor&
   return SampleFeatures(features, grid, B, N).sum(1).transpose(1, 2);
 }
 
+// Features sampled where the points project in every view, (B, P, N, C), and with
+// `summed` given its samples summed over the views, (B, P, C'): grid_sample under
+// autograd, SampleViewsForMerge (the same values, one pass) for inference.
+ViewSamples SamplePoints(const torch::Tensor& features, const torch::Tensor& grid,
+                         int64_t B, int64_t N, const torch::Tensor& summed = {}) {
+  if (UseInferenceKernels()) return SampleViewsForMerge(features, grid, B, N, summed);
+  ViewSamples s;
+  s.per_view = SampleViews(features, grid, B, N);
+  if (summed.defined()) s.summed_views = SampleViewsSum(summed, grid, B, N);
+  return s;
+}
+
 // Adds the time since the previous lap to a stage (nothing when times is null).
 class StageClock {
  public:
@@ -94,8 +106,11 @@ torch::Tensor MergeViews(const torch::Tensor& f, torch::nn::ModuleList& merge_ne
   const torch::Tensor master = e.index({Slice(), Slice(), 0});
   const torch::Tensor others =
       e.index({Slice(), Slice(), Slice(1, torch::indexing::None)});
-  const torch::Tensor s = torch::matmul(others, master.unsqueeze(-1));  // (B, P, N-1, 1)
-  const torch::Tensor agg = torch::matmul(others.transpose(2, 3), s).squeeze(-1);
+  // Per point: s = others . master, agg = others^T s. As products and sums rather than
+  // matmul: LibTorch ran them as one tiny matrix product per point (10 ms of 8 views x
+  // 4096 points, against 2 ms).
+  const torch::Tensor s = (others * master.unsqueeze(2)).sum(-1, true);  // (B, P, N-1, 1)
+  const torch::Tensor agg = (others * s).sum(2);                         // (B, P, C)
   return master_raw + RunMlp(*merge_net[1]->as<torch::nn::Sequential>(), agg);
 }
 
@@ -184,17 +199,20 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
   StageClock clock(stage_times);
 
   // Image features with the frustum-coordinate and sine position embeddings.
-  torch::Tensor x = input_proj(image_features.flatten(0, 1));  // (BN, E, H, W)
+  torch::Tensor x = RunPixelConv(input_proj, image_features.flatten(0, 1));  // (BN,E,H,W)
   const torch::Tensor frustum = FrustumPoints(batch.intrinsics, batch.master_from_cam, Hf,
                                               c.depth_bins, c.crop_size, zmin, zmax);
   torch::Tensor coords = NormalizePositions(frustum, c.position_range);  // (B,N,W,H,D,3)
   coords = coords.permute({0, 1, 4, 5, 3, 2}).reshape({B * N, 3 * c.depth_bins, Hf, Hf});
-  const torch::Tensor coords_embed = position_encoder->forward(InverseSigmoid(coords));
+  const torch::Tensor coords_embed =
+      RunPixelMlp(*position_encoder, InverseSigmoid(coords));
   const torch::Tensor sine = SineEncoding3d(N, Hf, Hf, E / 2).to(x.device());
   const torch::Tensor sin_embed =
-      adapt_pos3d(sine).repeat({B, 1, 1, 1});  // (BN, E, H, W)
+      RunPixelConv(adapt_pos3d, sine).repeat({B, 1, 1, 1});  // (BN, E, H, W)
   const torch::Tensor pos_embed = sin_embed + coords_embed;
   x = x + pos_embed;
+  // Sampled twice below (queries, points): laid out once as the sampling kernel reads it.
+  if (UseInferenceKernels()) x = x.contiguous(at::MemoryFormat::ChannelsLast);
   clock.Lap("frustum points + embeddings");
 
   // Ball centre: mesh mean shifted by a learnt function of the whole mesh.
@@ -209,7 +227,7 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
   const torch::Tensor mesh_grid =
       ProjectToGrid(mesh, batch.intrinsics, cam_from_master, c.crop_size);
   const torch::Tensor query_feat =
-      MergeViews(SampleViews(x, mesh_grid, B, N), merge_net_query_feature);
+      MergeViews(SamplePoints(x, mesh_grid, B, N).per_view, merge_net_query_feature);
   clock.Lap("queries: sampling + merge");
 
   // Deterministic point selection inside the ball (point_ops.h).
@@ -226,9 +244,9 @@ void PoemHeadImpl::forward(const torch::Tensor& image_features, const torch::Ten
   out->sampled_points = points;
   const torch::Tensor point_grid =
       ProjectToGrid(points, batch.intrinsics, cam_from_master, c.crop_size);
-  const torch::Tensor point_feat =
-      MergeViews(SampleViews(x, point_grid, B, N), merge_net_feature);
-  const torch::Tensor point_embed = SampleViewsSum(pos_embed, point_grid, B, N);
+  const ViewSamples point_samples = SamplePoints(x, point_grid, B, N, pos_embed);
+  const torch::Tensor point_feat = MergeViews(point_samples.per_view, merge_net_feature);
+  const torch::Tensor& point_embed = point_samples.summed_views;
   clock.Lap("points: sampling + merge");
 
   const torch::Tensor coords_out = transformer->forward(
@@ -313,7 +331,8 @@ PoemOutputs PoemModelImpl::forward(const PoemBatch& batch) {
   // Contiguous: bf16 inference leaves the decoders' outputs channels-last, and the
   // head's sampling reads them faster in the plain layout.
   const torch::Tensor feat =
-      feat_in(F::max_pool2d(feat_full, F::MaxPool2dFuncOptions(2).stride(2))).contiguous();
+      feat_in(F::max_pool2d(feat_full, F::MaxPool2dFuncOptions(2).stride(2)))
+          .contiguous();
   if (mask_head) {
     const int64_t M = c.mask_size();
     out.mask_logits = mask_head->forward(feat_full).view({B, N, M, M});
@@ -369,6 +388,11 @@ void PoemModelImpl::UseBf16ForInference() {
   ConvertToBf16ForInference(*head.merge_net_query_feature);
   ConvertToBf16ForInference(*head.query_embedding);
   ConvertToBf16ForInference(*head.transformer);
+  ConvertPixelConvToBf16(*head.input_proj);
+  ConvertPixelConvToBf16(*head.adapt_pos3d);
+  for (const auto& m : head.position_encoder->modules(/*include_self=*/false)) {
+    if (auto* conv = m->as<torch::nn::Conv2d>()) ConvertPixelConvToBf16(*conv);
+  }
 }
 
 PoemModel MakeRandomPoemModel(const PoemConfig& config, uint64_t seed) {

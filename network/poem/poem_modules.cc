@@ -44,10 +44,9 @@ torch::Tensor FoldedConv::operator()(const torch::Tensor& x) const {
   }
   // Channels-last: oneDNN's bf16 kernels then read and write the activations in place
   // of reordering them to and from its blocked layout on every call.
-  const torch::Tensor low =
-      at::empty(x.sizes(), x.options().dtype(weight.scalar_type()),
-                at::MemoryFormat::ChannelsLast)
-          .copy_(x);
+  const torch::Tensor low = at::empty(x.sizes(), x.options().dtype(weight.scalar_type()),
+                                      at::MemoryFormat::ChannelsLast)
+                                .copy_(x);
   const torch::Tensor y = at::conv2d(low, weight, bias, stride, padding);
   return CastForInference(y, x.scalar_type());
 }
@@ -87,14 +86,16 @@ void ConvertToBf16ForInference(torch::nn::Module& module) {
   };
   for (const auto& m : module.modules()) {
     if (auto* block = m->as<BasicBlock>()) {
-      HL_CHECK(block->folded1.defined(), "ConvertToBf16ForInference: fold the norms first");
+      HL_CHECK(block->folded1.defined(),
+               "ConvertToBf16ForInference: fold the norms first");
       convert(block->folded1), convert(block->folded2), convert(block->folded_downsample);
     }
     if (auto* resnet = m->as<ResNet>()) convert(resnet->folded_stem);
     if (auto* conv_block = m->as<ConvBlock>()) convert(conv_block->folded);
     if (auto* linear = m->as<torch::nn::Linear>()) {
       linear->weight.set_data(linear->weight.to(torch::kBFloat16));
-      if (linear->bias.defined()) linear->bias.set_data(linear->bias.to(torch::kBFloat16));
+      if (linear->bias.defined())
+        linear->bias.set_data(linear->bias.to(torch::kBFloat16));
     }
   }
 }
@@ -262,19 +263,27 @@ bool UseInferenceKernels() { return !torch::GradMode::is_enabled(); }
 
 namespace {
 
-// layer(x) in the layer's own precision (bf16 after ConvertToBf16ForInference).
-torch::Tensor LinearInLayerPrecision(const torch::nn::LinearImpl& layer,
-                                     const torch::Tensor& x) {
-  const int64_t out = layer.weight.size(0), in = layer.weight.size(1);
+void CheckPixelConv(const torch::nn::Conv2dImpl& conv) {
+  const auto& o = conv.options;
+  HL_CHECK(conv.weight.size(2) == 1 && conv.weight.size(3) == 1 &&
+               (*o.stride())[0] == 1 && (*o.stride())[1] == 1 && o.groups() == 1,
+           "pixel MLP: only 1x1 convolutions with stride 1 and one group");
+}
+
+// x W^T + b in the weights' precision (bf16 after ConvertToBf16ForInference); weight
+// (out, in), or (out, in, 1, 1) for a 1x1 convolution.
+torch::Tensor LinearInLayerPrecision(const torch::Tensor& weight,
+                                     const torch::Tensor& bias, const torch::Tensor& x) {
+  const int64_t out = weight.size(0), in = weight.size(1);
   HL_CHECK(x.size(-1) == in, "InferenceLinear: input width differs from the layer's");
   std::vector<int64_t> shape = x.sizes().vec();
   shape.back() = out;
   // One pass: a cast writes contiguous rows whatever x's strides.
   const torch::Tensor flat = x.reshape({-1, in});
   const torch::Tensor rows =
-      layer.weight.scalar_type() == x.scalar_type()
+      weight.scalar_type() == x.scalar_type()
           ? flat.contiguous()
-          : at::empty(flat.sizes(), flat.options().dtype(layer.weight.scalar_type()))
+          : at::empty(flat.sizes(), flat.options().dtype(weight.scalar_type()))
                 .copy_(flat);
   const int64_t m = rows.size(0);
   if (m == 0) return torch::empty(shape, rows.options());
@@ -282,9 +291,9 @@ torch::Tensor LinearInLayerPrecision(const torch::nn::LinearImpl& layer,
   // oneDNN writes the (1, out, m, 1) result channels-last, i.e. row-major (m, out).
   const torch::Tensor image = rows.as_strided({1, in, m, 1}, {m * in, 1, in, in});
   const torch::Tensor y = at::mkldnn_convolution(
-      image, layer.weight.view({out, in, 1, 1}),
-      layer.bias.defined() ? c10::optional<torch::Tensor>(layer.bias) : c10::nullopt,
-      {0, 0}, {1, 1}, {1, 1}, 1);
+      image, weight.view({out, in, 1, 1}),
+      bias.defined() ? c10::optional<torch::Tensor>(bias) : c10::nullopt, {0, 0}, {1, 1},
+      {1, 1}, 1);
   return y.permute({0, 2, 3, 1}).reshape(shape);
 }
 
@@ -292,28 +301,75 @@ torch::Tensor LinearInLayerPrecision(const torch::nn::LinearImpl& layer,
 
 torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer,
                               const torch::Tensor& x) {
-  return CastForInference(LinearInLayerPrecision(layer, x), x.scalar_type());
+  return CastForInference(LinearInLayerPrecision(layer.weight, layer.bias, x),
+                          x.scalar_type());
 }
 
-torch::Tensor InferenceMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {
+namespace {
+
+// Rows per chunk of the inference kernels (MLPs, attention): their temporaries (a few
+// chunk x d floats each) stay in the cache instead of whole tensors in fresh pages.
+constexpr int64_t kCacheChunkRows = 2048;
+
+torch::Tensor InferenceMlpRows(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {
   // Between the layers the activations stay in the layers' precision: with bf16
   // products on attention-sized chunks, casting every hidden activation to fp32 and
   // back cost about as much as the products.
   torch::Tensor y = x;
   for (const auto& child : mlp.children()) {
     if (const auto* linear = child->as<torch::nn::Linear>()) {
-      y = LinearInLayerPrecision(*linear, y);
+      y = LinearInLayerPrecision(linear->weight, linear->bias, y);
+    } else if (const auto* conv = child->as<torch::nn::Conv2d>()) {
+      CheckPixelConv(*conv);
+      y = LinearInLayerPrecision(conv->weight, conv->bias, y);
     } else {
       HL_CHECK(child->as<torch::nn::ReLU>() != nullptr,
-               "InferenceMlp: only Linear and ReLU modules");
+               "InferenceMlp: only Linear, 1x1 Conv2d and ReLU modules");
       y = torch::relu_(y);
     }
   }
   return CastForInference(y, x.scalar_type());
 }
 
+}  // namespace
+
+torch::Tensor InferenceMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {
+  const int64_t in = x.size(-1), rows = x.numel() / std::max<int64_t>(in, 1);
+  // On the 32768 rows of the released model's view merge the bf16 MLP took 55-60 ms in
+  // one piece and 20-25 ms in chunks.
+  if (rows <= kCacheChunkRows) return InferenceMlpRows(mlp, x);
+  const torch::Tensor flat = x.reshape({rows, in});
+  std::vector<torch::Tensor> parts;
+  for (int64_t r = 0; r < rows; r += kCacheChunkRows) {
+    parts.push_back(
+        InferenceMlpRows(mlp, flat.narrow(0, r, std::min(kCacheChunkRows, rows - r))));
+  }
+  std::vector<int64_t> shape = x.sizes().vec();
+  shape.back() = parts[0].size(-1);
+  return torch::cat(parts).view(shape);
+}
+
 torch::Tensor RunMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x) {
   return UseInferenceKernels() ? InferenceMlp(mlp, x) : mlp.forward(x);
+}
+
+torch::Tensor RunPixelMlp(torch::nn::SequentialImpl& stack, const torch::Tensor& x) {
+  if (!UseInferenceKernels()) return stack.forward(x);
+  // (N, C, H, W) as (N, H, W, C) rows: a view when x is channels-last.
+  return InferenceMlp(stack, x.permute({0, 2, 3, 1})).permute({0, 3, 1, 2});
+}
+
+torch::Tensor RunPixelConv(torch::nn::Conv2d& conv, const torch::Tensor& x) {
+  if (!UseInferenceKernels()) return conv(x);
+  torch::nn::Sequential one(conv);
+  return RunPixelMlp(*one, x);
+}
+
+void ConvertPixelConvToBf16(torch::nn::Conv2dImpl& conv) {
+  torch::NoGradGuard no_grad;
+  CheckPixelConv(conv);
+  conv.weight.set_data(conv.weight.to(torch::kBFloat16));
+  if (conv.bias.defined()) conv.bias.set_data(conv.bias.to(torch::kBFloat16));
 }
 
 VectorAttentionImpl::VectorAttentionImpl(int64_t d_points, int64_t d_model_in, bool cross)
@@ -341,16 +397,11 @@ torch::Tensor VectorAttentionImpl::Attend(const torch::Tensor& q, const torch::T
 
 namespace {
 
-// Gathered rows per chunk of the attention kernel: its temporaries (a few chunk x d
-// floats each) stay in the cache instead of B x Q x k x d tensors in fresh pages.
-constexpr int64_t kAttentionChunkRows = 2048;
-
-// Splits n queries of k rows each into chunks of about kAttentionChunkRows rows, the
+// Splits n queries of k rows each into chunks of about kCacheChunkRows rows, the
 // chunk count a multiple of the thread count so that the threads get equal shares.
 int64_t QueriesPerChunk(int64_t n, int64_t k) {
   const int64_t threads = std::max(1, at::get_num_threads());
-  int64_t chunks =
-      std::max<int64_t>(1, (n * k + kAttentionChunkRows - 1) / kAttentionChunkRows);
+  int64_t chunks = std::max<int64_t>(1, (n * k + kCacheChunkRows - 1) / kCacheChunkRows);
   chunks = (chunks + threads - 1) / threads * threads;
   return std::max<int64_t>(1, (n + chunks - 1) / chunks);
 }

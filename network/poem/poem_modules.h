@@ -109,6 +109,14 @@ torch::Tensor InferenceLinear(const torch::nn::LinearImpl& layer, const torch::T
 torch::Tensor InferenceMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x);
 // mlp(x) through InferenceMlp when UseInferenceKernels(), else the modules' forward.
 torch::Tensor RunMlp(torch::nn::SequentialImpl& mlp, const torch::Tensor& x);
+// A stack of 1x1 convolutions (Conv2d, stride 1) and ReLUs on (N, C, H, W) maps, or one
+// such convolution: for inference an MLP over the pixels in channels-last layout (the
+// result is channels-last), so oneDNN does not reorder the maps to its blocked layout
+// and back around every layer; else the modules' forward.
+torch::Tensor RunPixelMlp(torch::nn::SequentialImpl& stack, const torch::Tensor& x);
+torch::Tensor RunPixelConv(torch::nn::Conv2d& conv, const torch::Tensor& x);
+// A 1x1 convolution's weights in bf16 for RunPixelMlp / RunPixelConv (inference only).
+void ConvertPixelConvToBf16(torch::nn::Conv2dImpl& conv);
 
 // Point Transformer vector attention without heads (keys fc1, fc2, fc_delta, fc_gamma,
 // w_qs, w_ks, w_vs). Self-attention: neighbours among the same points. Cross

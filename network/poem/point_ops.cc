@@ -3,6 +3,7 @@
 #include <ATen/Parallel.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "core/errors.h"
@@ -48,7 +49,91 @@ void KeepNearest(const std::vector<float>& dist, int k, std::vector<float>* best
   }
 }
 
+// The four taps of one bilinear sample; taps outside the map get weight 0 and offset 0.
+struct BilinearTaps {
+  int64_t offset[4] = {0, 0, 0, 0};  // in pixels from the map's start
+  float weight[4] = {0, 0, 0, 0};
+};
+
+// grid_sample's unnormalisation for align_corners = false: -1 and 1 are the outer
+// edges of the border pixels.
+BilinearTaps TapsAt(float gx, float gy, int64_t H, int64_t W) {
+  BilinearTaps t;
+  if (!std::isfinite(gx) || !std::isfinite(gy)) return t;
+  const float ix = ((gx + 1.f) * W - 1.f) / 2.f, iy = ((gy + 1.f) * H - 1.f) / 2.f;
+  const float fx = std::floor(ix), fy = std::floor(iy);
+  // Beyond a pixel outside the map every tap is outside: also keeps the casts in range.
+  if (fx < -1.f || fy < -1.f || fx > W || fy > H) return t;
+  const int64_t x0 = static_cast<int64_t>(fx), y0 = static_cast<int64_t>(fy);
+  const float wx1 = ix - fx, wy1 = iy - fy, wx0 = 1.f - wx1, wy0 = 1.f - wy1;
+  const int64_t xs[4] = {x0, x0 + 1, x0, x0 + 1}, ys[4] = {y0, y0, y0 + 1, y0 + 1};
+  const float ws[4] = {wx0 * wy0, wx1 * wy0, wx0 * wy1, wx1 * wy1};
+  for (int i = 0; i < 4; ++i) {
+    if (xs[i] < 0 || xs[i] >= W || ys[i] < 0 || ys[i] >= H) continue;
+    t.offset[i] = ys[i] * W + xs[i];
+    t.weight[i] = ws[i];
+  }
+  return t;
+}
+
+// out[c] (+)= sum of the taps' weights x the map's rows (channels-last: C per pixel).
+void Blend(const BilinearTaps& t, const float* map, int64_t C, bool accumulate,
+           float* out) {
+  const float *r0 = map + t.offset[0] * C, *r1 = map + t.offset[1] * C,
+              *r2 = map + t.offset[2] * C, *r3 = map + t.offset[3] * C;
+  const float w0 = t.weight[0], w1 = t.weight[1], w2 = t.weight[2], w3 = t.weight[3];
+  for (int64_t c = 0; c < C; ++c) {
+    const float v = w0 * r0[c] + w1 * r1[c] + w2 * r2[c] + w3 * r3[c];
+    out[c] = accumulate ? out[c] + v : v;
+  }
+}
+
+void CheckMaps(const torch::Tensor& maps, int64_t BN, const char* name) {
+  HL_CHECK(maps.dim() == 4 && maps.size(0) == BN,
+           std::string(name) + " must be (B*N, C, H, W)");
+  HL_CHECK(maps.scalar_type() == torch::kFloat32, std::string(name) + " must be float32");
+}
+
 }  // namespace
+
+ViewSamples SampleViewsForMerge(const torch::Tensor& features, const torch::Tensor& grid,
+                                int64_t B, int64_t N, const torch::Tensor& summed) {
+  CheckMaps(features, B * N, "features");
+  if (summed.defined()) CheckMaps(summed, B * N, "summed");
+  HL_CHECK(grid.dim() == 4 && grid.size(0) == B * N && grid.size(2) == 1 &&
+               grid.size(3) == 2 && grid.scalar_type() == torch::kFloat32,
+           "grid must be (B*N, P, 1, 2) float32");
+  const int64_t P = grid.size(1), H = features.size(2), W = features.size(3);
+  const int64_t C = features.size(1), Cs = summed.defined() ? summed.size(1) : 0;
+  HL_CHECK(!summed.defined() || (summed.size(2) == H && summed.size(3) == W),
+           "summed must have the features' height and width");
+  const torch::Tensor maps = features.detach().contiguous(at::MemoryFormat::ChannelsLast);
+  const torch::Tensor maps2 =
+      summed.defined() ? summed.detach().contiguous(at::MemoryFormat::ChannelsLast)
+                       : summed;
+  const torch::Tensor g = grid.detach().contiguous();
+  ViewSamples out;
+  out.per_view = torch::empty({B, P, N, C}, torch::kFloat32);
+  if (summed.defined()) out.summed_views = torch::empty({B, P, Cs}, torch::kFloat32);
+  const float* gd = g.data_ptr<float>();
+  const float* fd = maps.data_ptr<float>();
+  const float* sd = summed.defined() ? maps2.data_ptr<float>() : nullptr;
+  float* od = out.per_view.data_ptr<float>();
+  float* osd = summed.defined() ? out.summed_views.data_ptr<float>() : nullptr;
+  at::parallel_for(0, B * P, 16, [&](int64_t begin, int64_t end) {
+    for (int64_t bp = begin; bp < end; ++bp) {
+      const int64_t b = bp / P, p = bp % P;
+      for (int64_t n = 0; n < N; ++n) {
+        const int64_t bn = b * N + n;
+        const float* xy = gd + (bn * P + p) * 2;
+        const BilinearTaps t = TapsAt(xy[0], xy[1], H, W);
+        Blend(t, fd + bn * H * W * C, C, false, od + (bp * N + n) * C);
+        if (sd) Blend(t, sd + bn * H * W * Cs, Cs, n > 0, osd + bp * Cs);
+      }
+    }
+  });
+  return out;
+}
 
 torch::Tensor KnnIndices(const torch::Tensor& query_in, const torch::Tensor& points_in,
                          int k) {

@@ -33,6 +33,22 @@ torch::Tensor SelectBallPoints(const torch::Tensor& points, const torch::Tensor&
                                double radius, int count,
                                std::vector<int64_t>* num_inside = nullptr);
 
+// Bilinear samples of per-view feature maps, the same values as grid_sample (bilinear,
+// zeros outside, align_corners false), written in the layout the view merge reads.
+// features (B*N, C, H, W) float32, grid (B*N, P, 1, 2) in [-1, 1] (x, y) ->
+// `per_view` (B, P, N, C). With `summed` (B*N, C', H, W) given, `summed_views`
+// (B, P, C') is its samples at the same places summed over the views. Inference only
+// (no gradient): it replaces grid_sample + permute + a copy, reading each sample's C
+// channels as one contiguous row (the maps are read channels-last). A non-finite grid
+// coordinate samples nothing (zeros).
+struct ViewSamples {
+  torch::Tensor per_view;
+  torch::Tensor summed_views;
+};
+ViewSamples SampleViewsForMerge(const torch::Tensor& features, const torch::Tensor& grid,
+                                int64_t B, int64_t N,
+                                const torch::Tensor& summed = torch::Tensor());
+
 // log(x / (1 - x)) after clamping x to [0, 1] and both x and 1 - x to >= eps.
 torch::Tensor InverseSigmoid(const torch::Tensor& x, double eps = 1e-5);
 

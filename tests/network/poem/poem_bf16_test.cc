@@ -28,9 +28,10 @@ void ExpectWithinOneBf16Rounding(const torch::Tensor& got, const torch::Tensor& 
   EXPECT_LE(excess.item<double>(), 0.0) << "largest difference " << MaxAbsDiff(got, want);
 }
 
-#define SKIP_WITHOUT_BF16()                                                   \
-  if (!CpuCanRunBf16()) GTEST_SKIP() << "this CPU has no AVX-512 BW/VL/DQ: " \
-                                        "LibTorch's oneDNN cannot run bf16"
+#define SKIP_WITHOUT_BF16()                            \
+  if (!CpuCanRunBf16())                                \
+  GTEST_SKIP() << "this CPU has no AVX-512 BW/VL/DQ: " \
+                  "LibTorch's oneDNN cannot run bf16"
 
 TEST(Bf16Inference, LinearIsTheProductOfRoundedInputsRoundedOnce) {
   SKIP_WITHOUT_BF16();
@@ -69,7 +70,33 @@ TEST(Bf16Inference, MlpIsTheChainOfRoundedProducts) {
   EXPECT_EQ(got.scalar_type(), torch::kFloat);
   // The hidden values may round the other way where the two accumulation orders
   // straddle a bf16 boundary: a few output ulps, not more.
-  EXPECT_LT(MaxAbsDiff(got, want), 4 * std::ldexp(1.0, -8) * want.abs().max().item<double>());
+  EXPECT_LT(MaxAbsDiff(got, want),
+            4 * std::ldexp(1.0, -8) * want.abs().max().item<double>());
+}
+
+TEST(Bf16Inference, PixelMlpIsTheChainOfRoundedProducts) {
+  SKIP_WITHOUT_BF16();
+  torch::manual_seed(14);
+  torch::NoGradGuard no_grad;
+  torch::nn::Conv2d first(torch::nn::Conv2dOptions(6, 20, 1)),
+      second(torch::nn::Conv2dOptions(20, 12, 1));
+  torch::nn::Sequential stack(first, torch::nn::ReLU(), second);
+  const torch::Tensor x = torch::randn({3, 6, 9, 11});
+  namespace F = torch::nn::functional;
+  const torch::Tensor hidden = RoundedToBf16(
+      torch::relu(F::conv2d(RoundedToBf16(x), RoundedToBf16(first->weight),
+                            F::Conv2dFuncOptions().bias(RoundedToBf16(first->bias)))));
+  const torch::Tensor want =
+      F::conv2d(hidden, RoundedToBf16(second->weight),
+                F::Conv2dFuncOptions().bias(RoundedToBf16(second->bias)));
+  const torch::Tensor fp32 = RunPixelMlp(*stack, x);
+  ConvertPixelConvToBf16(*first);
+  ConvertPixelConvToBf16(*second);
+  const torch::Tensor got = RunPixelMlp(*stack, x);
+  EXPECT_EQ(got.scalar_type(), torch::kFloat);
+  EXPECT_GT(MaxAbsDiff(got, fp32), 0) << "the products did not run in bf16";
+  EXPECT_LT(MaxAbsDiff(got, want),
+            4 * std::ldexp(1.0, -8) * want.abs().max().item<double>());
 }
 
 TEST(Bf16Inference, FoldedConvolutionIsTheConvolutionOfRoundedInputs) {
@@ -89,7 +116,8 @@ TEST(Bf16Inference, FoldedConvolutionIsTheConvolutionOfRoundedInputs) {
   ExpectWithinOneBf16Rounding(got, want);
 }
 
-const std::string kShipped = std::string(HANDLABEL_SOURCE_DIR) + "/models/poem_small_dexycb.pt";
+const std::string kShipped =
+    std::string(HANDLABEL_SOURCE_DIR) + "/models/poem_small_dexycb.pt";
 
 std::vector<HandMeshPrediction> ShippedPredictions(const std::string& precision,
                                                    const std::vector<HandMeshInput>& in) {
@@ -116,7 +144,8 @@ TEST(Bf16Inference, ShippedModelAnswersStayNearFp32) {
   for (size_t f = 0; f < fp32.size(); ++f) {
     const Eigen::VectorXd d = (bf16[f].vertices - fp32[f].vertices).rowwise().norm();
     EXPECT_LT(d.mean(), 2e-3) << "frame " << f;
-    EXPECT_GT(d.maxCoeff(), 0.0) << "frame " << f << ": bf16 gave fp32's answer bit for bit";
+    EXPECT_GT(d.maxCoeff(), 0.0)
+        << "frame " << f << ": bf16 gave fp32's answer bit for bit";
   }
 }
 

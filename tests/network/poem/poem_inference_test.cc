@@ -37,6 +37,34 @@ TEST(InferenceMlp, MatchesSequentialForward) {
   EXPECT_LT(MaxAbsDiff(InferenceMlp(*mlp, x), mlp->forward(x)), 1e-5);
 }
 
+TEST(InferenceMlp, MatchesSequentialForwardAcrossChunks) {
+  // 3 x 1700 rows: more than one chunk of rows, the last one partial.
+  torch::manual_seed(7);
+  torch::NoGradGuard no_grad;
+  torch::nn::Sequential mlp = Mlp(8, 32, 16);
+  const torch::Tensor x = torch::randn({3, 1700, 8});
+  const torch::Tensor got = InferenceMlp(*mlp, x);
+  ASSERT_EQ(got.sizes(), (std::vector<int64_t>{3, 1700, 16}));
+  EXPECT_LT(MaxAbsDiff(got, mlp->forward(x)), 1e-5);
+}
+
+TEST(PixelMlp, MatchesTheConvolutionsInEitherLayout) {
+  torch::manual_seed(8);
+  torch::nn::Sequential stack(torch::nn::Conv2d(torch::nn::Conv2dOptions(6, 20, 1)),
+                              torch::nn::ReLU(),
+                              torch::nn::Conv2d(torch::nn::Conv2dOptions(20, 12, 1)));
+  const torch::Tensor x = torch::randn({3, 6, 9, 11});
+  const torch::Tensor want = stack->forward(x);  // gradients recorded: the modules' path
+  torch::NoGradGuard no_grad;
+  for (const torch::Tensor& in : {x, x.contiguous(at::MemoryFormat::ChannelsLast)}) {
+    const torch::Tensor got = RunPixelMlp(*stack, in);
+    ASSERT_EQ(got.sizes(), want.sizes());
+    EXPECT_LT(MaxAbsDiff(got, want), 1e-5);
+  }
+  torch::nn::Conv2d one(torch::nn::Conv2dOptions(6, 5, 1));
+  EXPECT_LT(MaxAbsDiff(RunPixelConv(one, x), one->forward(x)), 1e-5);
+}
+
 // The chunked kernel against Attend() on B = 2 with more rows than one chunk, so
 // chunks cross the batch boundary; 1 and 2 threads.
 class AttentionKernel : public ::testing::TestWithParam<int> {};

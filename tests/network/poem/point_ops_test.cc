@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "tests/test_util.h"
@@ -40,6 +42,21 @@ TEST(Knn, MatchesBruteForceIncludingTies) {
       const auto expected = BruteKnn(query[b][q], points[b], 16);
       for (int j = 0; j < 16; ++j) ASSERT_EQ(knn[b][q][j].item<int64_t>(), expected[j]);
     }
+  }
+}
+
+TEST(Knn, MatchesBruteForceOnManyPointsWithDuplicates) {
+  // Thousands of points (the block bound's regime) with every fourth point repeated
+  // further on, so equal distances straddle the bound.
+  torch::manual_seed(testing::TestSeed());
+  torch::Tensor points = torch::rand({1, 3000, 3});
+  points.index_put_({0, torch::indexing::Slice(2000, 2750)},
+                    points.index({0, torch::indexing::Slice(0, 3000, 4)}));
+  const torch::Tensor query = torch::rand({1, 60, 3});
+  const torch::Tensor knn = KnnIndices(query, points, 24);
+  for (int q = 0; q < 60; ++q) {
+    const auto expected = BruteKnn(query[0][q], points[0], 24);
+    for (int j = 0; j < 24; ++j) ASSERT_EQ(knn[0][q][j].item<int64_t>(), expected[j]);
   }
 }
 
@@ -84,6 +101,56 @@ TEST(SelectBallPoints, FillsWithNearestOutsideNeverTheOrigin) {
   EXPECT_EQ(inside[0], 5);
   std::vector<int64_t> got(sel.data_ptr<int64_t>(), sel.data_ptr<int64_t>() + 10);
   EXPECT_EQ(got, (std::vector<int64_t>{48, 49, 50, 51, 52, 53, 47, 54, 46, 55}));
+}
+
+// grid_sample (bilinear, zeros, align_corners false) on a (B*N, P, 1, 2) grid ->
+// (B, N, C, P): the reference SampleViewsForMerge must reproduce.
+torch::Tensor GridSampled(const torch::Tensor& maps, const torch::Tensor& grid, int64_t B,
+                          int64_t N) {
+  namespace F = torch::nn::functional;
+  const torch::Tensor s = F::grid_sample(maps, grid,
+                                         F::GridSampleFuncOptions()
+                                             .mode(torch::kBilinear)
+                                             .padding_mode(torch::kZeros)
+                                             .align_corners(false));
+  return s.reshape({B, N, maps.size(1), grid.size(1)});
+}
+
+TEST(SampleViewsForMerge, MatchesGridSampleInsideOnTheBorderAndOutside) {
+  torch::manual_seed(testing::TestSeed());
+  const int64_t B = 2, N = 3, P = 200, C = 19, Cs = 6, H = 7, W = 9;
+  const torch::Tensor maps = torch::randn({B * N, C, H, W});
+  // The second map channels-last in memory: the kernel must read either layout.
+  const torch::Tensor summed =
+      torch::randn({B * N, Cs, H, W}).contiguous(at::MemoryFormat::ChannelsLast);
+  // Inside, outside by up to half the map, and exactly on pixel centres and edges.
+  torch::Tensor grid = torch::rand({B * N, P, 1, 2}) * 3 - 1.5;
+  grid.index_put_({torch::indexing::Slice(), torch::indexing::Slice(0, 4)},
+                  torch::tensor({-1.f, 1.f, 1.f / W, -1.f + 1.f / H}).view({1, 4, 1, 1}));
+  const ViewSamples got = SampleViewsForMerge(maps, grid, B, N, summed);
+  const torch::Tensor want = GridSampled(maps, grid, B, N).permute({0, 3, 1, 2});
+  const torch::Tensor want_sum = GridSampled(summed, grid, B, N).sum(1).transpose(1, 2);
+  ASSERT_EQ(got.per_view.sizes(), (std::vector<int64_t>{B, P, N, C}));
+  ASSERT_EQ(got.summed_views.sizes(), (std::vector<int64_t>{B, P, Cs}));
+  EXPECT_LT((got.per_view - want).abs().max().item<float>(), 1e-5);
+  EXPECT_LT((got.summed_views - want_sum).abs().max().item<float>(), 1e-5);
+  // The test means something: some samples fall outside, some inside.
+  const torch::Tensor zero = (want.abs().amax(-1) == 0);
+  EXPECT_GT(zero.sum().item<int64_t>(), 0);
+  EXPECT_LT(zero.sum().item<int64_t>(), B * P * N);
+}
+
+TEST(SampleViewsForMerge, NonFiniteCoordinatesSampleNothing) {
+  const torch::Tensor maps = torch::ones({2, 4, 5, 5});
+  const float inf = std::numeric_limits<float>::infinity();
+  const torch::Tensor grid =
+      torch::tensor({NAN, 0.f, 0.f, inf, -inf, 0.f, 1e30f, 1e30f, 0.f, 0.f})
+          .view({1, 5, 2})
+          .repeat({2, 1, 1})
+          .view({2, 5, 1, 2});
+  const torch::Tensor got = SampleViewsForMerge(maps, grid, 1, 2).per_view;  // (1,5,2,4)
+  EXPECT_EQ(got.index({0, torch::indexing::Slice(0, 4)}).abs().max().item<float>(), 0);
+  EXPECT_FLOAT_EQ(got[0][4][1][3].item<float>(), 1.f);
 }
 
 TEST(InverseSigmoid, InvertsSigmoidAndClamps) {
