@@ -3,6 +3,7 @@
 // that the detector has been run on (docs/fitting.md "Where the detector's keypoints
 // are").
 
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -76,7 +77,9 @@ int RunModelDetectorKeypoints(int argc, char** argv) {
       const std::vector<DetectorKeypointSample> s =
           DetectorKeypointSamples(source, source.FrameIds(), sample_options);
       samples.insert(samples.end(), s.begin(), s.end());
-      learned << " " << source.Describe();
+      // The folder's name, not its path: the file is shipped (models/NOTICE.*).
+      learned << " " << std::filesystem::path(dir).filename().string() << " (" << s.size()
+              << " frames)";
     }
     const HandModel hand = ResolveHandModel("", side).model;
     const DetectorKeypointModel model =
