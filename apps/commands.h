@@ -25,6 +25,8 @@ int RunModel(int argc, char** argv);
 int RunModelBuild(int argc, char** argv);
 int RunModelRender(int argc, char** argv);
 int RunModelExport(int argc, char** argv);
+// `model detector-keypoints` (apps/model_detector_keypoints_command.cc).
+int RunModelDetectorKeypoints(int argc, char** argv);
 int RunLabel(int argc, char** argv);
 int RunMerge(int argc, char** argv);
 int RunSmooth(int argc, char** argv);

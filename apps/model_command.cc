@@ -150,6 +150,9 @@ const std::vector<ModelSubcommand>& ModelSubcommands() {
        RunModelRender},
       {"export", "write the mesh in a named pose and shape as PLY or OBJ",
        RunModelExport},
+      {"detector-keypoints",
+       "learn where a 2D detector's keypoints lie on the hand (synthetic captures)",
+       RunModelDetectorKeypoints},
   };
   return table;
 }

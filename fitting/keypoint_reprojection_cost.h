@@ -18,7 +18,11 @@
 //   MultiViewKeypointSquareRootCost     the analytic one in square-root form (what the
 //                                       fitter uses): same cost, gradient and
 //                                       Gauss-Newton matrix in num_params + 1 rows;
-//                                       the priors may be folded into it.
+//                                       the priors may be folded into it; with a
+//                                       DetectorKeypointModel it compares the
+//                                       detector's keypoints of the hand
+//                                       (hand/detector_keypoints.h) instead of the
+//                                       model's own.
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/cost_function.h>
@@ -32,6 +36,7 @@
 #include "fitting/point_term_normal_equations.h"
 #include "fitting/robust_loss.h"
 #include "geometry/camera_models.h"
+#include "hand/detector_keypoints.h"
 #include "hand/hand_evaluator.h"
 
 namespace handlabel {
@@ -237,12 +242,16 @@ class MultiViewKeypointCostFunction : public ceres::CostFunction {
 // faster than its 42 rows per view. What the fitter uses.
 class MultiViewKeypointSquareRootCost : public ceres::CostFunction {
  public:
+  // `detector` (may be nullptr: the model's keypoints) must outlive the cost.
   MultiViewKeypointSquareRootCost(const HandEvaluator& evaluator,
                                   const std::vector<KeypointView>& views,
-                                  const RobustLoss& loss, double sigma_px)
+                                  const RobustLoss& loss, double sigma_px,
+                                  const DetectorKeypointModel* detector = nullptr)
       : evaluator_(evaluator),
         views_(MakeKeypointViewData(views, sigma_px)),
         loss_(loss),
+        detector_(detector),
+        detector_vertices_(detector ? detector->AllVertexIds() : std::vector<int>()),
         block_sizes_({3, evaluator.pose_dim(), evaluator.num_betas(), 3}),
         folded_(block_sizes_) {
     set_num_residuals(evaluator.num_params() + 1);
@@ -260,8 +269,13 @@ class MultiViewKeypointSquareRootCost : public ceres::CostFunction {
     double keypoints[3 * kNumHandKeypoints];
     thread_local std::vector<double> kp_jac;
     if (jacobians == nullptr) {
-      evaluator_.Keypoints(parameters[0], parameters[1], parameters[2], parameters[3],
-                           keypoints);
+      if (detector_) {
+        DetectorKeypoints(evaluator_, *detector_, detector_vertices_, parameters[0],
+                          parameters[1], parameters[2], parameters[3], keypoints);
+      } else {
+        evaluator_.Keypoints(parameters[0], parameters[1], parameters[2], parameters[3],
+                             keypoints);
+      }
       double squared_norm = 0.0;
       for (const KeypointViewData& view : views_) {
         for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -274,8 +288,14 @@ class MultiViewKeypointSquareRootCost : public ceres::CostFunction {
       return true;
     }
     kp_jac.resize(3 * kNumHandKeypoints * n);
-    evaluator_.KeypointsAndJacobian(parameters[0], parameters[1], parameters[2],
-                                    parameters[3], keypoints, kp_jac.data());
+    if (detector_) {
+      DetectorKeypointsAndJacobian(evaluator_, *detector_, detector_vertices_,
+                                   parameters[0], parameters[1], parameters[2],
+                                   parameters[3], keypoints, kp_jac.data());
+    } else {
+      evaluator_.KeypointsAndJacobian(parameters[0], parameters[1], parameters[2],
+                                      parameters[3], keypoints, kp_jac.data());
+    }
     PointTermNormalEquations normal(kNumHandKeypoints);
     for (const KeypointViewData& view : views_) {
       for (int k = 0; k < kNumHandKeypoints; ++k) {
@@ -311,6 +331,8 @@ class MultiViewKeypointSquareRootCost : public ceres::CostFunction {
   const HandEvaluator& evaluator_;
   std::vector<KeypointViewData> views_;
   RobustLoss loss_;
+  const DetectorKeypointModel* detector_;
+  std::vector<int> detector_vertices_;
   std::vector<int> block_sizes_;
   FoldedTerms folded_;
 };

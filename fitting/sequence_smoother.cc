@@ -90,14 +90,13 @@ ceres::Solver::Options WindowSolverOptions(const HandFitOptions& fit, int iterat
   return s;
 }
 
-// One frame's optimised blocks.
-struct FrameBlocks {
+}  // namespace
+
+struct SequenceSmoother::FrameBlocks {
   double orient[3];
   double pose[kNumPoseParams];
   double transl[3];
 };
-
-}  // namespace
 
 void SequenceSmoothOptions::Check(const std::string& source) const {
   RequireGreater(source, "acceleration_sigma_mm", acceleration_sigma_mm, 0);
@@ -108,7 +107,8 @@ void SequenceSmoothOptions::Check(const std::string& source) const {
 
 SequenceSmoother::SequenceSmoother(const HandModel& model, const HandFitConfig& config,
                                    const HandFitOptions& fit,
-                                   const SequenceSmoothOptions& options)
+                                   const SequenceSmoothOptions& options,
+                                   std::optional<DetectorKeypointModel> detector)
     : model_(model),
       config_(config),
       fit_(fit),
@@ -133,7 +133,10 @@ SequenceSmoother::SequenceSmoother(const HandModel& model, const HandFitConfig& 
                    return o;
                  }()),
       anatomy_(ComputeHandAnatomy(model)),
-      limits_(DefaultHandLimits()) {}
+      limits_(DefaultHandLimits()),
+      detector_(std::move(detector)) {
+  if (detector_) detector_->Check("detector keypoint model", model.num_vertices());
+}
 
 Eigen::VectorXd SequenceSmoother::SequenceShape(
     const std::vector<Points3d>& keypoints, const std::vector<HandParams>& params) const {
@@ -169,6 +172,62 @@ Eigen::VectorXd SequenceSmoother::SequenceShape(
   return betas;
 }
 
+void SequenceSmoother::AddFrame(const SmoothFrame& frame, FrameBlocks* b, double* shape,
+                                ceres::Problem* problem) const {
+  const HandParams& p = frame.start;
+  std::copy_n(p.global_orient.data(), 3, b->orient);
+  std::copy_n(p.hand_pose.data(), kNumPoseParams, b->pose);
+  std::copy_n(p.transl.data(), 3, b->transl);
+  problem->AddParameterBlock(b->orient, 3, CreateAxisAngleManifold());
+  problem->AddParameterBlock(b->pose, kNumPoseParams);
+  problem->AddParameterBlock(b->transl, 3);
+  // The per-frame fit's keypoint stage term, priors folded in as there
+  // (fitting/fit_run.h ForEachPrior; the shape prior apart: the shape is shared).
+  auto* keypoints = new MultiViewKeypointSquareRootCost(
+      evaluator_, frame.views, fit_.keypoint_loss, fit_.keypoint_sigma_px,
+      detector_ ? &*detector_ : nullptr);
+  if (config_.use_joint_limits) {
+    const double limit_weight = 1.0 / std::pow(fit_.limit_sigma_deg * M_PI / 180.0, 2);
+    keypoints->folded()->Add("joint_limits",
+                             JointLimitCost<kNumPoseParams>::Create(
+                                 evaluator_, anatomy_, limits_, limit_weight),
+                             1);
+  }
+  if (config_.use_pose_prior) {
+    const Eigen::Matrix<double, 45, 1> inv_pose_sigma =
+        Eigen::Matrix<double, 45, 1>::Constant(1.0 / fit_.pose_prior_sigma_rad);
+    keypoints->folded()->Add(
+        "pose_prior",
+        PosePriorCost<kNumPoseParams>::Create(
+            evaluator_, fitting_internal::PoseMean(model_), inv_pose_sigma),
+        1);
+  }
+  problem->AddResidualBlock(keypoints, nullptr, b->orient, b->pose, shape, b->transl);
+}
+
+Eigen::VectorXd SequenceSmoother::SequenceShapeFromEvidence(
+    const std::vector<SmoothFrame>& frames) const {
+  HL_CHECK(!frames.empty(), "at least one frame");
+  Eigen::VectorXd shape = Eigen::VectorXd::Zero(kShapeBetas);
+  const Eigen::VectorXd& start = frames[0].start.betas;
+  for (Eigen::Index i = 0; i < std::min<Eigen::Index>(start.size(), kShapeBetas); ++i) {
+    shape[i] = start[i];
+  }
+  std::vector<FrameBlocks> blocks(frames.size());
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  problem.AddParameterBlock(shape.data(), kShapeBetas);
+  for (size_t f = 0; f < frames.size(); ++f) {
+    AddFrame(frames[f], &blocks[f], shape.data(), &problem);
+    problem.AddResidualBlock(ShapePriorCost<kShapeBetas>::Create(fit_.shape_prior_sigma),
+                             nullptr, shape.data());
+  }
+  ceres::Solver::Summary summary;
+  ceres::Solve(WindowSolverOptions(fit_, options_.iterations), &problem, &summary);
+  return shape;
+}
+
 SmoothWindowResult SequenceSmoother::SmoothWindow(const std::vector<SmoothFrame>& frames,
                                                   const Eigen::VectorXd& betas) const {
   HL_CHECK(betas.size() == kShapeBetas, "10 betas");
@@ -180,38 +239,7 @@ SmoothWindowResult SequenceSmoother::SmoothWindow(const std::vector<SmoothFrame>
   ceres::Problem problem(problem_options);
   problem.AddParameterBlock(shape.data(), kShapeBetas);
   problem.SetParameterBlockConstant(shape.data());
-  const Eigen::Matrix<double, 45, 1> inv_pose_sigma =
-      Eigen::Matrix<double, 45, 1>::Constant(1.0 / fit_.pose_prior_sigma_rad);
-  const double limit_weight = 1.0 / std::pow(fit_.limit_sigma_deg * M_PI / 180.0, 2);
-  for (int f = 0; f < n; ++f) {
-    FrameBlocks& b = blocks[f];
-    const HandParams& p = frames[f].start;
-    std::copy_n(p.global_orient.data(), 3, b.orient);
-    std::copy_n(p.hand_pose.data(), kNumPoseParams, b.pose);
-    std::copy_n(p.transl.data(), 3, b.transl);
-    problem.AddParameterBlock(b.orient, 3, CreateAxisAngleManifold());
-    problem.AddParameterBlock(b.pose, kNumPoseParams);
-    problem.AddParameterBlock(b.transl, 3);
-    // The per-frame fit's keypoint stage term, priors folded in as there
-    // (fitting/fit_run.h ForEachPrior; the shape prior is left out: shape is fixed).
-    auto* keypoints = new MultiViewKeypointSquareRootCost(
-        evaluator_, frames[f].views, fit_.keypoint_loss, fit_.keypoint_sigma_px);
-    if (config_.use_joint_limits) {
-      keypoints->folded()->Add("joint_limits",
-                               JointLimitCost<kNumPoseParams>::Create(
-                                   evaluator_, anatomy_, limits_, limit_weight),
-                               1);
-    }
-    if (config_.use_pose_prior) {
-      keypoints->folded()->Add(
-          "pose_prior",
-          PosePriorCost<kNumPoseParams>::Create(
-              evaluator_, fitting_internal::PoseMean(model_), inv_pose_sigma),
-          1);
-    }
-    problem.AddResidualBlock(keypoints, nullptr, b.orient, b.pose, shape.data(),
-                             b.transl);
-  }
+  for (int f = 0; f < n; ++f) AddFrame(frames[f], &blocks[f], shape.data(), &problem);
   for (int f = 1; f + 1 < n; ++f) {
     problem.AddResidualBlock(
         new KeypointAccelerationCost(evaluator_, shape,

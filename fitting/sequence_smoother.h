@@ -12,14 +12,25 @@
 //      keypoint acceleration prior (fitting/acceleration_cost.h) between consecutive
 //      frames. Silhouettes are not refitted (the per-frame labels that start the
 //      windows carry what they gave).
+// With a model of where the 2D detector puts its keypoints (hand/detector_keypoints.h)
+// the keypoint terms compare the detector's keypoints of the hand with the 2D, and the
+// shape is fitted to the evidence of frames spread over the sequence
+// (SequenceShapeFromEvidence) instead of read off the per-frame labels' bones, whose
+// lengths are the detector's, not the hand's.
 // How windows overlap and blend, and which frames they cover, is the job's business
 // (pipeline/smooth_job.h). Units: metres, radians, pixels; frames are assumed equally
 // spaced in time.
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "fitting/ceres_hand_fitter.h"
+#include "hand/detector_keypoints.h"
+
+namespace ceres {
+class Problem;
+}
 
 namespace handlabel {
 
@@ -35,7 +46,8 @@ struct SequenceSmoothOptions {
   // Ceres iterations per window (>= 1).
   int iterations = 50;
   // Frames whose poses the shape estimate evaluates the bone lengths at (>= 1; tips
-  // move a little with the pose through the pose blend shapes).
+  // move a little with the pose through the pose blend shapes), or, with a detector
+  // keypoint model, whose evidence the shape is fitted to.
   int shape_frames = 16;
   // Bone length per residual unit of the shape estimate, mm (> 0).
   double bone_sigma_mm = 1.0;
@@ -59,16 +71,26 @@ struct SmoothWindowResult {
 
 class SequenceSmoother {
  public:
-  // Throws InputError when the options or config do not fit the model (PCA pose).
+  // Throws InputError when the options or config do not fit the model (PCA pose) or
+  // the detector keypoint model another topology. `detector`: where the 2D evidence's
+  // keypoints lie on the hand; nullopt: at the model's keypoints.
   SequenceSmoother(const HandModel& model, const HandFitConfig& config,
-                   const HandFitOptions& fit, const SequenceSmoothOptions& options);
+                   const HandFitOptions& fit, const SequenceSmoothOptions& options,
+                   std::optional<DetectorKeypointModel> detector = std::nullopt);
 
   const HandEvaluator& evaluator() const { return evaluator_; }
+  bool has_detector_model() const { return detector_.has_value(); }
 
   // The sequence's betas (10) from per-frame fits: their 21 keypoints each, and their
   // parameters (the poses the bone lengths are evaluated at), one per frame, >= 1.
   Eigen::VectorXd SequenceShape(const std::vector<Points3d>& keypoints,
                                 const std::vector<HandParams>& params) const;
+
+  // The sequence's betas (10) fitted to the 2D evidence of frames (at least one; any
+  // order, e.g. spread over the sequence) jointly: one shape, each frame's pose and
+  // place, the per-frame fit's keypoint term and priors (the shape prior once per
+  // frame), the frames' `start` as the start. Deterministic as SmoothWindow.
+  Eigen::VectorXd SequenceShapeFromEvidence(const std::vector<SmoothFrame>& frames) const;
 
   // Joint solve of consecutive frames with the shape held at `betas`. Deterministic:
   // one thread, the same inputs give the same bits.
@@ -76,6 +98,12 @@ class SequenceSmoother {
                                   const Eigen::VectorXd& betas) const;
 
  private:
+  struct FrameBlocks;  // one frame's optimised parameter blocks
+  // Adds the frame's blocks (started at frame.start) and its keypoint term with the
+  // priors folded in; `shape` is the shared betas block, already in the problem.
+  void AddFrame(const SmoothFrame& frame, FrameBlocks* blocks, double* shape,
+                ceres::Problem* problem) const;
+
   HandModel model_;
   HandFitConfig config_;
   HandFitOptions fit_;
@@ -83,6 +111,7 @@ class SequenceSmoother {
   HandEvaluator evaluator_;
   HandAnatomy anatomy_;
   HandLimits limits_;
+  std::optional<DetectorKeypointModel> detector_;
 };
 
 }  // namespace handlabel

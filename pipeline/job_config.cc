@@ -134,6 +134,7 @@ void ReadSequenceSection(Section& top, JobConfig* job) {
   sequence.Read("overlap", &s.overlap);
   sequence.Read("acceleration_sigma_mm", &s.acceleration_sigma_mm);
   sequence.Read("iterations", &s.iterations);
+  sequence.Read("detector_keypoints", &s.detector_keypoints);
   sequence.RejectUnknownKeys();
 }
 
@@ -377,6 +378,10 @@ void SequenceSettings::Check(const std::string& source) const {
   }
   RequireGreater(source, "sequence.acceleration_sigma_mm", acceleration_sigma_mm, 0);
   RequireAtLeast(source, "sequence.iterations", iterations, 1);
+  if (detector_keypoints.empty()) {
+    throw InputError(source, "sequence.detector_keypoints",
+                     "none, mediapipe or a detector keypoint model file", "\"\"");
+  }
 }
 
 JobConfig LoadJobConfig(const std::string& path) {

@@ -95,6 +95,13 @@ struct SequenceSettings {
   double acceleration_sigma_mm = 1.0;
   // Ceres iterations per window (>= 1).
   int iterations = 50;
+  // Where the 2D evidence's keypoints lie on the hand (hand/detector_keypoints.h):
+  // "none" (at the model's keypoints), "mediapipe" (the shipped model of MediaPipe
+  // Hands' keypoints, models/detector_keypoints_mediapipe.json) or a model file. With a
+  // model the sequence's shape is fitted to the evidence of frames spread over the job
+  // and the windows compare the detector's keypoints of the hand with the 2D; the
+  // per-frame labels are not affected.
+  std::string detector_keypoints = "none";
   // Throws InputError naming the file and the field.
   void Check(const std::string& source) const;
 };

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/data_dir.h"
 #include "core/errors.h"
 #include "fitting/sequence_smoother.h"
 #include "hand/metrics.h"
@@ -56,12 +57,31 @@ struct LabelledFrame {
 json SmoothingStamp(const JobConfig& job, const std::string& job_hash,
                     const Eigen::VectorXd& betas) {
   const SequenceSettings& s = job.sequence;
-  return {{"job_hash", job_hash},
-          {"window", s.window},
-          {"overlap", s.overlap},
-          {"acceleration_sigma_mm", s.acceleration_sigma_mm},
-          {"iterations", s.iterations},
-          {"betas", std::vector<double>(betas.data(), betas.data() + betas.size())}};
+  json stamp = {
+      {"job_hash", job_hash},
+      {"window", s.window},
+      {"overlap", s.overlap},
+      {"acceleration_sigma_mm", s.acceleration_sigma_mm},
+      {"iterations", s.iterations},
+      {"betas", std::vector<double>(betas.data(), betas.data() + betas.size())}};
+  // Only when set, so that the stamps of jobs smoothed before the field existed hold.
+  if (s.detector_keypoints != "none") stamp["detector_keypoints"] = s.detector_keypoints;
+  return stamp;
+}
+
+// sequence.detector_keypoints read: none, the shipped MediaPipe model or a file.
+std::optional<DetectorKeypointModel> SequenceDetectorKeypoints(const JobConfig& job) {
+  const std::string& setting = job.sequence.detector_keypoints;
+  if (setting == "none") return std::nullopt;
+  const std::string path = setting == "mediapipe"
+                               ? ShippedModelPath("detector_keypoints_mediapipe.json")
+                               : setting;
+  if (!fs::exists(path)) {
+    throw InputError(job.source_file, "sequence.detector_keypoints",
+                     "none, mediapipe or an existing detector keypoint model file",
+                     setting + " (" + path + " does not exist)");
+  }
+  return ReadDetectorKeypointModel(path);
 }
 
 std::string RecordedJobHash(const std::string& output_dir) {
@@ -117,7 +137,8 @@ class SmoothJobRun {
     SequenceSmoothOptions smooth;
     smooth.acceleration_sigma_mm = job_.sequence.acceleration_sigma_mm;
     smooth.iterations = job_.sequence.iterations;
-    smoother_.emplace(model_, fit.config, fit.fit, smooth);
+    smoother_.emplace(model_, fit.config, fit.fit, smooth,
+                      SequenceDetectorKeypoints(job_));
     if (job_.overlays) {
       overlays_ = std::make_unique<RasterOverlayWriter>(model_, job_.overlay_format);
     }
@@ -180,7 +201,39 @@ class SmoothJobRun {
       throw InputError(job_.output_dir + "/labels", "", "per-frame labels of the job",
                        "none with MANO parameters");
     }
-    betas_ = smoother_->SequenceShape(keypoints, params);
+    betas_ = smoother_->has_detector_model()
+                 ? ShapeFromEvidence()
+                 : smoother_->SequenceShape(keypoints, params);
+  }
+
+  // The shape fitted to the evidence of SequenceSmoothOptions::shape_frames labelled
+  // frames spread evenly over the job (the same ones for the same labels).
+  Eigen::VectorXd ShapeFromEvidence() const {
+    std::vector<size_t> labelled;
+    for (size_t i = 0; i < frames_.size(); ++i) {
+      if (frames_[i].label) labelled.push_back(i);
+    }
+    const int count =
+        std::min<int>(SequenceSmoothOptions().shape_frames, labelled.size());
+    std::vector<SmoothFrame> chosen;
+    for (int i = 0; i < count; ++i) {
+      const size_t f = labelled[(2 * i + 1) * labelled.size() / (2 * count)];
+      chosen.push_back(LoadSmoothFrame(frames_[f]));
+    }
+    return smoother_->SequenceShapeFromEvidence(chosen);
+  }
+
+  // A labelled frame's 2D evidence (the views the per-frame fit saw) and its label.
+  SmoothFrame LoadSmoothFrame(const LabelledFrame& f) const {
+    const FrameInput input = source_->Load(f.id);
+    SmoothFrame frame;
+    const std::vector<std::optional<Keypoints2d>> evidence =
+        FitEvidence(job_, input, nullptr);
+    for (size_t v = 0; v < evidence.size(); ++v) {
+      if (evidence[v]) frame.views.push_back({input.rig[v], *evidence[v]});
+    }
+    frame.start = *f.label->params;
+    return frame;
   }
 
   // smoothed/ holds labels of one smoothing: refuse other settings unless force.
@@ -253,16 +306,7 @@ class SmoothJobRun {
                                       const WindowSpan& span) const {
     std::vector<SmoothFrame> frames;
     for (int i = span.begin; i < span.end; ++i) {
-      const LabelledFrame& f = frames_[segment[i]];
-      const FrameInput input = source_->Load(f.id);
-      SmoothFrame frame;
-      const std::vector<std::optional<Keypoints2d>> evidence =
-          FitEvidence(job_, input, nullptr);
-      for (size_t v = 0; v < evidence.size(); ++v) {
-        if (evidence[v]) frame.views.push_back({input.rig[v], *evidence[v]});
-      }
-      frame.start = *f.label->params;
-      frames.push_back(std::move(frame));
+      frames.push_back(LoadSmoothFrame(frames_[segment[i]]));
     }
     return smoother_->SmoothWindow(frames, betas_).params;
   }
@@ -421,6 +465,7 @@ json SmoothJobRun::Report() const {
       {"window", job_.sequence.window},
       {"overlap", job_.sequence.overlap},
       {"acceleration_sigma_mm", job_.sequence.acceleration_sigma_mm},
+      {"detector_keypoints", job_.sequence.detector_keypoints},
       {"betas", std::vector<double>(betas_.data(), betas_.data() + betas_.size())},
       {"moved_mm", moved / compared.size() * 1000},
       {"per_frame", MetricsOf(compared, false)},

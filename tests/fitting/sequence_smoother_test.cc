@@ -217,6 +217,69 @@ TEST_F(SequenceSmootherTest, SameBitsTwice) {
   }
 }
 
+// A detector whose keypoints are not the model's: each is a skin vertex near the
+// model's keypoint (a different one per keypoint, a few mm off), as MediaPipe's lie on
+// the skin and elsewhere along the bones.
+DetectorKeypointModel OffsetDetector(const HandModel& model) {
+  DetectorKeypointModel d;
+  d.detector = "offset";
+  d.num_vertices = model.num_vertices();
+  d.vertices = NearestVertexIds(model, 12);
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    d.weights[k].assign(d.vertices[k].size(), 0.0);
+    d.weights[k][3 + k % 5] = 1.0;
+  }
+  return d;
+}
+
+// The per-frame fits of the model's keypoints to such a detector's 2D (2 px noise) have
+// the detector's bones, and so has a shape from their medians or from the evidence
+// without the detector's model; with it, the shape fitted to the evidence of the frames
+// has the hand's own bones.
+TEST(SequenceShapeFromEvidence, RecoversTheBonesOfAHandSeenThroughAnOffsetDetector) {
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
+  const DetectorKeypointModel detector = OffsetDetector(model);
+  MovingHand hand = MakeMovingHand(model, 8);
+  std::mt19937_64 rng(46);
+  const CeresHandFitter fitter(model);
+  std::vector<SmoothFrame> frames;
+  std::vector<Points3d> per_frame_keypoints;
+  std::vector<HandParams> per_frame;
+  for (size_t f = 0; f < hand.params.size(); ++f) {
+    const Points3d seen =
+        DetectorKeypointsOfMesh(detector, PoseHand(model, hand.params[f]));
+    std::vector<KeypointView> views = hand.views[f];
+    for (KeypointView& view : views) {
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        Eigen::Vector2d uv;
+        view.camera.ProjectWorld(seen.row(k).transpose(), &uv);
+        view.keypoints.uv_px.row(k) = uv.transpose();
+      }
+    }
+    CorruptViews(&views, 2.0, 0.0, {}, rng);
+    HandFitInput input;
+    input.views = views;
+    const HandFitResult fit = fitter.Fit(input, fitter.InitFromViews(views));
+    frames.push_back({views, fit.params});
+    per_frame.push_back(fit.params);
+    per_frame_keypoints.push_back(fit.keypoints);
+  }
+  const auto bone_error = [&](const Eigen::VectorXd& betas) {
+    HandParams shaped = hand.params[0];
+    shaped.betas = betas;
+    return MeanBoneLengthError(PoseHand(model, shaped).keypoints, hand.keypoints[0]);
+  };
+  const SequenceSmoother plain(model, {}, {}, {});
+  const SequenceSmoother with_model(model, {}, {}, {}, detector);
+  const double from_medians =
+      bone_error(plain.SequenceShape(per_frame_keypoints, per_frame));
+  const double without_model = bone_error(plain.SequenceShapeFromEvidence(frames));
+  const double with = bone_error(with_model.SequenceShapeFromEvidence(frames));
+  EXPECT_GT(from_medians, 0.0015) << "the detector's offsets must bias the bones";
+  EXPECT_GT(without_model, 0.0015);
+  EXPECT_LT(with, 0.001) << "medians " << from_medians << ", evidence " << without_model;
+}
+
 TEST(SequenceSmoothOptions, ChecksNameTheField) {
   SequenceSmoothOptions o;
   o.acceleration_sigma_mm = 0;

@@ -128,6 +128,12 @@ TEST(JobConfig, SequenceSection) {
   EXPECT_EQ(job.sequence.overlap, 8);
   EXPECT_DOUBLE_EQ(job.sequence.acceleration_sigma_mm, 0.5);
   EXPECT_EQ(job.sequence.iterations, 20);
+  EXPECT_EQ(plain.sequence.detector_keypoints, "none");
+  EXPECT_EQ(LoadJobConfig(WriteJob(base + "sequence: {detector_keypoints: mediapipe}\n"))
+                .sequence.detector_keypoints,
+            "mediapipe");
+  ExpectError(base + "sequence: {detector_keypoints: \"\"}\n",
+              "sequence.detector_keypoints", "none, mediapipe or");
   ExpectError(base + "sequence: {window: 32, overlap: 20}\n", "sequence.overlap",
               "at most half of sequence.window");
   ExpectError(base + "sequence: {window: 2, overlap: 1}\n", "sequence.window", "3");

@@ -255,5 +255,17 @@ TEST_F(SmoothJobTest, RefusesEvidenceThatIsNotOnDisk) {
   }
 }
 
+// sequence.detector_keypoints: a file that is not there is refused naming the field; the
+// shipped MediaPipe model is the open hand's (778 vertices), not the capsule hand's.
+TEST_F(SmoothJobTest, RefusesADetectorKeypointModelThatIsMissingOrOfAnotherTopology) {
+  JobConfig job = Job(1);
+  job.sequence.detector_keypoints = *scratch_ + "/no_such_model.json";
+  EXPECT_THAT(testing::InputErrorOf([&] { RunSmoothJob(job, {}); }),
+              HasSubstr("sequence.detector_keypoints"));
+  job.sequence.detector_keypoints = "mediapipe";
+  EXPECT_THAT(testing::InputErrorOf([&] { RunSmoothJob(job, {}); }),
+              HasSubstr("num_vertices"));
+}
+
 }  // namespace
 }  // namespace handlabel
