@@ -13,6 +13,7 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "core/stopwatch.h"
@@ -234,6 +235,56 @@ TEST_F(LabelStageTimes, TheTableListsGroupsLongestFirstWithTheirParts) {
     at = row;
   }
   EXPECT_LT(table.find("\n  fit "), table.find("\n    .solve "));
+}
+
+// A job that tracks the hand calls the detector itself on some frames only: there the
+// detector's reported parts come out under their names and the rest of its call as
+// detect.other; frames labelled from the previous label's crops have no detect stage.
+TEST(LabelStageTimesTracked, TheJobsOwnDetectorCallsAreTimedWhereTheyRan) {
+  const std::string out = testing::ScratchDir() + "/out";
+  TestCapture capture{9};
+  capture.without_2d = true;
+  TestPredictor network;
+  TestFitter fitter;
+  constexpr double kReportedLandmarks = 0.004;
+  std::set<std::string> detected;
+  std::mutex mutex;
+  LabelStageSet set;
+  set.source = &capture;
+  set.predictor = &network;
+  set.fitter = &fitter;
+  set.hand_model_name = capture.model().name;
+  set.faces = capture.model().faces;
+  set.find_keypoints_2d = [&](FrameInput* frame) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(6));
+    for (const RigCamera& camera : frame->rig.cameras()) {
+      frame->keypoints_2d.push_back(
+          testing::ProjectKeypoints(camera, frame->ground_truth->keypoints));
+    }
+    frame->stage_seconds["detect.landmarks"] = kReportedLandmarks;
+    std::lock_guard<std::mutex> lock(mutex);
+    detected.insert(frame->id);
+  };
+  JobConfig job = testing::MakeTestJob(out, RefineMode::kFallback);
+  job.keypoints = KeypointSource::kFiles;
+  job.keypoints_from_detector = true;
+  job.detector_every = 3;
+  const LabelSummary summary = RunLabelJob(job, set, {});
+  ASSERT_EQ(summary.ok, 9);
+  ASSERT_EQ(detected.size(), 3u);  // frames 0, 3, 6
+  for (const FrameRecord& r : FrameLog::Read(ShardLogPath(out, {0, 1}))) {
+    if (detected.count(r.frame)) {
+      EXPECT_NEAR(r.stages.at("detect.landmarks"), kReportedLandmarks, 1e-12) << r.frame;
+      EXPECT_GE(r.stages.at("detect.other"), 0.006 - kReportedLandmarks - 1e-4)
+          << r.frame;
+    } else {
+      EXPECT_EQ(r.stages.count("detect.landmarks") + r.stages.count("detect.other"), 0u)
+          << r.frame;
+    }
+    EXPECT_GT(r.stages.at("network"), 0.0) << r.frame;
+  }
+  EXPECT_NEAR(summary.stage_seconds.at("detect.landmarks"), 3 * kReportedLandmarks,
+              1e-12);
 }
 
 TEST(DetectorSeconds, ModelTimesSplitTheWallTimeAndParallelViewsAreScaledToIt) {
