@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stage_times.h"
 #include "geometry/rig.h"
 #include "hand/hand_lbs.h"
 #include "hand/keypoints2d.h"
@@ -55,6 +56,11 @@ struct FrameInput {
   // around: 3D points (world frame) whose projection the crop frames, e.g. the previous
   // frame's label keypoints in a job that tracks (evidence.detector_every). Empty: none.
   Points3d crop_prior;
+  // Wall seconds the stages that loaded or processed the frame spent on it beyond
+  // reading it, per stage (core/stage_times.h), e.g. a reader that detects the hand:
+  // "detect.palm", "detect.landmarks", "detect.other". The label job adds its own
+  // stages and records them in the frame log (pipeline/frame_log.h).
+  StageSeconds stage_seconds;
 };
 
 class FrameSource {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stage_times.h"
 #include "fitting/keypoint_view.h"
 #include "fitting/points3d_targets.h"
 #include "fitting/robust_loss.h"
@@ -175,6 +176,10 @@ struct HandFitResult {
   std::vector<double> view_mask_margin_px;
   int iterations = 0;  // Ceres iterations over all stages
   double seconds = 0.0;
+  // Where `seconds` went (core/stage_times.h): "setup" (checks, parameter blocks),
+  // "rigid", "keypoints" and "silhouettes" (the solves; silhouettes with building their
+  // evidence), "evaluate" (the final mesh and its agreement per view).
+  StageSeconds stage_seconds;
   bool converged = false;  // the last stage met a Ceres convergence tolerance
   std::string message;     // Ceres' message of the last stage
   // Set when silhouette rounds ran: the keypoints-only result they started from.

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/stage_times.h"
 #include "fitting/analytic_hand_pose.h"
 #include "fitting/ceres_hand_fitter.h"
 #include "fitting/joint_limit_cost.h"
@@ -281,19 +282,38 @@ class FitRun {
     const auto start = std::chrono::steady_clock::now();
     CheckMaskCounts(input);
     FitState state = StartFit(input, init);
-    SolveRigid(&state);
-    SolveKeypoints(&state);
-    SilhouetteEvidence silhouettes = BuildSilhouetteViews(state);
-    state.result.view_mask_margin_px.assign(input.views.size(), kNaN);
+    StageSeconds& times = state.result.stage_seconds;
+    times["setup"] = SecondsSince(start);
+    {
+      StageTimer timer(&times, "rigid");
+      SolveRigid(&state);
+    }
+    {
+      StageTimer timer(&times, "keypoints");
+      SolveKeypoints(&state);
+    }
+    {
+      StageTimer timer(&times, "silhouettes");
+      SolveSilhouettes(&state);
+    }
+    const auto end = std::chrono::steady_clock::now();
+    HandFitResult result = MakeResult(&state, start);
+    result.stage_seconds["evaluate"] = SecondsSince(end);
+    return result;
+  }
+
+  // The silhouette rounds after the keypoint fit (none without masks).
+  void SolveSilhouettes(FitState* state) const {
+    SilhouetteEvidence silhouettes = BuildSilhouetteViews(*state);
+    state->result.view_mask_margin_px.assign(state->input.views.size(), kNaN);
     // What the same fit without silhouettes gives, to check the silhouette fit against.
     if (!silhouettes.views.empty()) {
-      state.result.keypoints_only = Evaluate(input, FromBlocks(state.blocks));
+      state->result.keypoints_only = Evaluate(state->input, FromBlocks(state->blocks));
     }
     for (int round = 0; !silhouettes.views.empty() && round < options_.silhouette_rounds;
          ++round) {
-      SolveSilhouetteRound(&silhouettes, &state);
+      SolveSilhouetteRound(&silhouettes, state);
     }
-    return MakeResult(&state, start);
   }
 
   // The posed hand of `params` and its agreement with the evidence per view.

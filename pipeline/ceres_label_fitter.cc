@@ -216,7 +216,8 @@ HandParams CeresLabelFitter::Start(const LabelFitRequest& request,
 HandFitResult CeresLabelFitter::RefineAgainstFiles(const LabelFitRequest& request,
                                                    const CeresHandFitter& fitter,
                                                    const HandFitInput& input,
-                                                   std::string* start) const {
+                                                   std::string* start,
+                                                   StageSeconds* times) const {
   const MeshPrediction& net = *request.init;
   // A target at sigma s with weight w pulls as one at sigma s / sqrt(w).
   const double sigma_ratio = fitter.options().points3d_sigma_m / options_.network_sigma_m;
@@ -224,9 +225,14 @@ HandFitResult CeresLabelFitter::RefineAgainstFiles(const LabelFitRequest& reques
   from_network.targets3d =
       NetworkTargets(net, num_vertices_, sigma_ratio * sigma_ratio, false);
   *start = "network";
-  HandFitResult fit = fitter.Fit(
-      from_network, fitter.InitFromKeypoints3d(net.keypoints,
-                                               Eigen::VectorXd::Ones(kNumHandKeypoints)));
+  HandParams init;
+  {
+    StageTimer timer(times, "init");
+    init = fitter.InitFromKeypoints3d(net.keypoints,
+                                      Eigen::VectorXd::Ones(kNumHandKeypoints));
+  }
+  HandFitResult fit = fitter.Fit(from_network, init);
+  AddStageSeconds(fit.stage_seconds, times);
   if (WorstViewRmsPx(input.views, net.keypoints) <= options_.restart_px) return fit;
   // A restart from the views alone needs two of them (CeresHandFitter::Fit): from one,
   // the network's pull is all that places the hand in depth.
@@ -234,7 +240,13 @@ HandFitResult CeresLabelFitter::RefineAgainstFiles(const LabelFitRequest& reques
     *start = "network (one view: no triangulated restart)";
     return fit;
   }
-  HandFitResult from_views = fitter.Fit(input, fitter.InitFromViews(input.views));
+  HandParams from_views_init;
+  {
+    StageTimer timer(times, "init");
+    from_views_init = fitter.InitFromViews(input.views);
+  }
+  HandFitResult from_views = fitter.Fit(input, from_views_init);
+  AddStageSeconds(from_views.stage_seconds, times);
   if (EvidenceCost(from_views) < EvidenceCost(fit)) {
     *start = "triangulated_views (network start too far)";
     return from_views;
@@ -262,20 +274,34 @@ std::optional<QualityReport> CeresLabelFitter::CheckSilhouettes(
 }
 
 LabelFit CeresLabelFitter::Fit(const LabelFitRequest& request) const {
+  LabelFit out;
+  StageSeconds* times = &out.stage_seconds;
   std::string silhouettes, start;
-  HandFitInput input = Evidence(request, &silhouettes);
+  HandFitInput input;
+  {
+    StageTimer timer(times, "evidence");
+    input = Evidence(request, &silhouettes);
+  }
   const CeresHandFitter& fitter =
       !request.masks.empty() && network_mask_fitter_ ? *network_mask_fitter_ : fitter_;
   HandFitResult fit;
   if (request.init && request.file_views > 0) {
-    fit = RefineAgainstFiles(request, fitter, input, &start);
+    fit = RefineAgainstFiles(request, fitter, input, &start, times);
   } else {
-    const HandParams init = Start(request, fitter, &input, &start);
+    HandParams init;
+    {
+      StageTimer timer(times, "init");
+      init = Start(request, fitter, &input, &start);
+    }
     fit = fitter.Fit(input, init);
+    AddStageSeconds(fit.stage_seconds, times);
   }
-  const std::optional<QualityReport> check = CheckSilhouettes(&fit);
+  std::optional<QualityReport> check;
+  {
+    StageTimer timer(times, "silhouette_check");
+    check = CheckSilhouettes(&fit);
+  }
 
-  LabelFit out;
   out.params = fit.params;
   out.mesh.vertices = fit.vertices;
   out.mesh.keypoints = fit.keypoints;

@@ -81,10 +81,12 @@ class CeresLabelFitter : public LabelFitter {
                    HandFitInput* input, std::string* start) const;
   // Refinement against file 2D: from the network's answer, loosely pulled, and from
   // the triangulated views too when that answer is far from the file views; the fit
-  // with the lower keypoint cost wins. `start` names the winner's start.
+  // with the lower keypoint cost wins. `start` names the winner's start; `times` gets
+  // the stage times of both fits (LabelFit::stage_seconds).
   HandFitResult RefineAgainstFiles(const LabelFitRequest& request,
                                    const CeresHandFitter& fitter,
-                                   const HandFitInput& input, std::string* start) const;
+                                   const HandFitInput& input, std::string* start,
+                                   StageSeconds* times) const;
 
   // With silhouette rounds run: the check of the silhouette fit; when it fails and
   // check_silhouettes is set, `fit` becomes its keypoints-only result.

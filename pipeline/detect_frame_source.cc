@@ -1,8 +1,11 @@
 #include "pipeline/detect_frame_source.h"
 
+#include <chrono>
+
 #include "capture/frame_images.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/stopwatch.h"
 #include "pipeline/label_outputs.h"
 
 namespace handlabel {
@@ -36,6 +39,21 @@ void DetectionStore::TakeAndWrite(const std::string& output_dir,
   for (const RigCamera& camera : frame.rig.cameras()) cameras.push_back(camera.name);
   WriteFileAtomically(JobDetectionsPath(output_dir, frame.id),
                       FrameDetectionsJson(frame.id, cameras, *result).dump(1) + "\n");
+}
+
+void AddDetectorSeconds(const FrameHandResult& result, double seconds,
+                        StageSeconds* times) {
+  double palm = 0, landmarks = 0;
+  for (const ViewHandResult& view : result.views) {
+    palm += view.palm_seconds;
+    landmarks += view.landmarks_seconds;
+  }
+  // Views that ran in parallel (video mode) may sum to more than the wall time.
+  const double models = palm + landmarks;
+  const double scale = models > seconds ? seconds / models : 1.0;
+  (*times)["detect.palm"] += palm * scale;
+  (*times)["detect.landmarks"] += landmarks * scale;
+  (*times)["detect.other"] += seconds - models * scale;
 }
 
 std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
@@ -88,6 +106,7 @@ FrameInput DetectorFrameSource::Load(const std::string& id) const {
 
 FrameHandResult DetectorFrameSource::Detect(FrameInput* frame,
                                             const FrameHandResult* previous) const {
+  const auto start = std::chrono::steady_clock::now();
   // Frames may be detected in parallel: the models keep no state between calls and
   // each call runs on options_.hands.num_threads threads (1 by default).
   FrameHandResult result = options_.video
@@ -96,6 +115,7 @@ FrameHandResult DetectorFrameSource::Detect(FrameInput* frame,
                                : DetectHandMultiView(*detector_, frame->rig,
                                                      frame->images, options_.multiview);
   frame->keypoints_2d = KeypointsFromDetection(result);
+  AddDetectorSeconds(result, SecondsSince(start), &frame->stage_seconds);
   if (store_) store_->Put(frame->id, result);
   return result;
 }

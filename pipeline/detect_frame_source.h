@@ -41,6 +41,13 @@ class DetectionStore {
   std::map<std::string, FrameHandResult> results_;
 };
 
+// The detector's wall time on a frame (`seconds`) into `times` as "detect.palm" and
+// "detect.landmarks" (the models' calls, summed over views; scaled down to `seconds`
+// where views ran in parallel) and "detect.other" (the rest: palm matching,
+// triangulation, ROI placement, checks).
+void AddDetectorSeconds(const FrameHandResult& result, double seconds,
+                        StageSeconds* times);
+
 // The 2D keypoints of one frame's detection in rig order, as the detections file of
 // `handlabel detect` gives them to a job (unknown keypoints: confidence 0, position 0;
 // views without a detection: nullopt).

@@ -37,6 +37,8 @@ FrameRecord ParseRecord(const std::string& line, const std::string& source) {
         r.metrics[name] = value.is_null() ? std::nan("") : value.get<double>();
       }
     }
+    if (j.contains("stages"))
+      r.stages = j.at("stages").get<std::map<std::string, double>>();
     if (j.contains("keypoints_mm")) {
       r.keypoints_mm =
           j.at("keypoints_mm").get<std::map<std::string, std::vector<double>>>();
@@ -120,6 +122,7 @@ void FrameLog::Record(const FrameRecord& record) {
                       {"status", record.status},
                       {"path", record.path},
                       {"seconds", record.seconds}};
+  if (!record.stages.empty()) j["stages"] = record.stages;
   if (!record.reason.empty()) j["reason"] = record.reason;
   if (!record.metrics.empty()) j["metrics"] = record.metrics;
   if (!record.keypoints_mm.empty()) j["keypoints_mm"] = record.keypoints_mm;

@@ -17,7 +17,11 @@ struct FrameRecord {
   std::string status;  // "ok" or "failed"
   std::string path;    // which stage produced the label ("network", "refined", "fit")
   std::string reason;  // why it failed (empty when ok)
-  double seconds = 0;  // wall time spent on the frame
+  double seconds = 0;  // wall time spent on the frame: the sum of `stages`
+  // Where `seconds` went: wall seconds per stage ("read", "detect.palm", "network",
+  // "fit.keypoints", "write.labels", ...; docs/labeling-jobs.md, "Where the time went"),
+  // the stages that ran on the frame only; empty in older logs.
+  std::map<std::string, double> stages;
   // Per-frame errors against ground truth, "<group>/<metric>" -> value (label_summary.h);
   // empty when the capture has no ground truth.
   std::map<std::string, double> metrics;

@@ -23,6 +23,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "core/progress.h"
+#include "core/stage_times.h"
 #include "core/stopwatch.h"
 #include "formats/sha256.h"
 #include "pipeline/build_info.h"
@@ -48,7 +49,8 @@ struct Batch {
   std::vector<std::string> errors;  // non-empty: the frame failed in an earlier stage
   // Non-empty: the network failed on this frame; in fallback mode the fitter takes over.
   std::vector<std::string> network_errors;
-  std::vector<double> seconds;
+  // Wall seconds per stage spent on each frame so far (FrameRecord::stages).
+  std::vector<StageSeconds> stages;
   // Jobs that track the hand: where the network's crops came from (FrameRecord::crops).
   std::vector<std::string> crops;
 };
@@ -62,7 +64,7 @@ std::shared_ptr<Batch> MakeBatch(size_t index, std::vector<std::string> ids) {
   batch->predictions.resize(n);
   batch->errors.resize(n);
   batch->network_errors.resize(n);
-  batch->seconds.assign(n, 0.0);
+  batch->stages.resize(n);
   batch->crops.resize(n);
   return batch;
 }
@@ -281,7 +283,23 @@ class LabelJobRun {
     } catch (...) {
       batch.errors[i] = "read: " + Describe(std::current_exception());
     }
-    batch.seconds[i] += SecondsSince(t);
+    AddStageTime(batch, i, "read", t);
+  }
+
+  // The wall time since `start` of a step on frame i: the parts the step timed itself
+  // (FrameInput::stage_seconds, e.g. the detector's models inside a reader) under their
+  // own names, the rest under `stage`.
+  static void AddStageTime(Batch& batch, size_t i, const std::string& stage,
+                           Clock::time_point start) {
+    const double seconds = SecondsSince(start);
+    double parts = 0;
+    if (batch.inputs[i]) {
+      StageSeconds& reported = batch.inputs[i]->stage_seconds;
+      parts = TotalStageSeconds(reported);
+      AddStageSeconds(reported, &batch.stages[i]);
+      reported.clear();
+    }
+    batch.stages[i][stage] += std::max(0.0, seconds - parts);
   }
 
   // The frame's images, decoded here (in parallel) once for the network, whose stage
@@ -328,7 +346,7 @@ class LabelJobRun {
       }
     }
     const double share = SecondsSince(t) / frames.size();
-    for (size_t i : ready) batch.seconds[i] += share;
+    for (size_t i : ready) batch.stages[i]["network"] += share;
   }
 
   // fit.init previous: the label parameters of the frame before `frame` in the job's
@@ -345,6 +363,7 @@ class LabelJobRun {
   // Labels one frame (policy, outputs) and records it in the shard log.
   void FinishFrame(Batch& batch, size_t i) {
     const Clock::time_point frame_start = Clock::now();
+    const double before = TotalStageSeconds(batch.stages[i]);
     FrameRecord record;
     record.frame = batch.ids[i];
     std::string error = batch.errors[i];
@@ -360,8 +379,10 @@ class LabelJobRun {
         if (!network_error.empty()) error = network_error + "; fallback fit: " + error;
       }
     }
+    StageSeconds& stages = batch.stages[i];
     if (stages_.write_detections && batch.inputs[i]) {
       try {  // before the record: a finished frame has its detections file
+        StageTimer timer(&stages, "write.detections");
         stages_.write_detections(out_, *batch.inputs[i]);
       } catch (...) {
         if (error.empty())
@@ -376,11 +397,17 @@ class LabelJobRun {
     }
     record.job_hash = job_hash_;
     if (error.empty()) {  // what resume and merge check the file against
+      StageTimer timer(&stages, "write.checksum");
       const std::string label = LabelFilePath(out_, record.frame);
       record.label_bytes = static_cast<int64_t>(fs::file_size(label));
       record.label_sha256 = Sha256OfFile(label);
     }
-    record.seconds = batch.seconds[i] + SecondsSince(frame_start);
+    const double finish = SecondsSince(frame_start);
+    // What this step did outside its timed stages: the label policy's choices,
+    // fit.init previous's read of the previous label, the record.
+    stages["other"] += std::max(0.0, finish - (TotalStageSeconds(stages) - before));
+    record.seconds = TotalStageSeconds(stages);
+    record.stages = stages;
     record.crops = batch.crops[i];
     log_->Record(record);
     progress_->FrameDone(!error.empty());
@@ -395,12 +422,19 @@ class LabelJobRun {
     FrameOutcome outcome =
         LabelFrame(context_, frame, prediction, FrameSeed(job_.seed, frame.id),
                    previous ? &*previous : nullptr);
+    StageSeconds& stages = batch.stages[i];
+    AddStageSeconds(outcome.stage_seconds, &stages);
     if (!batch.network_errors[i].empty()) {
       outcome.label.fit["why"] = batch.network_errors[i];
     }
-    if (stages_.overlays && job_.overlays)
+    if (stages_.overlays && job_.overlays) {
+      StageTimer timer(&stages, "write.overlays");
       stages_.overlays->Write(out_, frame, outcome.label);
-    WriteLabelFiles(out_, outcome.label, stages_.faces, job_.meshes);
+    }
+    {
+      StageTimer timer(&stages, "write.labels");
+      WriteLabelFiles(out_, outcome.label, stages_.faces, job_.meshes);
+    }
     record->status = "ok";
     record->path = ToString(outcome.label.path);
     record->metrics = std::move(outcome.metrics);
@@ -530,7 +564,7 @@ class LabelJobRun {
     } catch (...) {
       batch.errors[0] = "detect: " + Describe(std::current_exception());
     }
-    batch.seconds[0] += SecondsSince(t);
+    AddStageTime(batch, 0, "detect.other", t);
   }
 
   // Video mode without a network or fit.init previous: the runs (VideoRuns) in
@@ -571,7 +605,7 @@ class LabelJobRun {
         } catch (...) {
           batch->errors[0] = "detect: " + Describe(std::current_exception());
         }
-        batch->seconds[0] += SecondsSince(t);
+        AddStageTime(*batch, 0, "detect.other", t);
       }
       if (!batch->errors[0].empty()) track = stages_.start_video_track();
       FinishFrame(*batch, 0);
@@ -695,7 +729,7 @@ class LabelJobRun {
     } catch (...) {
       batch.errors[0] = "detect: " + Describe(std::current_exception());
     }
-    batch.seconds[0] += SecondsSince(t);
+    AddStageTime(batch, 0, "detect.other", t);
   }
 
   // What the job's 2D keypoints are: the capture's (or evidence.detections'), the
@@ -719,12 +753,13 @@ class LabelJobRun {
     summary.keypoints_2d_source = KeypointsSourceText();
     summary.skipped = done_before_;
     summary.wall_seconds = wall_seconds;
+    summary.threads = in_order_ ? 1 : threads_;
     WriteFileAtomically(ShardSummaryPath(out_, options_.shard),
                         summary.ToJson().dump(1) + "\n");
     const bool whole_job = options_.shard.count == 1;
     if (whole_job) {
       MergeLabelOutputs(out_, job_.name, job_hash_, all_frames_,
-                        summary.keypoints_2d_source);
+                        summary.keypoints_2d_source, nullptr, &summary);
     }
     if (!options_.log) return summary;
     *options_.log << summary.ToText();

@@ -138,7 +138,8 @@ LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string&
                                const std::string& job_hash,
                                const std::vector<std::string>& frames,
                                const std::string& keypoints_2d_source,
-                               std::vector<std::string>* not_labelled) {
+                               std::vector<std::string>* not_labelled,
+                               const LabelSummary* run) {
   CheckOutputsBelongToJob(output_dir, job_hash);  // before anything is written
   std::map<std::string, FrameRecord> records = ReadShardLogs(output_dir);
   nlohmann::json entries = nlohmann::json::array();
@@ -175,6 +176,11 @@ LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string&
   summary.keypoints_2d_source = keypoints_2d_source.empty()
                                     ? KeypointsSourceOfShards(output_dir)
                                     : keypoints_2d_source;
+  if (run) {
+    summary.wall_seconds = run->wall_seconds;
+    summary.threads = run->threads;
+    summary.skipped = run->skipped;
+  }
   const nlohmann::json manifest = {{"format", "handlabel-manifest"},
                                    {"format_version", 1},
                                    {"job", job_name},

@@ -50,12 +50,15 @@ void CheckOutputsBelongToJob(const std::string& output_dir, const std::string& j
 // path, label file, reason: nothing run-dependent, so it is identical however the job was
 // sharded), summary.json and summary.md, each atomically, and returns the summary.
 // `keypoints_2d_source` (FrameSource::KeypointsSource) is stated in the summary; ""
-// takes it from the shards' summaries (what `merge` knows).
+// takes it from the shards' summaries (what `merge` knows). `run`: the summary of a
+// run of the whole job that merges at its end; its wall time, threads and skipped
+// frames go into summary.json (a merge alone knows no wall time).
 LabelSummary MergeLabelOutputs(const std::string& output_dir, const std::string& job_name,
                                const std::string& job_hash,
                                const std::vector<std::string>& frames,
                                const std::string& keypoints_2d_source = "",
-                               std::vector<std::string>* not_labelled = nullptr);
+                               std::vector<std::string>* not_labelled = nullptr,
+                               const LabelSummary* run = nullptr);
 
 // Removes leftovers of interrupted atomic writes that belong to `frames` (never other
 // shards' files, which may be in flight). Returns how many were removed.

@@ -1,9 +1,11 @@
 #include "pipeline/label_policy.h"
 
 #include <algorithm>
+#include <chrono>
 
 #include "core/errors.h"
 #include "core/random.h"
+#include "core/stage_times.h"
 #include "pipeline/frame_metrics.h"
 #include "pipeline/quality_checks.h"
 
@@ -105,6 +107,7 @@ class FrameLabeler {
 
   FrameOutcome Run() {
     FrameOutcome outcome;
+    times_ = &outcome.stage_seconds;
     LabelRecord& label = outcome.label;
     label.frame = frame_.id;
     label.side = context_.side;
@@ -113,6 +116,7 @@ class FrameLabeler {
     if (prediction_) {
       // The frame's file 2D judge the answer too, where the job uses them.
       const bool files = job_.keypoints != KeypointSource::kNetwork;
+      StageTimer timer(times_, "checks");
       label.quality = CheckPrediction(frame_.rig, *prediction_, job_.quality,
                                       files ? &frame_.keypoints_2d : nullptr);
     }
@@ -121,14 +125,30 @@ class FrameLabeler {
         !label.mesh.keypoints.array().isFinite().all()) {
       throw Error("the " + ToString(label.path) + " result is not finite");
     }
-    if (job_.evaluate && frame_.ground_truth) Evaluate(&outcome);
+    if (job_.evaluate && frame_.ground_truth) {
+      StageTimer timer(times_, "evaluate");
+      Evaluate(&outcome);
+    }
     return outcome;
   }
 
  private:
   // A fit from `init` (the network's mesh) or, with nullptr, from 2D evidence alone.
-  LabelFit Fit(const MeshPrediction* init) const {
+  // `times` (optional) gets the fitter's stages as "fit.<stage>" and the rest of this
+  // call (the evidence per view) as "fit.other".
+  LabelFit Fit(const MeshPrediction* init, StageSeconds* times) const {
     if (!context_.fitter) throw Error("refine.mode needs a fitter, and none was built");
+    const auto start = std::chrono::steady_clock::now();
+    LabelFit fit = FitWithoutTimes(init);
+    if (times) {
+      AddStageSeconds(fit.stage_seconds, times, "fit.");
+      (*times)["fit.other"] +=
+          std::max(0.0, SecondsSince(start) - TotalStageSeconds(fit.stage_seconds));
+    }
+    return fit;
+  }
+
+  LabelFit FitWithoutTimes(const MeshPrediction* init) const {
     LabelFitRequest request;
     request.frame = &frame_;
     request.init = init;
@@ -158,7 +178,7 @@ class FrameLabeler {
       throw Error("refine.mode is off and there is no network prediction");
     }
     const bool refine = prediction_ && job_.refine_mode == RefineMode::kAlways;
-    LabelFit result = Fit(refine ? prediction_ : nullptr);
+    LabelFit result = Fit(refine ? prediction_ : nullptr, times_);
     label->path = refine ? LabelPath::kRefined : LabelPath::kFallbackFit;
     label->params = result.params;
     label->mesh = std::move(result.mesh);
@@ -187,7 +207,7 @@ class FrameLabeler {
     }
     // The baseline is for comparison only; its failure does not fail the frame.
     try {
-      const LabelFit baseline = Fit(nullptr);
+      const LabelFit baseline = Fit(nullptr, nullptr);  // in "evaluate"
       AddMetrics("fit_only", baseline.mesh.keypoints, baseline.mesh.vertices, truth,
                  outcome);
     } catch (const std::exception&) {
@@ -200,6 +220,7 @@ class FrameLabeler {
   const MeshPrediction* prediction_;
   const uint64_t seed_;
   const HandParams* previous_;
+  StageSeconds* times_ = nullptr;  // the outcome's (Run)
 };
 
 }  // namespace

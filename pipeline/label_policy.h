@@ -31,6 +31,11 @@ struct FrameOutcome {
   // With ground truth: the keypoints each metric group was scored on, and the truth's
   // ("truth"), for the motion metrics over consecutive frames (label_summary.h).
   std::map<std::string, Points3d> keypoints;
+  // Where the frame's labelling time went (core/stage_times.h): "checks" (the network
+  // answer's quality checks), "fit.<stage>" (LabelFit::stage_seconds, and "fit.other":
+  // the rest of the fit call), "evaluate" (against ground truth, with the fit-only
+  // baseline). Stages that did not run are absent.
+  StageSeconds stage_seconds;
 };
 
 // Where the network's own 2D fills a view that has no file 2D while other views do,

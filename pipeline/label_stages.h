@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "capture/frame_source.h"
+#include "core/stage_times.h"
 #include "geometry/rig.h"
 #include "hand/hand_lbs.h"
 #include "image/distance_transform.h"
@@ -82,6 +83,10 @@ struct LabelFit {
   HandMesh mesh;
   nlohmann::json
       report;  // solver summary (cost, iterations, ...), written into the label
+  // Where the fit's time went, wall seconds per stage (core/stage_times.h), for the
+  // job's stage times; never written into the label (labels of identical runs are
+  // identical). Empty when the fitter does not say.
+  StageSeconds stage_seconds;
 };
 
 class LabelFitter {

@@ -1,5 +1,6 @@
 #include "pipeline/label_summary.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <set>
 #include <sstream>
@@ -75,7 +76,85 @@ void AddMotionMetrics(const std::vector<std::string>& frames,
   }
 }
 
+// Stages grouped by the name before the first dot: group -> (its total, its parts).
+struct StageGroup {
+  std::string name;
+  double seconds = 0;
+  std::vector<std::pair<std::string, double>> parts;  // "palm" of "detect.palm"
+};
+
+std::vector<StageGroup> GroupStages(const std::map<std::string, double>& stages) {
+  std::map<std::string, StageGroup> groups;
+  for (const auto& [stage, seconds] : stages) {
+    const size_t dot = stage.find('.');
+    StageGroup& g = groups[stage.substr(0, dot)];
+    g.name = stage.substr(0, dot);
+    g.seconds += seconds;
+    if (dot != std::string::npos) g.parts.emplace_back(stage.substr(dot + 1), seconds);
+  }
+  const auto longest_first = [](const auto& a, const auto& b) {
+    return a.second != b.second ? a.second > b.second : a.first < b.first;
+  };
+  std::vector<StageGroup> out;
+  for (auto& [name, g] : groups) {
+    std::sort(g.parts.begin(), g.parts.end(), longest_first);
+    out.push_back(std::move(g));
+  }
+  std::sort(out.begin(), out.end(), [](const StageGroup& a, const StageGroup& b) {
+    return a.seconds != b.seconds ? a.seconds > b.seconds : a.name < b.name;
+  });
+  return out;
+}
+
+std::string StageRow(const std::string& name, double seconds, double total, int frames) {
+  char row[128];
+  std::snprintf(row, sizeof(row), "  %-22s %9.2f %6.1f %% %9.1f\n", name.c_str(), seconds,
+                total > 0 ? 100 * seconds / total : 0.0,
+                frames > 0 ? 1000 * seconds / frames : 0.0);
+  return row;
+}
+
 }  // namespace
+
+std::string LabelSummary::StageTable() const {
+  if (stage_frames == 0) return "";
+  double total = 0;
+  for (const auto& [stage, seconds] : stage_seconds) total += seconds;
+  std::ostringstream out;
+  out << "where the time went (" << stage_frames << " frames; seconds inside each stage "
+      << "summed over frames, " << Number(total, 1) << " s in all";
+  // Only a run that labelled every frame it reports compares with its wall time.
+  if (wall_seconds > 0 && threads > 0 && skipped == 0) {
+    out << "; " << threads << " thread(s) x " << Number(wall_seconds, 1)
+        << " s wall: stages busy " << Number(100 * total / (threads * wall_seconds), 0)
+        << " %";
+  }
+  out << "):\n";
+  char head[128];
+  std::snprintf(head, sizeof(head), "  %-22s %9s %8s %9s\n", "stage", "seconds", "share",
+                "ms/frame");
+  out << head;
+  for (const StageGroup& g : GroupStages(stage_seconds)) {
+    out << StageRow(g.name, g.seconds, total, stage_frames);
+    // Parts under 0.1 % of all stages in one row when there are several (JSON: each).
+    size_t shown = g.parts.size();
+    while (shown > 0 && g.parts[shown - 1].second < 1e-3 * total) --shown;
+    if (g.parts.size() - shown < 2) shown = g.parts.size();
+    double rest = 0;
+    for (size_t k = 0; k < g.parts.size(); ++k) {
+      if (k < shown) {
+        out << StageRow("  ." + g.parts[k].first, g.parts[k].second, total, stage_frames);
+      } else {
+        rest += g.parts[k].second;
+      }
+    }
+    if (shown < g.parts.size()) {
+      out << StageRow("  (" + std::to_string(g.parts.size() - shown) + " more)", rest,
+                      total, stage_frames);
+    }
+  }
+  return out.str();
+}
 
 LabelSummary Summarize(const std::vector<std::string>& frames,
                        const std::map<std::string, FrameRecord>& records) {
@@ -89,6 +168,8 @@ LabelSummary Summarize(const std::vector<std::string>& frames,
     }
     const FrameRecord& r = it->second;
     s.frame_seconds += r.seconds;
+    for (const auto& [stage, seconds] : r.stages) s.stage_seconds[stage] += seconds;
+    s.stage_frames += r.stages.empty() ? 0 : 1;
     if (r.status == "ok") {
       ++s.ok;
       ++s.by_path[r.path];
@@ -120,6 +201,11 @@ nlohmann::json LabelSummary::ToJson() const {
   if (!by_crops.empty()) j["by_crops"] = by_crops;
   // A merge does not know a wall time (shards may run anywhere): no field then.
   if (wall_seconds > 0) j["wall_seconds"] = wall_seconds;
+  if (threads > 0) j["threads"] = threads;
+  if (stage_frames > 0) {
+    j["stage_seconds"] = stage_seconds;
+    j["stage_frames"] = stage_frames;
+  }
   nlohmann::json fails = nlohmann::json::array();
   for (const auto& [frame, reason] : failures)
     fails.push_back({{"frame", frame}, {"reason", reason}});
@@ -155,6 +241,7 @@ std::string LabelSummary::ToText() const {
   } else {
     out << "time: " << Number(frame_seconds, 1) << " s summed over frames\n";
   }
+  out << StageTable();
   const size_t shown = std::min<size_t>(failures.size(), 10);
   for (size_t i = 0; i < shown; ++i) {
     out << "  failed " << failures[i].first << ": " << failures[i].second << "\n";
@@ -211,6 +298,7 @@ std::string LabelSummary::ToMarkdown() const {
     }
     out << "\n";
   }
+  if (stage_frames > 0) out << "```\n" << StageTable() << "```\n\n";
   if (!failures.empty()) {
     out << "Failed frames:\n\n";
     for (const auto& [frame, reason] : failures)

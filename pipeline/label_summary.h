@@ -37,8 +37,14 @@ struct LabelSummary {
   // Jobs that track the hand: where the network's crops came from -> frames
   // ("detector": the frame was detected, "previous_label": it was not).
   std::map<std::string, int> by_crops;
-  double frame_seconds = 0;            // summed per-frame time of the latest records
+  double frame_seconds = 0;  // summed per-frame time of the latest records
+  // The same per stage (FrameRecord::stages; records of older logs have none): wall
+  // seconds spent inside each stage, summed over frames. Stages run side by side on
+  // `threads` threads, so they add up to more than wall_seconds.
+  std::map<std::string, double> stage_seconds;
+  int stage_frames = 0;     // frames whose records carry stage times
   double wall_seconds = 0;  // wall time of this run (0 for a merge: not written)
+  int threads = 0;          // threads the run labelled frames on (0: unknown, merge)
   int skipped = 0;          // done in an earlier run and skipped (run only)
   std::vector<std::pair<std::string, std::string>> failures;  // frame, reason
   // Where the job's 2D keypoints came from (FrameSource::KeypointsSource, or the
@@ -50,6 +56,11 @@ struct LabelSummary {
   nlohmann::json ToJson() const;
   // A few lines for the terminal at the end of a run or merge.
   std::string ToText() const;
+  // "Where the time went": stage_seconds as a table, stages grouped by the name before
+  // the dot ("detect" over "detect.palm", ...), groups and their parts longest first,
+  // with their share of all stages and per frame (a group's parts under 0.1 % of all
+  // in one row "(N more)"); "" without stage times.
+  std::string StageTable() const;
   // The same as a Markdown section (for reports).
   std::string ToMarkdown() const;
 };

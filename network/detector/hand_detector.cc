@@ -1,6 +1,7 @@
 #include "network/detector/hand_detector.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -8,6 +9,7 @@
 
 #include "core/errors.h"
 #include "core/option_checks.h"
+#include "core/stopwatch.h"
 #include "geometry/triangulation.h"
 
 namespace handlabel {
@@ -219,7 +221,9 @@ bool ProjectHand(const RigCamera& camera, const FrameHandResult& frame,
 void RunLandmarks(const MediapipeHands& detector, const ImageU8& image,
                   const NormalizedRect& roi, const std::string& source,
                   double min_presence, ViewHandResult* r) {
+  const auto start = std::chrono::steady_clock::now();
   r->hand = detector.LandmarksInRoi(image, roi);
+  r->landmarks_seconds += SecondsSince(start);
   r->detected = r->hand.presence >= min_presence;
   if (r->detected) {
     r->source = source;
@@ -284,7 +288,9 @@ int TrackViews(const MediapipeHands& detector, const Rig& rig,
 void RedetectLostView(const MediapipeHands& detector, const ImageU8& image,
                       ViewHandResult* r) {
   r->region = "palm";
+  const auto palm_start = std::chrono::steady_clock::now();
   r->palms = detector.DetectPalms(image);
+  r->palm_seconds += SecondsSince(palm_start);
   r->palm_candidates = static_cast<int>(r->palms.size());
   const RotatedRect track = r->hand.roi.ToPixels(image.width, image.height);
   const PalmDetection* nearest = nullptr;
@@ -296,8 +302,10 @@ void RedetectLostView(const MediapipeHands& detector, const ImageU8& image,
     if (d < nearest_px) nearest_px = d, nearest = &palm;
   }
   if (!nearest) return;
+  const auto landmarks_start = std::chrono::steady_clock::now();
   const HandLandmarks from_palm = detector.LandmarksInRoi(
       image, HandRoiFromPalm(*nearest, image.width, image.height));
+  r->landmarks_seconds += SecondsSince(landmarks_start);
   if (from_palm.presence < detector.options().min_presence ||
       from_palm.presence <= r->hand.presence) {
     return;
@@ -346,7 +354,9 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
   frame.views.resize(n);
   std::vector<std::vector<PalmDetection>> palms(n);
   for (int v = 0; v < n; ++v) {
+    const auto start = std::chrono::steady_clock::now();
     palms[v] = detector.DetectPalms(images[v]);
+    frame.views[v].palm_seconds = SecondsSince(start);
     frame.views[v].palm_candidates = static_cast<int>(palms[v].size());
     frame.views[v].palms = palms[v];
     frame.views[v].reason = "no_hand_in_frame";
@@ -434,10 +444,17 @@ FrameHandResult DetectHandInVideo(const MediapipeHands& detector, const Rig& rig
                                   const std::vector<ImageU8>& images,
                                   const FrameHandResult* previous,
                                   const MultiViewDetectorOptions& options) {
-  const auto per_frame = [&](const char* why) {
+  // `given_up`: the track this frame tried first, whose model time counts too.
+  const auto per_frame = [&](const char* why, const FrameHandResult* given_up = nullptr) {
     FrameHandResult frame = DetectHandMultiView(detector, rig, images, options);
     frame.tracking = why;
-    for (ViewHandResult& r : frame.views) r.region = "palm";
+    for (size_t v = 0; v < frame.views.size(); ++v) {
+      ViewHandResult& r = frame.views[v];
+      r.region = "palm";
+      if (!given_up) continue;
+      r.palm_seconds += given_up->views[v].palm_seconds;
+      r.landmarks_seconds += given_up->views[v].landmarks_seconds;
+    }
     return frame;
   };
   if (!previous) return per_frame("start");
@@ -450,7 +467,7 @@ FrameHandResult DetectHandInVideo(const MediapipeHands& detector, const Rig& rig
   frame.tracking = "track";
   if (TrackViews(detector, rig, images, *previous, options, &frame) <
       options.min_palm_views) {
-    return per_frame("lost");
+    return per_frame("lost", &frame);
   }
   std::vector<int> lost;
   for (int v = 0; v < static_cast<int>(frame.views.size()); ++v) {
@@ -464,7 +481,7 @@ FrameHandResult DetectHandInVideo(const MediapipeHands& detector, const Rig& rig
   });
   TriangulateKeypoints(rig, images, options, &frame);
   frame.found = frame.keypoint3d_valid[0];
-  if (!frame.found) return per_frame("lost");
+  if (!frame.found) return per_frame("lost", &frame);
   DropInconsistentViews(rig, images, options, &frame);
   VoteSide(&frame);
   return frame;

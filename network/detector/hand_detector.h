@@ -84,6 +84,11 @@ struct ViewHandResult {
   HandLandmarks hand;                // valid when detected
   Keypoints2d keypoints;  // distorted pixels, confidence per header rule; 0 = missing
   double median_reprojection_px = -1;  // against the triangulated keypoints; -1 unknown
+  // Wall seconds this view's palm detection and landmark model calls took (every pass,
+  // in video mode also a track given up for per-frame detection), for the label job's
+  // stage times; not written into detections files.
+  double palm_seconds = 0;
+  double landmarks_seconds = 0;
 };
 
 struct FrameHandResult {

@@ -150,6 +150,12 @@ TEST(LabelCommand, ShardsFromFlagOrEnvironmentMergeToTheSingleProcessResult) {
   EXPECT_THAT(merged.out, HasSubstr("2D keypoints: "));
   EXPECT_THAT(testing::ReadFileBytes(dir + "/sharded/summary.md"),
               HasSubstr("2D keypoints: "));
+  // The merge knows no wall time (shards may run anywhere: no zero written), but the
+  // shards' stage times summed over every frame.
+  const nlohmann::json merged_summary =
+      nlohmann::json::parse(testing::ReadFileBytes(dir + "/sharded/summary.json"));
+  EXPECT_FALSE(merged_summary.contains("wall_seconds"));
+  EXPECT_EQ(merged_summary.at("stage_frames").get<int>(), 5);
   EXPECT_EQ(testing::FilesUnder(dir + "/sharded/labels"),
             testing::FilesUnder(dir + "/single/labels"));
   EXPECT_EQ(testing::ReadFileBytes(dir + "/sharded/manifest.json"),
@@ -173,11 +179,15 @@ TEST(LabelCommand, FitOnlyJobLabelsEveryFrameCloseToTheGroundTruth) {
       nlohmann::json::parse(testing::ReadFileBytes(dir + "/out/summary.json"));
   // Simulated detections with ~2 px noise at 160x120: the fit lands within ~1.5 cm.
   EXPECT_LT(summary.at("metrics").at("labels").at("mpjpe_mm").get<double>(), 15.0);
-  // The merge knows no wall time (no zero written); the shard's summary has it.
-  EXPECT_FALSE(summary.contains("wall_seconds"));
+  // A run of the whole job merges at its end: its wall time and threads go into
+  // summary.json, as into its shard's summary, beside the stage times.
   const nlohmann::json shard = nlohmann::json::parse(
       testing::ReadFileBytes(dir + "/out/shards/shard-00000-of-00001.summary.json"));
   EXPECT_GT(shard.at("wall_seconds").get<double>(), 0.0);
+  EXPECT_EQ(summary.at("wall_seconds"), shard.at("wall_seconds"));
+  EXPECT_EQ(summary.at("threads"), shard.at("threads"));
+  EXPECT_EQ(summary.at("stage_frames").get<int>(), 3);
+  EXPECT_THAT(r.err, HasSubstr("where the time went (3 frames"));
   const LabelRecord label = ReadLabelFile(LabelFilePath(dir + "/out", "000001"));
   EXPECT_EQ(label.path, LabelPath::kFallbackFit);
   ASSERT_TRUE(label.params.has_value());

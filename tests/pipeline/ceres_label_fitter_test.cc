@@ -6,6 +6,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <set>
+
+#include "core/stopwatch.h"
+
 #include "pipeline/ceres_label_fitter.h"
 #include "pipeline/label_policy.h"
 #include "tests/pipeline/label_test_stages.h"
@@ -92,6 +97,29 @@ TEST_F(RefineAgainstFiles, AFarStartAlsoFitsFromTheViewsAndSaysWhichWon) {
   const LabelFit kept =
       CeresLabelFitter(capture_.model(), options).Fit(RefineRequest(frame, near));
   EXPECT_EQ(kept.report.at("init"), "network");
+}
+
+TEST_F(RefineAgainstFiles, TheFitSaysWhereItsTimeWentOutsideTheLabel) {
+  const FrameInput frame = capture_.Load(capture_.FrameIds()[0]);
+  const MeshPrediction far = ShiftedAnswer(frame, 0.10);
+  CeresLabelFitterOptions options;
+  options.restart_px = 15;  // two fits: from the answer and from the views
+  const auto start = std::chrono::steady_clock::now();
+  const LabelFit fit =
+      CeresLabelFitter(capture_.model(), options).Fit(RefineRequest(frame, far));
+  const double wall = SecondsSince(start);
+  std::set<std::string> stages;
+  for (const auto& [stage, seconds] : fit.stage_seconds) {
+    stages.insert(stage);
+    EXPECT_GE(seconds, 0.0) << stage;
+  }
+  EXPECT_EQ(stages,
+            (std::set<std::string>{"evidence", "init", "setup", "rigid", "keypoints",
+                                   "silhouettes", "evaluate", "silhouette_check"}));
+  EXPECT_GT(fit.stage_seconds.at("keypoints"), 0.0);
+  EXPECT_LE(TotalStageSeconds(fit.stage_seconds), wall);
+  // Timing never reaches the label (identical runs write identical labels).
+  EXPECT_EQ(fit.report.dump().find("second"), std::string::npos);
 }
 
 TEST_F(RefineAgainstFiles, WithoutFileViewsTheAnswerIsTheStartAndTheTarget) {

@@ -49,6 +49,28 @@ TEST(FrameLog, RecordsSurviveReopenAndLaterRecordsSupersede) {
   EXPECT_EQ(latest[0].path, "fit");
 }
 
+TEST(FrameLog, StageTimesRoundTripAndOlderRecordsHaveNone) {
+  const std::string path = TempDir() + "/shard-0-of-1.jsonl";
+  FrameRecord timed = Rec("000001", "ok", "fit", "", 0.5);
+  timed.stages = {{"read", 0.125}, {"detect.palm", 0.25}, {"fit.keypoints", 0.125}};
+  {
+    FrameLog log(path);
+    log.Record(timed);
+    log.Record(Rec("000002", "ok", "fit", "", 0.2));  // as a log before stage times
+  }
+  const std::vector<FrameRecord> read = FrameLog::Read(path);
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[0].stages, timed.stages);
+  EXPECT_TRUE(read[1].stages.empty());
+  // An older record's line has no "stages" field at all.
+  std::ifstream in(path);
+  std::string first, second;
+  std::getline(in, first);
+  std::getline(in, second);
+  EXPECT_NE(first.find("\"stages\""), std::string::npos);
+  EXPECT_EQ(second.find("\"stages\""), std::string::npos);
+}
+
 TEST(FrameLog, PartialLastLineFromACrashIsIgnored) {
   const std::string path = TempDir() + "/log.jsonl";
   {
