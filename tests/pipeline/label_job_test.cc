@@ -32,13 +32,7 @@ struct Stages {
   TestPredictor predictor;
   TestFitter fitter;
   LabelStageSet Set(bool with_network = true) {
-    LabelStageSet set;
-    set.source = &capture;
-    set.predictor = with_network ? &predictor : nullptr;
-    set.fitter = &fitter;
-    set.hand_model_name = capture.model().name;
-    set.faces = capture.model().faces;
-    return set;
+    return testing::TestStageSet(capture, with_network ? &predictor : nullptr, &fitter);
   }
 };
 

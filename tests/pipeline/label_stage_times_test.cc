@@ -93,15 +93,7 @@ struct SlowStages {
       return predictor.Predict(frames);
     };
   }
-  LabelStageSet Set() {
-    LabelStageSet set;
-    set.source = &capture;
-    set.predictor = &predictor;
-    set.fitter = &fitter;
-    set.hand_model_name = capture.model().name;
-    set.faces = capture.model().faces;
-    return set;
-  }
+  LabelStageSet Set() { return testing::TestStageSet(capture, &predictor, &fitter); }
 };
 
 // What the job left: its summary, its shard log and its summary.json.
@@ -249,12 +241,7 @@ TEST(LabelStageTimesTracked, TheJobsOwnDetectorCallsAreTimedWhereTheyRan) {
   constexpr double kReportedLandmarks = 0.004;
   std::set<std::string> detected;
   std::mutex mutex;
-  LabelStageSet set;
-  set.source = &capture;
-  set.predictor = &network;
-  set.fitter = &fitter;
-  set.hand_model_name = capture.model().name;
-  set.faces = capture.model().faces;
+  LabelStageSet set = testing::TestStageSet(capture, &network, &fitter);
   set.find_keypoints_2d = [&](FrameInput* frame) {
     std::this_thread::sleep_for(std::chrono::milliseconds(6));
     for (const RigCamera& camera : frame->rig.cameras()) {

@@ -236,4 +236,17 @@ class TestFitter : public LabelFitter {
   mutable std::atomic<int> fits{0};
 };
 
+// A test job's stages: its capture, network (nullptr: none) and fitter, with the
+// capture's hand model named and its faces for the mesh files.
+inline LabelStageSet TestStageSet(const TestCapture& capture, const NetworkStage* network,
+                                  const LabelFitter* fitter) {
+  LabelStageSet set;
+  set.source = &capture;
+  set.predictor = network;
+  set.fitter = fitter;
+  set.hand_model_name = capture.model().name;
+  set.faces = capture.model().faces;
+  return set;
+}
+
 }  // namespace handlabel::testing

@@ -66,12 +66,7 @@ struct TrackingStages {
   }
 
   LabelStageSet Set() {
-    LabelStageSet set;
-    set.source = &capture;
-    set.predictor = &network;
-    set.fitter = &fitter;
-    set.hand_model_name = capture.model().name;
-    set.faces = capture.model().faces;
+    LabelStageSet set = testing::TestStageSet(capture, &network, &fitter);
     set.find_keypoints_2d = [this](FrameInput* frame) {
       std::lock_guard<std::mutex> lock(mutex);
       detected.push_back(frame->id);
