@@ -6,14 +6,9 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <memory>
@@ -29,6 +24,7 @@
 #include "pipeline/build_info.h"
 #include "pipeline/frame_log.h"
 #include "pipeline/frame_metrics.h"
+#include "pipeline/job_stamp.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_policy.h"
 #include "pipeline/output_lock.h"
@@ -77,57 +73,6 @@ std::string Describe(const std::exception_ptr& error) {
   } catch (...) {
     return "unknown error";
   }
-}
-
-// The job hash recorded in job.json.
-std::string RecordedJobHash(const std::string& stamp) {
-  std::ifstream in(stamp);
-  try {
-    return nlohmann::json::parse(in).at("job_hash").get<std::string>();
-  } catch (const std::exception& e) {
-    throw InputError(stamp, "job_hash", "a job stamp written by handlabel", e.what());
-  }
-}
-
-// Creates `path` with `content` unless it exists (no-replace, so that shards starting
-// together cannot overwrite each other's stamp); false if it existed.
-bool CreateFileIfAbsent(const std::string& path, const std::string& content) {
-  const std::string staged = path + ".tmp." + std::to_string(::getpid()) + ".new";
-  WriteFileAtomically(staged, content);
-  const bool created = ::link(staged.c_str(), path.c_str()) == 0;
-  const int error = errno;
-  fs::remove(staged);
-  if (!created && error != EEXIST) {
-    throw InputError(path, "", "a job stamp the run can create", std::strerror(error));
-  }
-  return created;
-}
-
-// A folder holds the outputs of one job: refuse to mix labels of different jobs.
-// Replacing another job's stamp (--force) needs the folder to itself.
-void ClaimOutputFolder(const JobConfig& job, const std::string& job_hash, bool force,
-                       OutputFolderLock* lock) {
-  const std::string stamp = JobStampPath(job.output_dir);
-  const nlohmann::json j = {
-      {"job", job.name}, {"job_hash", job_hash}, {"job_file", job.source_file}};
-  if (!fs::exists(stamp) && CreateFileIfAbsent(stamp, j.dump(1) + "\n")) return;
-  const std::string recorded = RecordedJobHash(stamp);
-  if (recorded == job_hash) return;
-  if (!force) {
-    throw InputError(stamp, "job_hash",
-                     "this job's hash " + job_hash +
-                         " (the folder holds labels of a different job or job version; "
-                         "use another output.dir, or --force to relabel every frame)",
-                     recorded);
-  }
-  lock->MakeWhole("replace " + stamp + " of another job");
-  // The other job's records describe labels this job replaces: none may count as done.
-  std::error_code ignored;
-  for (const auto& e :
-       fs::directory_iterator(fs::path(job.output_dir) / "shards", ignored)) {
-    if (e.path().extension() == ".jsonl") fs::remove(e.path(), ignored);
-  }
-  WriteFileAtomically(stamp, j.dump(1) + "\n");
 }
 
 // One run of one shard of a job: plan (frames, resume, folder), label every frame to

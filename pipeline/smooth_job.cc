@@ -22,6 +22,7 @@
 #include "hand/metrics.h"
 #include "pipeline/frame_metrics.h"
 #include "pipeline/hand_model_source.h"
+#include "pipeline/job_stamp.h"
 #include "pipeline/label_job.h"
 #include "pipeline/label_outputs.h"
 #include "pipeline/label_overlay.h"
@@ -82,20 +83,6 @@ std::optional<DetectorKeypointModel> SequenceDetectorKeypoints(const JobConfig& 
                      setting + " (" + path + " does not exist)");
   }
   return ReadDetectorKeypointModel(path);
-}
-
-std::string RecordedJobHash(const std::string& output_dir) {
-  const std::string stamp = (fs::path(output_dir) / "job.json").string();
-  std::ifstream in(stamp);
-  if (!in) {
-    throw InputError(stamp, "", "the job stamp of a labelled job (run `handlabel label`)",
-                     "missing");
-  }
-  try {
-    return json::parse(in).at("job_hash").get<std::string>();
-  } catch (const std::exception& e) {
-    throw InputError(stamp, "job_hash", "a job stamp written by handlabel", e.what());
-  }
 }
 
 // The job's frames with the 2D the per-frame labels were fitted to: the job's own
