@@ -147,6 +147,12 @@ int RunDetect(int argc, char** argv) {
                     s.views_tracked, s.frames_tracked);
       }
       std::printf("); %.1f s\n", s.seconds);
+      if (s.worker_parks > 0) {
+        std::printf(
+            "other processes kept the cores busy: frames ran one at a time %d time(s) "
+            "(docs/speed.md, \"Threads under load\")\n",
+            s.worker_parks);
+      }
       std::cout << "detections: " << capture_dir << "/detections\n";
       return 0;
     });

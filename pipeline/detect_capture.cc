@@ -1,12 +1,13 @@
 #include "pipeline/detect_capture.h"
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <limits>
 #include <mutex>
 #include <optional>
+#include <thread>
 
-#include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -20,6 +21,7 @@
 #include "core/json_util.h"
 #include "core/option_checks.h"
 #include "core/stopwatch.h"
+#include "core/worker_governor.h"
 #include "image/image_file.h"
 #include "network/detector/detector_overlay.h"
 
@@ -67,6 +69,7 @@ void DetectCaptureSummary::Add(const DetectCaptureSummary& other) {
   views_tracked += other.views_tracked;
   frames_tracked += other.frames_tracked;
   frames_with_hand += other.frames_with_hand;
+  worker_parks += other.worker_parks;
 }
 
 std::vector<FrameRun> FrameRuns(int total, int palm_every) {
@@ -189,26 +192,42 @@ DetectCaptureSummary DetectCapture(const std::string& capture_dir,
   const int total = capture.num_frames();
   const std::vector<FrameRun> runs =
       FrameRuns(total, options.video ? options.palm_every : 1);
-  tbb::task_arena arena(options.threads > 0 ? options.threads
-                                            : tbb::info::default_concurrency());
+  const int workers =
+      options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+  // Workers take the next run until none is left; the governor parks all but the first
+  // while other processes keep the cores busy (core/worker_governor.h).
+  WorkerGovernorOptions governed;
+  governed.calibration = std::chrono::milliseconds(30);
+  WorkerGovernor governor(workers, governed);
+  governor.Calibrate();
+  std::atomic<size_t> next_run{0};
+  const auto detect_run = [&](size_t k) {
+    std::optional<FrameHandResult> previous;
+    for (int f = runs[k].begin; f < runs[k].end; ++f) {
+      DetectCaptureSummary frame;
+      previous = DetectFrame(capture, f, detector, options,
+                             previous ? &*previous : nullptr, &frame);
+      const std::lock_guard<std::mutex> lock(mutex);
+      summary.Add(frame);
+      if (on_frame) on_frame(summary.frames, total);
+    }
+  };
+  tbb::task_arena arena(workers);
   arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, runs.size(), 1),
-        [&](const tbb::blocked_range<size_t>& range) {
-          for (size_t k = range.begin(); k != range.end(); ++k) {
-            std::optional<FrameHandResult> previous;
-            for (int f = runs[k].begin; f < runs[k].end; ++f) {
-              DetectCaptureSummary frame;
-              previous = DetectFrame(capture, f, detector, options,
-                                     previous ? &*previous : nullptr, &frame);
-              const std::lock_guard<std::mutex> lock(mutex);
-              summary.Add(frame);
-              if (on_frame) on_frame(summary.frames, total);
-            }
-          }
-        },
-        tbb::simple_partitioner());
+    tbb::parallel_for(0, workers, [&](int worker) {
+      while (next_run.load() < runs.size()) {
+        if (!governor.MayRun(worker)) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
+          continue;
+        }
+        const size_t k = next_run.fetch_add(1);
+        // Isolated: while a run waits for its views' tasks, its thread must not take up
+        // another worker's loop (a parked one would then sleep on top of this run).
+        if (k < runs.size()) tbb::this_task_arena::isolate([&] { detect_run(k); });
+      }
+    });
   });
+  summary.worker_parks = governor.parks();
   ListDetections(capture);
   summary.seconds = SecondsSince(t0);
   return summary;

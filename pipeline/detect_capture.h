@@ -49,6 +49,9 @@ struct DetectCaptureSummary {
   int views_tracked = 0;     // ... whose ROI came from the previous frame (video mode)
   int frames_tracked = 0;    // frames whose regions came from the previous frame
   int frames_with_hand = 0;  // frames where a 3D hand was established
+  // Times the workers but one were parked because other processes kept the cores busy
+  // (core/worker_governor.h).
+  int worker_parks = 0;
   double seconds = 0;
   // Adds another part's counts (not its seconds).
   void Add(const DetectCaptureSummary& other);
