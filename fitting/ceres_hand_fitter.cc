@@ -72,7 +72,12 @@ CeresHandFitter::CeresHandFitter(const HandModel& model, const HandFitConfig& co
       evaluator_(model, (config.Check("HandFitConfig"), options.Check("HandFitOptions"),
                          EvaluatorOptionsFor(model, config))),
       anatomy_(ComputeHandAnatomy(model)),
-      limits_(DefaultHandLimits()) {}
+      limits_(DefaultHandLimits()) {
+  if (options.detector_keypoints) {
+    options.detector_keypoints->Check("HandFitOptions detector_keypoints",
+                                      static_cast<int>(model.num_vertices()));
+  }
+}
 
 HandParams CeresHandFitter::InitFromKeypoints3d(const Points3d& keypoints,
                                                 const Eigen::VectorXd& weights) const {

@@ -16,6 +16,7 @@
 // coefficients), the first 10 betas, transl. Units: metres, radians, pixels.
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "fitting/points3d_targets.h"
 #include "fitting/robust_loss.h"
 #include "fitting/silhouette_outline.h"
+#include "hand/detector_keypoints.h"
 #include "hand/hand_anatomy.h"
 #include "hand/hand_evaluator.h"
 #include "hand/hand_lbs.h"
@@ -121,6 +123,11 @@ struct HandFitOptions {
   double triangulation_inlier_px = 10.0;
   // Distance from the first camera used when fewer than 3 palm keypoints triangulate.
   double fallback_depth_m = 0.6;
+  // Where the 2D keypoints lie on the hand (hand/detector_keypoints.h): the keypoint
+  // term compares the detector's keypoints of the hand (a MediaPipe keypoint is not at
+  // the model's joint) with the 2D; nullptr = the model's own keypoints. The fitted
+  // hand's joints stay the model's. Checked against the model in the fitter.
+  std::shared_ptr<const DetectorKeypointModel> detector_keypoints;
   // Throws InputError naming the field.
   void Check(const std::string& source) const;
 };

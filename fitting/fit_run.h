@@ -417,7 +417,8 @@ class FitRun {
   void AddEvidence(StageProblem* problem, FitState* s, bool with_priors) const {
     if (s->use_kp) {
       auto* keypoints = new MultiViewKeypointSquareRootCost(
-          evaluator_, s->input.views, options_.keypoint_loss, options_.keypoint_sigma_px);
+          evaluator_, s->input.views, options_.keypoint_loss, options_.keypoint_sigma_px,
+          options_.detector_keypoints.get());
       if (with_priors) {
         ForEachPrior([&](const char* name, ceres::CostFunction* cost, int block) {
           keypoints->folded()->Add(name, cost, block);

@@ -2,9 +2,11 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "core/data_dir.h"
 #include "core/errors.h"
 #include "core/json_util.h"
 #include "core/option_checks.h"
@@ -243,6 +245,20 @@ DetectorKeypointModel ReadDetectorKeypointModel(const std::string& path) {
   }
   model.Check(path, model.num_vertices);
   return model;
+}
+
+std::optional<DetectorKeypointModel> DetectorKeypointModelOfSetting(
+    const std::string& setting, const std::string& source, const std::string& field) {
+  if (setting == "none") return std::nullopt;
+  const std::string path = setting == "mediapipe"
+                               ? ShippedModelPath("detector_keypoints_mediapipe.json")
+                               : setting;
+  if (!std::filesystem::exists(path)) {
+    throw InputError(source, field,
+                     "none, mediapipe or an existing detector keypoint model file",
+                     setting + " (" + path + " does not exist)");
+  }
+  return ReadDetectorKeypointModel(path);
 }
 
 }  // namespace handlabel

@@ -19,6 +19,7 @@
 // stay the model's.
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -134,5 +135,12 @@ DetectorKeypointModel LearnDetectorKeypoints(
 void WriteDetectorKeypointModel(const std::string& path,
                                 const DetectorKeypointModel& model);
 DetectorKeypointModel ReadDetectorKeypointModel(const std::string& path);
+
+// A job field's setting (`fit.detector_keypoints`, `sequence.detector_keypoints`): "none"
+// (nothing: the 2D marks the model's keypoints), "mediapipe" (the shipped
+// models/detector_keypoints_mediapipe.json) or a model file. Throws InputError naming
+// `source` and `field` when the file does not exist.
+std::optional<DetectorKeypointModel> DetectorKeypointModelOfSetting(
+    const std::string& setting, const std::string& source, const std::string& field);
 
 }  // namespace handlabel

@@ -71,6 +71,10 @@ void CheckFitSettings(const FitSettings& fit, const std::string& f) {
   if (fit.silhouette_rounds) {
     RequireAtLeast(f, "fit.silhouette_rounds", *fit.silhouette_rounds, 0);
   }
+  if (fit.detector_keypoints && fit.detector_keypoints->empty()) {
+    throw InputError(f, "fit.detector_keypoints",
+                     "none, mediapipe or a detector keypoint model file", "\"\"");
+  }
   if (fit.unknown_occluders && *fit.unknown_occluders != "one_sided" &&
       *fit.unknown_occluders != "two_sided") {
     throw InputError(f, "fit.unknown_occluders", "one_sided | two_sided",
@@ -123,6 +127,7 @@ void ReadFitSection(Section& top, JobConfig* job) {
   ReadOptional(fit, "optimise_shape", &s.optimise_shape);
   ReadOptional(fit, "silhouette_check", &s.silhouette_check);
   ReadOptional(fit, "unknown_occluders", &s.unknown_occluders);
+  ReadOptional(fit, "detector_keypoints", &s.detector_keypoints);
   fit.RejectUnknownKeys();
 }
 
@@ -233,7 +238,7 @@ bool FitSettings::IsDefault() const {
   return init == "triangulate" && !keypoint_loss && !keypoint_loss_scale &&
          !keypoint_sigma_px && !silhouette_sigma_px && !silhouette_rounds &&
          !pose_pca_comps && !joint_limits && !optimise_shape && !silhouette_check &&
-         !unknown_occluders && !mask_margin_px;
+         !unknown_occluders && !mask_margin_px && !detector_keypoints;
 }
 
 std::string ToString(RefineMode mode) {
@@ -452,6 +457,10 @@ JobConfig LoadJobConfig(const std::string& path) {
   job.network_weights = Resolve(job.network_weights, base);
   job.output_dir = Resolve(job.output_dir, base);
   if (!IsFitInitKeyword(job.fit.init)) job.fit.init = Resolve(job.fit.init, base);
+  if (std::optional<std::string>& model = job.fit.detector_keypoints;
+      model && *model != "none" && *model != "mediapipe") {
+    *model = Resolve(*model, base);
+  }
   job.Check(path);
   return job;
 }

@@ -71,6 +71,11 @@ struct FitSettings {
   // "two_sided" (the full term, guarded by the silhouette check; the default) or
   // "one_sided" (only observed hand pixels must be covered).
   std::optional<std::string> unknown_occluders;
+  // Where the 2D keypoints lie on the hand (hand/detector_keypoints.h): "none",
+  // "mediapipe" (the shipped model of MediaPipe Hands' keypoints) or a model file. With
+  // a model every fit's keypoint term compares the detector's keypoints of the hand with
+  // the 2D, so the labels' joints and bones are the hand's, not the detector's.
+  std::optional<std::string> detector_keypoints;
 
   // True when nothing differs from the defaults (the job hash then leaves `fit` out,
   // so jobs written before the section existed keep their hash).

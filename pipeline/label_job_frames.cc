@@ -33,6 +33,9 @@ nlohmann::json FitSettingsJson(const FitSettings& f) {
     j.push_back({Optional(f.silhouette_check), Optional(f.unknown_occluders)});
   }
   if (f.mask_margin_px) j.push_back({{"mask_margin_px", *f.mask_margin_px}});
+  if (f.detector_keypoints) {
+    j.push_back({{"detector_keypoints", *f.detector_keypoints}});
+  }
   return j;
 }
 

@@ -1,5 +1,7 @@
 #include "pipeline/label_stage_factory.h"
 
+#include "hand/detector_keypoints.h"
+
 #include "capture/detections_frame_source.h"
 #include "capture/dexycb_frame_source.h"
 #include "capture/ho3d_frame_source.h"
@@ -39,6 +41,13 @@ CeresLabelFitterOptions FitterOptions(const JobConfig& job) {
   o.check_silhouettes = s.silhouette_check.value_or(o.check_silhouettes);
   if (s.unknown_occluders) {
     o.one_sided_without_object_masks = *s.unknown_occluders == "one_sided";
+  }
+  if (s.detector_keypoints) {
+    if (auto model = DetectorKeypointModelOfSetting(
+            *s.detector_keypoints, job.source_file, "fit.detector_keypoints")) {
+      o.fit.detector_keypoints =
+          std::make_shared<const DetectorKeypointModel>(std::move(*model));
+    }
   }
   return o;
 }

@@ -16,7 +16,6 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
-#include "core/data_dir.h"
 #include "core/errors.h"
 #include "fitting/sequence_smoother.h"
 #include "hand/metrics.h"
@@ -72,17 +71,8 @@ json SmoothingStamp(const JobConfig& job, const std::string& job_hash,
 
 // sequence.detector_keypoints read: none, the shipped MediaPipe model or a file.
 std::optional<DetectorKeypointModel> SequenceDetectorKeypoints(const JobConfig& job) {
-  const std::string& setting = job.sequence.detector_keypoints;
-  if (setting == "none") return std::nullopt;
-  const std::string path = setting == "mediapipe"
-                               ? ShippedModelPath("detector_keypoints_mediapipe.json")
-                               : setting;
-  if (!fs::exists(path)) {
-    throw InputError(job.source_file, "sequence.detector_keypoints",
-                     "none, mediapipe or an existing detector keypoint model file",
-                     setting + " (" + path + " does not exist)");
-  }
-  return ReadDetectorKeypointModel(path);
+  return DetectorKeypointModelOfSetting(job.sequence.detector_keypoints, job.source_file,
+                                        "sequence.detector_keypoints");
 }
 
 // The job's frames with the 2D the per-frame labels were fitted to: the job's own

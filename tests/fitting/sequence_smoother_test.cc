@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 
 #include "fitting/acceleration_cost.h"
@@ -278,6 +279,44 @@ TEST(SequenceShapeFromEvidence, RecoversTheBonesOfAHandSeenThroughAnOffsetDetect
   EXPECT_GT(from_medians, 0.0015) << "the detector's offsets must bias the bones";
   EXPECT_GT(without_model, 0.0015);
   EXPECT_LT(with, 0.001) << "medians " << from_medians << ", evidence " << without_model;
+}
+
+// The per-frame fit with the detector's model (HandFitOptions::detector_keypoints, job
+// field fit.detector_keypoints): fitting the model's own keypoints to such a detector's
+// 2D puts the labels' joints where the detector marks them, a few mm off; comparing
+// the detector's keypoints of the hand with the 2D puts them on the hand's joints.
+TEST(PerFrameFit, WithTheDetectorsModelTheJointsAreTheHands) {
+  const HandModel model = MakeCapsuleHand(HandSide::kRight);
+  auto detector = std::make_shared<const DetectorKeypointModel>(OffsetDetector(model));
+  MovingHand hand = MakeMovingHand(model, 4);
+  std::mt19937_64 rng(47);
+  HandFitOptions with_model;
+  with_model.detector_keypoints = detector;
+  const CeresHandFitter plain(model), aware(model, {}, with_model);
+  double error_plain = 0, error_aware = 0;
+  for (size_t f = 0; f < hand.params.size(); ++f) {
+    const Points3d seen =
+        DetectorKeypointsOfMesh(*detector, PoseHand(model, hand.params[f]));
+    std::vector<KeypointView> views = hand.views[f];
+    for (KeypointView& view : views) {
+      for (int k = 0; k < kNumHandKeypoints; ++k) {
+        Eigen::Vector2d uv;
+        view.camera.ProjectWorld(seen.row(k).transpose(), &uv);
+        view.keypoints.uv_px.row(k) = uv.transpose();
+      }
+    }
+    CorruptViews(&views, 1.0, 0.0, {}, rng);
+    HandFitInput input;
+    input.views = views;
+    error_plain += Mpjpe({plain.Fit(input, plain.InitFromViews(views)).keypoints},
+                         {hand.keypoints[f]});
+    error_aware += Mpjpe({aware.Fit(input, aware.InitFromViews(views)).keypoints},
+                         {hand.keypoints[f]});
+  }
+  error_plain /= hand.params.size();
+  error_aware /= hand.params.size();
+  EXPECT_GT(error_plain, 0.002) << "the detector's offsets must move the joints";
+  EXPECT_LT(error_aware, error_plain / 3) << error_plain;
 }
 
 TEST(SequenceSmoothOptions, ChecksNameTheField) {

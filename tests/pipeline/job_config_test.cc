@@ -8,6 +8,7 @@
 
 #include "core/errors.h"
 #include "pipeline/label_job.h"
+#include "pipeline/label_stage_factory.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -152,6 +153,39 @@ TEST(JobConfig, SequenceSection) {
           .sequence.smooth);
   // The section does not enter the job hash: per-frame labels stay where they were.
   EXPECT_EQ(JobHash(plain, ""), JobHash(job, ""));
+}
+
+// fit.detector_keypoints: unset keeps the fit's defaults (and the job hash); set, it
+// enters the hash (the labels change) and the fitter gets the detector's model.
+TEST(JobConfig, FitDetectorKeypoints) {
+  const std::string base =
+      "input: {path: c}\noutput: {dir: o}\nnetwork: {weights: w}\n"
+      "evidence: {keypoints_2d: files}\n";
+  const JobConfig plain = LoadJobConfig(WriteJob(base));
+  EXPECT_FALSE(plain.fit.detector_keypoints);
+  EXPECT_TRUE(plain.fit.IsDefault());
+  EXPECT_EQ(FitterOptions(plain).fit.detector_keypoints, nullptr);
+  const JobConfig none =
+      LoadJobConfig(WriteJob(base + "fit: {detector_keypoints: none}\n"));
+  EXPECT_EQ(FitterOptions(none).fit.detector_keypoints, nullptr);
+  const JobConfig mediapipe =
+      LoadJobConfig(WriteJob(base + "fit: {detector_keypoints: mediapipe}\n"));
+  EXPECT_NE(JobHash(mediapipe, ""), JobHash(plain, ""));
+  EXPECT_NE(JobHash(mediapipe, ""), JobHash(none, ""));
+  const auto model = FitterOptions(mediapipe).fit.detector_keypoints;
+  ASSERT_NE(model, nullptr);
+  EXPECT_EQ(model->detector, "mediapipe");
+  ExpectError(base + "fit: {detector_keypoints: \"\"}\n", "fit.detector_keypoints",
+              "none, mediapipe or");
+  const JobConfig missing =
+      LoadJobConfig(WriteJob(base + "fit: {detector_keypoints: no_such_model.json}\n"));
+  try {
+    FitterOptions(missing);
+    ADD_FAILURE() << "a missing model file must be refused";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("fit.detector_keypoints"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("no_such_model.json"));
+  }
 }
 
 // evidence.keypoints_2d: detector: the detector's 2D counts as file evidence, with the
