@@ -233,6 +233,26 @@ DetectorKeypointModel OffsetDetector(const HandModel& model) {
   return d;
 }
 
+// Frame f of `hand` as `detector` sees it: its keypoints of the posed hand projected
+// into every view, with noise_px of noise.
+std::vector<KeypointView> ViewsThroughDetector(const DetectorKeypointModel& detector,
+                                               const HandModel& model,
+                                               const MovingHand& hand, size_t f,
+                                               double noise_px, std::mt19937_64& rng) {
+  const Points3d seen =
+      DetectorKeypointsOfMesh(detector, PoseHand(model, hand.params[f]));
+  std::vector<KeypointView> views = hand.views[f];
+  for (KeypointView& view : views) {
+    for (int k = 0; k < kNumHandKeypoints; ++k) {
+      Eigen::Vector2d uv;
+      view.camera.ProjectWorld(seen.row(k).transpose(), &uv);
+      view.keypoints.uv_px.row(k) = uv.transpose();
+    }
+  }
+  CorruptViews(&views, noise_px, 0.0, {}, rng);
+  return views;
+}
+
 // The per-frame fits of the model's keypoints to such a detector's 2D (2 px noise) have
 // the detector's bones, and so has a shape from their medians or from the evidence
 // without the detector's model; with it, the shape fitted to the evidence of the frames
@@ -247,17 +267,8 @@ TEST(SequenceShapeFromEvidence, RecoversTheBonesOfAHandSeenThroughAnOffsetDetect
   std::vector<Points3d> per_frame_keypoints;
   std::vector<HandParams> per_frame;
   for (size_t f = 0; f < hand.params.size(); ++f) {
-    const Points3d seen =
-        DetectorKeypointsOfMesh(detector, PoseHand(model, hand.params[f]));
-    std::vector<KeypointView> views = hand.views[f];
-    for (KeypointView& view : views) {
-      for (int k = 0; k < kNumHandKeypoints; ++k) {
-        Eigen::Vector2d uv;
-        view.camera.ProjectWorld(seen.row(k).transpose(), &uv);
-        view.keypoints.uv_px.row(k) = uv.transpose();
-      }
-    }
-    CorruptViews(&views, 2.0, 0.0, {}, rng);
+    const std::vector<KeypointView> views =
+        ViewsThroughDetector(detector, model, hand, f, 2.0, rng);
     HandFitInput input;
     input.views = views;
     const HandFitResult fit = fitter.Fit(input, fitter.InitFromViews(views));
@@ -295,17 +306,8 @@ TEST(PerFrameFit, WithTheDetectorsModelTheJointsAreTheHands) {
   const CeresHandFitter plain(model), aware(model, {}, with_model);
   double error_plain = 0, error_aware = 0;
   for (size_t f = 0; f < hand.params.size(); ++f) {
-    const Points3d seen =
-        DetectorKeypointsOfMesh(*detector, PoseHand(model, hand.params[f]));
-    std::vector<KeypointView> views = hand.views[f];
-    for (KeypointView& view : views) {
-      for (int k = 0; k < kNumHandKeypoints; ++k) {
-        Eigen::Vector2d uv;
-        view.camera.ProjectWorld(seen.row(k).transpose(), &uv);
-        view.keypoints.uv_px.row(k) = uv.transpose();
-      }
-    }
-    CorruptViews(&views, 1.0, 0.0, {}, rng);
+    const std::vector<KeypointView> views =
+        ViewsThroughDetector(*detector, model, hand, f, 1.0, rng);
     HandFitInput input;
     input.views = views;
     error_plain += Mpjpe({plain.Fit(input, plain.InitFromViews(views)).keypoints},
