@@ -10,7 +10,11 @@
 
 #include "capture/capture_format.h"
 #include "capture/detections_frame_source.h"
+#include "capture/native_frame_source.h"
+#include "capture/synth_capture.h"
 #include "core/errors.h"
+#include "core/json_util.h"
+#include "hand/capsule_hand.h"
 #include "tests/test_util.h"
 
 namespace handlabel {
@@ -132,6 +136,46 @@ TEST(DetectionsHands, MalformedOtherHandsAreRefusedByName) {
   EXPECT_THAT(testing::InputErrorOf(
                   [&] { ChooseDetectionsHand(no_found, HandSide::kLeft, "det.json"); }),
               HasSubstr("other_hands[0].hand.found"));
+}
+
+// A native capture of the left hand whose detections hold two hands, the right one first
+// (it had more views): a label job's reader takes the left one and says so.
+TEST(DetectionsHands, ANativeCaptureOfTheLeftHandReadsItsLeftHand) {
+  const std::string dir = testing::ScratchDir() + "/cap";
+  SynthCaptureOptions o;
+  o.rig.preset = "random";
+  o.rig.num_cameras = 2;
+  o.rig.width = 120;
+  o.rig.height = 90;
+  o.num_frames = 1;
+  o.num_threads = 1;
+  WriteSynthCapture(MakeCapsuleHand(HandSide::kLeft), o, dir, "builtin:capsule");
+  const std::string path = dir + "/detections/000000.json";
+  nlohmann::json file = ReadJsonFileStrict(path);
+  nlohmann::json left = file;  // the simulated views, moved 3 px to the right
+  left.erase("frame");
+  for (nlohmann::json& view : left["views"]) {
+    for (nlohmann::json& kp : view["keypoints"]) {
+      if (!kp[0].is_null()) kp[0] = kp[0].get<double>() + 3;
+    }
+  }
+  left["hand"] = {{"found", true}, {"side", "left"}};
+  file["hand"] = {{"found", true}, {"side", "right"}};
+  file["other_hands"] = {left};
+  file["max_hands"] = 2;
+  std::ofstream(path) << file.dump();
+
+  const NativeFrameSource source(dir, std::nullopt, "detections");
+  ASSERT_EQ(source.side(), HandSide::kLeft);
+  const FrameInput frame = source.Load("000000");
+  EXPECT_EQ(frame.evidence_hand, "hand 2 of 2 (left)");
+  const nlohmann::json& first_view = file["views"][0];
+  for (int k = 0; k < kNumHandKeypoints; ++k) {
+    if (first_view["keypoints"][k][0].is_null()) continue;
+    ASSERT_TRUE(frame.keypoints_2d[0]);
+    EXPECT_DOUBLE_EQ(frame.keypoints_2d[0]->uv_px(k, 0),
+                     first_view["keypoints"][k][0].get<double>() + 3);
+  }
 }
 
 }  // namespace
