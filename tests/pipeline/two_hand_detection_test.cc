@@ -10,7 +10,7 @@
 // truth of each hand is its own capture's projected keypoints. Real MediaPipe models
 // (models/mediapipe; the tests skip without them).
 //
-// HANDLABEL_TWO_HAND_FRAMES=N (default 3) measures on N frames and prints the counts
+// HANDLABEL_TWO_HAND_FRAMES=N (default 1) measures on N frames and prints the counts
 // (docs/detector.md, "Several hands").
 
 #include <gtest/gtest.h>
@@ -134,7 +134,7 @@ HandSide TrueSide(const FrameHandResult& hand, const TwoHandFrame& frame) {
 
 int FramesToMeasure() {
   const char* text = std::getenv("HANDLABEL_TWO_HAND_FRAMES");
-  return text ? std::max(1, std::atoi(text)) : 2;
+  return text ? std::max(1, std::atoi(text)) : 1;
 }
 
 // Views where the palm detector found a palm of the true hand `truth`: a palm whose box
