@@ -321,8 +321,12 @@ bool FoundWithSide(const json& record, const std::string& wanted,
 
 DetectionsHandChoice ChooseDetectionsHand(const json& file, std::optional<HandSide> side,
                                           const std::string& source) {
-  const std::string wanted = HandSideName(side.value_or(HandSide::kRight));
   DetectionsHandChoice choice;
+  if (!side) {  // a reader of the first hand (contact sheets)
+    choice.record = file;
+    return choice;
+  }
+  const std::string wanted = HandSideName(*side);
   const bool first_matches = FoundWithSide(file, wanted, source, "", &choice.side);
   const json* others = file.contains("other_hands") ? &file["other_hands"] : nullptr;
   if (others && !others->is_array())

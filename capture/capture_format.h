@@ -125,11 +125,12 @@ struct DetectionsHandChoice {
   // "hand 2 of 2 (left)" for logs; "" when one hand was looked for.
   std::string Describe() const;
 };
-// The first hand with "found" true whose "side" is `side` (nullopt: the right hand, as
-// a capture that does not say), else the first (the hand most views confirmed) in a file
-// of one hand looked for. In a file where several were ("max_hands" > 1) and none of them
-// is of that side: InputError (the frame fails: another hand is not the capture's).
-// Throws InputError naming `source` for a malformed "other_hands" or "max_hands".
+// The first hand with "found" true whose "side" is `side` (nullopt: the first hand, for
+// readers that draw what the file holds, such as contact sheets), else the first (the
+// hand most views confirmed) in a file of one hand looked for. In a file where several
+// were ("max_hands" > 1) and none of them is of that side: InputError (the frame fails:
+// another hand is not the capture's). Throws InputError naming `source` for a malformed
+// "other_hands" or "max_hands".
 DetectionsHandChoice ChooseDetectionsHand(const nlohmann::json& file,
                                           std::optional<HandSide> side,
                                           const std::string& source);

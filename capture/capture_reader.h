@@ -43,7 +43,8 @@ class CaptureReader {
   // Per view, rig order (views are matched to cameras by name).
   std::vector<ViewKeypoints> ReadKeypoints(int frame) const;
   // A file of several hands (`detect --max-hands`): the hand of side `side`
-  // (ChooseDetectionsHand, capture_format.h), which one into `choice` when given.
+  // (ChooseDetectionsHand, capture_format.h; nullopt: the first hand, as contact sheets
+  // draw it), which one into `choice` when given.
   std::vector<ViewKeypoints> ReadDetections(int frame,
                                             std::optional<HandSide> side = std::nullopt,
                                             DetectionsHandChoice* choice = nullptr) const;

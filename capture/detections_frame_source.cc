@@ -55,8 +55,9 @@ DetectionsFrameSource::DetectionsFrameSource(std::unique_ptr<FrameSource> inner,
 FrameInput DetectionsFrameSource::Load(const std::string& id) const {
   FrameInput frame = inner_->Load(id);
   DetectionsHandChoice hand;  // several hands: the capture's side
-  frame.keypoints_2d = ReadDetectionsFile((fs::path(folder_) / (id + ".json")).string(),
-                                          id, frame.rig, side(), &hand);
+  frame.keypoints_2d =
+      ReadDetectionsFile((fs::path(folder_) / (id + ".json")).string(), id, frame.rig,
+                         side().value_or(HandSide::kRight), &hand);
   frame.evidence_hand = hand.Describe();
   return frame;
 }

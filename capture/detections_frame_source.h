@@ -33,8 +33,8 @@ class DetectionsFrameSource : public Replaced2dFrameSource {
 
 // The detections file of frame `frame` in rig order (nullopt: no view for that
 // camera); its checks are FrameKeypointsFromJson's (capture_format.h). A file of several
-// hands gives the hand of side `side` (ChooseDetectionsHand), which one into `choice`
-// when given.
+// hands gives the hand of side `side` (ChooseDetectionsHand; nullopt: the first hand),
+// which one into `choice` when given.
 std::vector<std::optional<Keypoints2d>> ReadDetectionsFile(
     const std::string& path, const std::string& frame, const Rig& rig,
     std::optional<HandSide> side = std::nullopt, DetectionsHandChoice* choice = nullptr);

@@ -69,8 +69,11 @@ TEST(DetectionsHands, TheHandOfTheCapturesSideIsTaken) {
   EXPECT_EQ(right.index, 0);
   EXPECT_EQ(FirstX(right), 10);
   EXPECT_EQ(right.Describe(), "hand 1 of 3 (right)");
-  // A capture that does not say is a right-hand capture.
-  EXPECT_EQ(ChooseDetectionsHand(file, std::nullopt, "f").index, 0);
+  // No side: the first hand, whatever was looked for (a contact sheet draws it).
+  nlohmann::json looked_for_two = file;
+  looked_for_two["max_hands"] = 2;
+  EXPECT_EQ(ChooseDetectionsHand(looked_for_two, std::nullopt, "f").index, 0);
+  EXPECT_EQ(FirstX(ChooseDetectionsHand(looked_for_two, std::nullopt, "f")), 10);
 }
 
 TEST(DetectionsHands, NoHandOfTheSideOrOneHandGivesTheFirst) {
