@@ -62,8 +62,9 @@ int RunDetect(int argc, char** argv) {
   app.add_option(
       "--model-dir", o.model_dir,
       "folder with the .tflite files (default: <data folder>/models/mediapipe)");
-  app.add_option("--max-hands", o.max_hands, "hands per image at most")
-      ->capture_default_str();
+  app.add_option("--max-hands", o.max_hands,
+                 "hands at most: per image with --images (default 2), per frame with "
+                 "--capture (default 1: the hand most views confirm)");
   app.add_option("--min-palm-score", o.min_palm_score, "palm detection threshold")
       ->capture_default_str();
   std::string palm_tiles = PalmTilesText(o.palm_tiles);
@@ -122,6 +123,13 @@ int RunDetect(int argc, char** argv) {
     std::cerr << "detect: --palm-every needs --video\n";
     return 2;
   }
+  // Per-frame hands of a capture: 3D hands across the rig, one unless asked for more.
+  dc.multiview.max_hands = app.count("--max-hands") > 0 ? o.max_hands : 1;
+  if (!capture_dir.empty() && dc.video && dc.multiview.max_hands > 1) {
+    std::cerr << "detect: --max-hands above 1 works without --video only (video mode "
+                 "tracks one hand)\n";
+    return 2;
+  }
   UseOneMallocArena();
   o.palm_tiles = ParsePalmTiles(palm_tiles, "detect", "--palm-tiles");  // checked
   if (!capture_dir.empty()) {
@@ -146,7 +154,12 @@ int RunDetect(int argc, char** argv) {
         std::printf(", %d tracked from the previous frame; %d frames tracked",
                     s.views_tracked, s.frames_tracked);
       }
-      std::printf("); %.1f s\n", s.seconds);
+      std::printf(")");
+      if (dc.multiview.max_hands > 1) {
+        std::printf("; hands found %d (%d frames with more than one)", s.hands_found,
+                    s.frames_with_hands);
+      }
+      std::printf("; %.1f s\n", s.seconds);
       if (s.worker_parks > 0) {
         std::printf(
             "other processes kept the cores busy: frames ran one at a time %d time(s) "

@@ -165,7 +165,9 @@ std::vector<ViewKeypoints> ViewKeypointsFromJson(const json& j,
                                                  const std::string& source) {
   // "detector", "hand" and "tracking" (and the per-view fields after "hand_pixels")
   // are what `handlabel detect` records beside the keypoints (docs/detector.md).
-  RejectUnknownKeys(j, {"frame", "views", "detector", "hand", "tracking"}, source);
+  RejectUnknownKeys(
+      j, {"frame", "views", "detector", "hand", "tracking", "other_hands", "max_hands"},
+      source);
   const json& views = JsonMember(j, "views", source);
   if (!views.is_array()) throw InputError(source, "views", "an array", views.dump());
   std::vector<ViewKeypoints> out;
@@ -290,6 +292,78 @@ std::vector<std::optional<ViewKeypoints>> FrameKeypointsFromJson(
     ordered[c] = view;
   }
   return ordered;
+}
+
+std::string DetectionsHandChoice::Describe() const {
+  if (count <= 1 && max_hands <= 1) return "";
+  return "hand " + std::to_string(index + 1) + " of " + std::to_string(count) +
+         (side.empty() ? "" : " (" + side + ")");
+}
+
+namespace {
+
+// A hand record's "hand" {found, side}: whether it was found with side `side`; its side
+// into `side_name` ("" when the record has no "hand").
+bool FoundWithSide(const json& record, const std::string& wanted,
+                   const std::string& source, const std::string& where,
+                   std::string* side_name) {
+  side_name->clear();
+  if (!record.contains("hand")) return false;
+  const json& hand = JsonMember(record, "hand", source, where);
+  *side_name = JsonString(hand, "side", source, where + "hand.");
+  const json& found = JsonMember(hand, "found", source, where + "hand.");
+  if (!found.is_boolean())
+    throw InputError(source, where + "hand.found", "true or false", found.dump());
+  return found.get<bool>() && *side_name == wanted;
+}
+
+}  // namespace
+
+DetectionsHandChoice ChooseDetectionsHand(const json& file, std::optional<HandSide> side,
+                                          const std::string& source) {
+  DetectionsHandChoice choice;
+  if (!side) {  // a reader of the first hand (contact sheets)
+    choice.record = file;
+    return choice;
+  }
+  const std::string wanted = HandSideName(*side);
+  const bool first_matches = FoundWithSide(file, wanted, source, "", &choice.side);
+  const json* others = file.contains("other_hands") ? &file["other_hands"] : nullptr;
+  if (others && !others->is_array())
+    throw InputError(source, "other_hands", "an array of hands", others->dump());
+  choice.count = 1 + (others ? static_cast<int>(others->size()) : 0);
+  if (file.contains("max_hands")) {
+    const json& looked_for = file["max_hands"];
+    if (!looked_for.is_number_integer() || looked_for.get<int>() < 1)
+      throw InputError(source, "max_hands", "a whole number >= 1", looked_for.dump());
+    choice.max_hands = looked_for.get<int>();
+  }
+  if (first_matches) {
+    choice.record = file;
+    return choice;
+  }
+  for (size_t k = 0; others && k < others->size(); ++k) {
+    const std::string where = "other_hands[" + std::to_string(k) + "].";
+    std::string other_side;
+    if (!FoundWithSide((*others)[k], wanted, source, where, &other_side)) continue;
+    choice.record = (*others)[k];
+    if (file.contains("frame")) choice.record["frame"] = file["frame"];
+    choice.index = static_cast<int>(k) + 1;
+    choice.side = other_side;
+    return choice;
+  }
+  if (choice.max_hands > 1) {
+    // Several hands were looked for and none of them is this side's: another hand is not
+    // the one the capture is about.
+    throw InputError(source, "hand",
+                     "a found " + wanted +
+                         " hand (the capture's side) among the hands "
+                         "`detect --max-hands " +
+                         std::to_string(choice.max_hands) + "` found",
+                     std::to_string(choice.count) + " hand(s), none " + wanted);
+  }
+  choice.record = file;
+  return choice;
 }
 
 json GroundTruthToJson(const std::string& frame, const HandGroundTruth& gt) {

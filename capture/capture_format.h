@@ -112,6 +112,29 @@ std::vector<std::optional<ViewKeypoints>> FrameKeypointsFromJson(
     const nlohmann::json& json, const std::string& source, const std::string& frame,
     const Rig& rig);
 
+// A detections file of several hands (`handlabel detect --max-hands N`, docs/detector.md:
+// the first hand at the top level, as in a single-hand file, the others in
+// "other_hands", each {"views", "hand"}): the hand a single-hand reader of side `side`
+// takes.
+struct DetectionsHandChoice {
+  nlohmann::json record;  // {"frame", "views", ...}, for FrameKeypointsFromJson
+  int index = 0;          // 0 = the first hand, k = other_hands[k - 1]
+  int count = 1;          // hands in the file
+  std::string side;       // the chosen hand's voted side; "" when the file has none
+  int max_hands = 1;      // hands looked for (the file's "max_hands", 1 when absent)
+  // "hand 2 of 2 (left)" for logs; "" when one hand was looked for.
+  std::string Describe() const;
+};
+// The first hand with "found" true whose "side" is `side` (nullopt: the first hand, for
+// readers that draw what the file holds, such as contact sheets), else the first (the
+// hand most views confirmed) in a file of one hand looked for. In a file where several
+// were ("max_hands" > 1) and none of them is of that side: InputError (the frame fails:
+// another hand is not the capture's). Throws InputError naming `source` for a malformed
+// "other_hands" or "max_hands".
+DetectionsHandChoice ChooseDetectionsHand(const nlohmann::json& file,
+                                          std::optional<HandSide> side,
+                                          const std::string& source);
+
 struct ObjectGroundTruth {
   std::string kind;  // sphere, box, cylinder
   Eigen::Vector3d size = Eigen::Vector3d::Zero();

@@ -150,12 +150,12 @@ ImageF CaptureReader::ReadDepth(int frame, int camera) const {
   return depth;
 }
 
-std::vector<ViewKeypoints> CaptureReader::ReadViews(const std::string& kind,
-                                                    int frame) const {
-  const std::string path = Path(kind, frame);
+std::vector<ViewKeypoints> CaptureReader::ViewsOfRecord(const nlohmann::json& record,
+                                                        const std::string& path,
+                                                        int frame) const {
   // Rig order, matched by camera name; every camera must be present once.
   const std::vector<std::optional<ViewKeypoints>> views =
-      FrameKeypointsFromJson(ReadJsonFile(path), path, frame_id(frame), rig_);
+      FrameKeypointsFromJson(record, path, frame_id(frame), rig_);
   std::vector<ViewKeypoints> ordered;
   for (size_t c = 0; c < rig_.size(); ++c) {
     if (!views[c])
@@ -165,12 +165,23 @@ std::vector<ViewKeypoints> CaptureReader::ReadViews(const std::string& kind,
   return ordered;
 }
 
+std::vector<ViewKeypoints> CaptureReader::ReadViews(const std::string& kind,
+                                                    int frame) const {
+  const std::string path = Path(kind, frame);
+  return ViewsOfRecord(ReadJsonFile(path), path, frame);
+}
+
 std::vector<ViewKeypoints> CaptureReader::ReadKeypoints(int frame) const {
   return ReadViews(kFileKeypoints, frame);
 }
-std::vector<ViewKeypoints> CaptureReader::ReadDetections(int frame) const {
-  std::vector<ViewKeypoints> views = ReadViews(kFileDetections, frame);
-  RequireSomeEvidence(views, Path(kFileDetections, frame));
+std::vector<ViewKeypoints> CaptureReader::ReadDetections(
+    int frame, std::optional<HandSide> side, DetectionsHandChoice* choice) const {
+  const std::string path = Path(kFileDetections, frame);
+  const DetectionsHandChoice chosen =
+      ChooseDetectionsHand(ReadJsonFile(path), side, path);
+  std::vector<ViewKeypoints> views = ViewsOfRecord(chosen.record, path, frame);
+  RequireSomeEvidence(views, path);
+  if (choice) *choice = chosen;
   return views;
 }
 

@@ -42,12 +42,20 @@ class CaptureReader {
   ImageU8 ReadDetectionMask(int frame, int camera) const;
   // Per view, rig order (views are matched to cameras by name).
   std::vector<ViewKeypoints> ReadKeypoints(int frame) const;
-  std::vector<ViewKeypoints> ReadDetections(int frame) const;
+  // A file of several hands (`detect --max-hands`): the hand of side `side`
+  // (ChooseDetectionsHand, capture_format.h; nullopt: the first hand, as contact sheets
+  // draw it), which one into `choice` when given.
+  std::vector<ViewKeypoints> ReadDetections(int frame,
+                                            std::optional<HandSide> side = std::nullopt,
+                                            DetectionsHandChoice* choice = nullptr) const;
   HandGroundTruth ReadGroundTruth(int frame) const;
 
  private:
   void RequireKind(const std::string& kind) const;
   std::vector<ViewKeypoints> ReadViews(const std::string& kind, int frame) const;
+  // The views of file `path` (frame `frame`) in rig order, every camera once.
+  std::vector<ViewKeypoints> ViewsOfRecord(const nlohmann::json& record,
+                                           const std::string& path, int frame) const;
   ImageU8 ReadGray(const std::string& kind, int frame, int camera) const;
 
   std::string dir_;

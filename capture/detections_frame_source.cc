@@ -13,15 +13,20 @@ namespace fs = std::filesystem;
 
 std::vector<std::optional<Keypoints2d>> ReadDetectionsFile(const std::string& path,
                                                            const std::string& frame,
-                                                           const Rig& rig) {
+                                                           const Rig& rig,
+                                                           std::optional<HandSide> side,
+                                                           DetectionsHandChoice* choice) {
   if (!fs::exists(path)) {
     throw InputError(path, "(file)",
                      "the frame's 2D detections (native detections/{frame}.json format)",
                      "missing");
   }
   std::vector<std::optional<Keypoints2d>> out(rig.size());
+  const DetectionsHandChoice chosen =
+      ChooseDetectionsHand(ReadJsonFileStrict(path), side, path);
+  if (choice) *choice = chosen;
   const std::vector<std::optional<ViewKeypoints>> views =
-      FrameKeypointsFromJson(ReadJsonFileStrict(path), path, frame, rig);
+      FrameKeypointsFromJson(chosen.record, path, frame, rig);
   for (size_t c = 0; c < rig.size(); ++c) {
     if (!views[c]) continue;
     Keypoints2d keypoints;
@@ -49,8 +54,11 @@ DetectionsFrameSource::DetectionsFrameSource(std::unique_ptr<FrameSource> inner,
 
 FrameInput DetectionsFrameSource::Load(const std::string& id) const {
   FrameInput frame = inner_->Load(id);
+  DetectionsHandChoice hand;  // several hands: the capture's side
   frame.keypoints_2d =
-      ReadDetectionsFile((fs::path(folder_) / (id + ".json")).string(), id, frame.rig);
+      ReadDetectionsFile((fs::path(folder_) / (id + ".json")).string(), id, frame.rig,
+                         side().value_or(HandSide::kRight), &hand);
+  frame.evidence_hand = hand.Describe();
   return frame;
 }
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "capture/capture_format.h"
 #include "capture/replaced_2d_frame_source.h"
 
 namespace handlabel {
@@ -31,9 +32,11 @@ class DetectionsFrameSource : public Replaced2dFrameSource {
 };
 
 // The detections file of frame `frame` in rig order (nullopt: no view for that
-// camera); its checks are FrameKeypointsFromJson's (capture_format.h).
-std::vector<std::optional<Keypoints2d>> ReadDetectionsFile(const std::string& path,
-                                                           const std::string& frame,
-                                                           const Rig& rig);
+// camera); its checks are FrameKeypointsFromJson's (capture_format.h). A file of several
+// hands gives the hand of side `side` (ChooseDetectionsHand; nullopt: the first hand),
+// which one into `choice` when given.
+std::vector<std::optional<Keypoints2d>> ReadDetectionsFile(
+    const std::string& path, const std::string& frame, const Rig& rig,
+    std::optional<HandSide> side = std::nullopt, DetectionsHandChoice* choice = nullptr);
 
 }  // namespace handlabel

@@ -51,6 +51,10 @@ struct FrameInput {
   // empty when the capture has no keypoint files. Unknown keypoints: confidence 0 and
   // position 0.
   std::vector<std::optional<Keypoints2d>> keypoints_2d;
+  // Which hand keypoints_2d are when the frame's detections hold several
+  // (`detect --max-hands`, docs/detector.md): "hand 2 of 2 (left)", the hand of the
+  // capture's side; "" with one hand. The label job puts it in the frame log.
+  std::string evidence_hand;
   std::optional<FrameGroundTruth> ground_truth;
   // Where the hand is expected in views without 2D keypoints to cut the network's crop
   // around: 3D points (world frame) whose projection the crop frames, e.g. the previous

@@ -89,9 +89,11 @@ FrameInput NativeFrameSource::Load(const std::string& id) const {
       frame.object_mask_paths.push_back(reader_.Path(kFileObjectMask, f, c));
   }
   if (!keypoint_kind_.empty()) {
-    const std::vector<ViewKeypoints> views = keypoint_kind_ == kFileDetections
-                                                 ? reader_.ReadDetections(f)
-                                                 : reader_.ReadKeypoints(f);
+    DetectionsHandChoice hand;  // several hands: the capture's side
+    const std::vector<ViewKeypoints> views =
+        keypoint_kind_ == kFileDetections ? reader_.ReadDetections(f, side(), &hand)
+                                          : reader_.ReadKeypoints(f);
+    frame.evidence_hand = hand.Describe();
     for (const ViewKeypoints& view : views) {
       // Known: a finite position that the ground truth does not mark out of frame.
       Keypoints2d out;

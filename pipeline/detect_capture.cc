@@ -69,6 +69,8 @@ void DetectCaptureSummary::Add(const DetectCaptureSummary& other) {
   views_tracked += other.views_tracked;
   frames_tracked += other.frames_tracked;
   frames_with_hand += other.frames_with_hand;
+  hands_found += other.hands_found;
+  frames_with_hands += other.frames_with_hands;
   worker_parks += other.worker_parks;
 }
 
@@ -81,9 +83,13 @@ std::vector<FrameRun> FrameRuns(int total, int palm_every) {
   return runs;
 }
 
-nlohmann::json FrameDetectionsJson(const std::string& frame,
-                                   const std::vector<std::string>& cameras,
-                                   const FrameHandResult& result) {
+namespace {
+
+// One hand's record: "views" (native format plus the detector's per-view fields) and
+// "hand" {found, side, side_score, palm_views}.
+nlohmann::json HandDetectionsJson(const std::string& frame,
+                                  const std::vector<std::string>& cameras,
+                                  const FrameHandResult& result) {
   std::vector<ViewKeypoints> views(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     views[c].camera = cameras[c];
@@ -114,12 +120,31 @@ nlohmann::json FrameDetectionsJson(const std::string& frame,
     }
     if (!r.region.empty()) jv["region"] = r.region;  // video mode only
   }
-  out["detector"] = "mediapipe_hands";
   out["hand"] = {{"found", result.found},
                  {"side", HandSideName(result.side)},
                  {"side_score", result.side_score},
                  {"palm_views", result.palm_views}};
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json FrameDetectionsJson(const std::string& frame,
+                                   const std::vector<std::string>& cameras,
+                                   const FrameHandResult& result) {
+  const nlohmann::json first = HandDetectionsJson(frame, cameras, result);
+  nlohmann::json out = {{"frame", first["frame"]}, {"views", first["views"]}};
+  out["detector"] = "mediapipe_hands";
+  out["hand"] = first["hand"];
   if (!result.tracking.empty()) out["tracking"] = result.tracking;  // video mode only
+  if (result.max_hands > 1) out["max_hands"] = result.max_hands;
+  // Several hands (max_hands > 1): the first where a single-hand file has it, the
+  // others after it, each with its views and hand record.
+  for (const FrameHandResult& other : result.other_hands) {
+    nlohmann::json hand = HandDetectionsJson(frame, cameras, other);
+    hand.erase("frame");
+    out["other_hands"].push_back(std::move(hand));
+  }
   return out;
 }
 
@@ -152,6 +177,10 @@ FrameHandResult DetectFrame(const CaptureReader& capture, int f,
   summary->frames += 1;
   summary->views += n;
   summary->frames_with_hand += result.found ? 1 : 0;
+  // Further hands are always found (3D hands): only the first may not be.
+  const int hands = (result.found ? 1 : 0) + static_cast<int>(result.other_hands.size());
+  summary->hands_found += hands;
+  summary->frames_with_hands += hands > 1 ? 1 : 0;
   summary->frames_tracked += result.tracking == "track" ? 1 : 0;
   for (const ViewHandResult& r : result.views) {
     summary->views_detected += r.detected ? 1 : 0;

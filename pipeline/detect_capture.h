@@ -43,12 +43,14 @@ struct DetectCaptureOptions {
 
 struct DetectCaptureSummary {
   int frames = 0;
-  int views = 0;             // frames x cameras
-  int views_detected = 0;    // views with a detection
-  int views_from_palm = 0;   // ... whose ROI came from their own palm
-  int views_tracked = 0;     // ... whose ROI came from the previous frame (video mode)
-  int frames_tracked = 0;    // frames whose regions came from the previous frame
-  int frames_with_hand = 0;  // frames where a 3D hand was established
+  int views = 0;              // frames x cameras
+  int views_detected = 0;     // views with a detection
+  int views_from_palm = 0;    // ... whose ROI came from their own palm
+  int views_tracked = 0;      // ... whose ROI came from the previous frame (video mode)
+  int frames_tracked = 0;     // frames whose regions came from the previous frame
+  int frames_with_hand = 0;   // frames where a 3D hand was established
+  int hands_found = 0;        // 3D hands established, over all frames (max_hands > 1)
+  int frames_with_hands = 0;  // frames where more than one was
   // Times the workers but one were parked because other processes kept the cores busy
   // (core/worker_governor.h).
   int worker_parks = 0;

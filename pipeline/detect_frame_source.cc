@@ -56,6 +56,13 @@ void AddDetectorSeconds(const FrameHandResult& result, double seconds,
   (*times)["detect.other"] += seconds - models * scale;
 }
 
+std::string EvidenceHandName(const FrameHandResult& result, int index) {
+  const int count = 1 + static_cast<int>(result.other_hands.size());
+  if (result.max_hands == 1) return "";
+  return "hand " + std::to_string(index + 1) + " of " + std::to_string(count) + " (" +
+         HandSideName(HandAt(result, index).side) + ")";
+}
+
 std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
     const FrameHandResult& result) {
   std::vector<std::optional<Keypoints2d>> out;
@@ -100,6 +107,7 @@ FrameInput DetectorFrameSource::Load(const std::string& id) const {
   }
   // The capture's own 2D (if any) is not this job's evidence.
   frame.keypoints_2d.clear();
+  frame.evidence_hand.clear();
   if (detect_on_load_) Detect(&frame);
   return frame;
 }
@@ -114,7 +122,17 @@ FrameHandResult DetectorFrameSource::Detect(FrameInput* frame,
                                                    previous, options_.multiview)
                                : DetectHandMultiView(*detector_, frame->rig,
                                                      frame->images, options_.multiview);
-  frame->keypoints_2d = KeypointsFromDetection(result);
+  // Several hands (multiview.max_hands > 1): the capture's hand.
+  const HandSide wanted = side().value_or(HandSide::kRight);
+  const int hand = HandIndexOfSide(result, wanted);
+  if (hand >= 0) {
+    frame->keypoints_2d = KeypointsFromDetection(HandAt(result, hand));
+    frame->evidence_hand = EvidenceHandName(result, hand);
+  } else {  // not the other hand: no 2D, the frame fails as one without a detection
+    frame->keypoints_2d.assign(result.views.size(), std::nullopt);
+    frame->evidence_hand = "no " + HandSideName(wanted) + " hand among " +
+                           std::to_string(1 + result.other_hands.size()) + " found";
+  }
   AddDetectorSeconds(result, SecondsSince(start), &frame->stage_seconds);
   if (store_) store_->Put(frame->id, result);
   return result;

@@ -54,6 +54,11 @@ void AddDetectorSeconds(const FrameHandResult& result, double seconds,
 std::vector<std::optional<Keypoints2d>> KeypointsFromDetection(
     const FrameHandResult& result);
 
+// Which hand of `result` (HandAt's `index`) a job took, as the frame log says it:
+// "hand 2 of 2 (left)", as DetectionsHandChoice::Describe (capture_format.h) for a file;
+// "" when one hand was looked for.
+std::string EvidenceHandName(const FrameHandResult& result, int index);
+
 class DetectorFrameSource : public Replaced2dFrameSource {
  public:
   // Loads the models (InputError naming the file when one is missing). `store` may be
@@ -66,8 +71,10 @@ class DetectorFrameSource : public Replaced2dFrameSource {
   // Reads the frame's images (InputError naming a file that cannot be read or does not
   // fit its camera) and detects unless told not to. Several frames may load at once.
   FrameInput Load(const std::string& id) const override;
-  // Detects the hand in a frame that Load read: sets frame->keypoints_2d and returns
-  // the detector's answer. Video mode (options.video): `previous` is the answer on the
+  // Detects the hand in a frame that Load read: sets frame->keypoints_2d (with several
+  // hands, options.multiview.max_hands > 1: those of the capture's side, HandIndexOfSide,
+  // none when no hand of that side was found, and frame->evidence_hand) and returns the
+  // detector's answer. Video mode (options.video): `previous` is the answer on the
   // previous frame of the run (nullptr on a run's first frame, DetectHandInVideo).
   FrameHandResult Detect(FrameInput* frame,
                          const FrameHandResult* previous = nullptr) const;

@@ -32,6 +32,7 @@ FrameRecord ParseRecord(const std::string& line, const std::string& source) {
     r.label_sha256 = j.value("label_sha256", "");
     r.job_hash = j.value("job_hash", "");
     r.crops = j.value("crops", "");
+    r.hand = j.value("hand", "");
     if (j.contains("metrics")) {
       for (const auto& [name, value] : j.at("metrics").items()) {
         r.metrics[name] = value.is_null() ? std::nan("") : value.get<double>();
@@ -130,6 +131,7 @@ void FrameLog::Record(const FrameRecord& record) {
   if (!record.label_sha256.empty()) j["label_sha256"] = record.label_sha256;
   if (!record.job_hash.empty()) j["job_hash"] = record.job_hash;
   if (!record.crops.empty()) j["crops"] = record.crops;
+  if (!record.hand.empty()) j["hand"] = record.hand;
   std::lock_guard<std::mutex> lock(mutex_);
   AppendLineDurably(path_, j.dump());
   latest_[record.frame] = record;

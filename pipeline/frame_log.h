@@ -38,6 +38,9 @@ struct FrameRecord {
   // Jobs that track the hand (evidence.detector_every): where the network's crops came
   // from, "detector" or "previous_label"; "" otherwise.
   std::string crops;
+  // When the frame's 2D detections hold several hands (`detect --max-hands`): which one
+  // the job took, "hand 2 of 2 (left)" (FrameInput::evidence_hand); "" otherwise.
+  std::string hand;
 };
 
 // Why the label file at `label_path` is not the one `record` (an ok record) wrote:

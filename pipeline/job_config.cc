@@ -193,6 +193,7 @@ void ReadEvidenceSection(Section& top, const std::string& path, JobConfig* job) 
   }
   job->detector_video = detector_mode == "video";
   evidence.Read("detector_palm_every", &job->detector_palm_every);
+  evidence.Read("detector_max_hands", &job->detector_max_hands);
   if (job->detector_model != "full" && job->detector_model != "lite") {
     throw InputError(path, evidence.Name("detector_model"), "full | lite",
                      "'" + job->detector_model + "'");
@@ -295,6 +296,23 @@ void CheckDetectorVideo(const JobConfig& job, const std::string& source) {
   }
 }
 
+// evidence.detector_max_hands.
+void CheckDetectorMaxHands(const JobConfig& job, const std::string& source) {
+  RequireAtLeast(source, "evidence.detector_max_hands", job.detector_max_hands, 1);
+  if (job.detector_max_hands == 1) return;
+  const std::string got = std::to_string(job.detector_max_hands);
+  if (!job.keypoints_from_detector) {
+    throw InputError(source, "evidence.detector_max_hands",
+                     "1 (hands are looked for by the job's detector: "
+                     "evidence.keypoints_2d: detector)",
+                     got);
+  }
+  if (job.detector_video) {
+    throw InputError(source, "evidence.detector_max_hands",
+                     "1 with evidence.detector_mode video (it tracks one hand)", got);
+  }
+}
+
 }  // namespace
 
 void JobConfig::Check(const std::string& source) const {
@@ -330,6 +348,7 @@ void JobConfig::Check(const std::string& source) const {
   }
   CheckTracking(*this, source);
   CheckDetectorVideo(*this, source);
+  CheckDetectorMaxHands(*this, source);
   RequireGreater(source, "refine.max_reprojection_px", quality.max_reprojection_px, 0);
   RequireGreater(source, "refine.max_view_disagreement_mm",
                  quality.max_view_disagreement_mm, 0);

@@ -192,6 +192,11 @@ struct JobConfig {
   // evidence.detector_palm_every: with detector_mode video, the job's frame positions
   // (input.frames order) that start a run; 0 = only a shard's first frame and gaps.
   int detector_palm_every = 30;
+  // evidence.detector_max_hands: N > 1 (with keypoints_2d: detector, detector_mode
+  // frame) looks for up to N hands per frame (MultiViewDetectorOptions::max_hands); the
+  // job fits the hand of the capture's side among them (HandIndexOfSide) and says which
+  // in the frame log. 1 = the hand most views confirm.
+  int detector_max_hands = 1;
   // Camera names whose 2D keypoints and masks are not fitted to (a broken camera).
   std::vector<std::string> ignore_views;
   // Silhouette residual scale (pixels per unit) for the network's masks. In the file

@@ -354,6 +354,7 @@ class LabelJobRun {
     record.seconds = TotalStageSeconds(stages);
     record.stages = stages;
     record.crops = batch.crops[i];
+    if (batch.inputs[i]) record.hand = batch.inputs[i]->evidence_hand;
     log_->Record(record);
     progress_->FrameDone(!error.empty());
     batch.inputs[i].reset();  // free the frame's memory early

@@ -71,6 +71,7 @@ std::string JobHash(const JobConfig& job, const std::string& weights_sha256) {
   }
   if (job.detector_every != 1) extra["detector_every"] = job.detector_every;
   if (job.detector_video) extra["detector_video"] = job.detector_palm_every;
+  if (job.detector_max_hands != 1) extra["detector_max_hands"] = job.detector_max_hands;
   // The requested arithmetic; what "auto" chose on each machine is in every label's
   // provenance (model name).
   if (!weights_sha256.empty() && job.network_precision != "fp32") {

@@ -111,6 +111,7 @@ std::unique_ptr<FrameSource> BuildFrameSource(const JobConfig& job,
                                              "evidence.detector_palm_tiles");
     detect.video = job.detector_video;
     detect.palm_every = job.detector_palm_every;
+    detect.multiview.max_hands = job.detector_max_hands;
     // A job that tracks detects only the frames that need it, one in video mode its
     // frames in order (label_job.h).
     const bool detect_on_load = job.detector_every == 1 && !job.detector_video;

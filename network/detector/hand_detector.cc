@@ -331,6 +331,252 @@ void VoteSide(FrameHandResult* frame) {
   frame->side_score = p_right >= 0.5 ? p_right : 1 - p_right;
 }
 
+// Step 1: every view's palms (into `palms`, rig order), and the frame as it is when
+// no palms agree: per view the palms found and the reason "no_hand_in_frame".
+FrameHandResult DetectPalmsInViews(const MediapipeHands& detector,
+                                   const std::vector<ImageU8>& images,
+                                   std::vector<std::vector<PalmDetection>>* palms) {
+  const int n = static_cast<int>(images.size());
+  FrameHandResult frame;
+  frame.views.resize(n);
+  palms->assign(n, {});
+  for (int v = 0; v < n; ++v) {
+    const auto start = std::chrono::steady_clock::now();
+    (*palms)[v] = detector.DetectPalms(images[v]);
+    frame.views[v].palm_seconds = SecondsSince(start);
+    frame.views[v].palm_candidates = static_cast<int>((*palms)[v].size());
+    frame.views[v].palms = (*palms)[v];
+    frame.views[v].reason = "no_hand_in_frame";
+  }
+  return frame;
+}
+
+// Steps 3 and 4a: landmarks where the palms of `best` agreed, then in the views whose
+// palm detection missed, from the projected 3D palm.
+void LandmarksFromPalms(const MediapipeHands& detector, const Rig& rig,
+                        const std::vector<ImageU8>& images,
+                        const std::vector<std::vector<PalmDetection>>& palms,
+                        const PalmHypothesis& best,
+                        const MultiViewDetectorOptions& options, FrameHandResult* frame) {
+  for (const auto& [v, index] : best.members) {
+    const NormalizedRect roi =
+        HandRoiFromPalm(palms[v][index], images[v].width, images[v].height);
+    RunLandmarks(detector, images[v], roi, "palm", detector.options().min_presence,
+                 &frame->views[v]);
+  }
+  const auto palm3d = TriangulatePalmWithBox(rig, images, palms, best);
+  for (int v = 0; v < static_cast<int>(images.size()) && palm3d; ++v) {
+    ViewHandResult& r = frame->views[v];
+    if (r.detected || r.reason == "low_presence") continue;
+    const auto palm = ProjectPalm(rig[v], *palm3d, images[v].width, images[v].height);
+    if (!palm) {
+      r.reason = "hand_outside_view";
+      continue;
+    }
+    RunLandmarks(detector, images[v],
+                 HandRoiFromPalm(*palm, images[v].width, images[v].height), "3d_palm",
+                 options.min_presence_from_3d, &r);
+  }
+}
+
+// Fewer than two views agree on the keypoints: no view's hand can be checked against
+// the others (step 5), and one view alone leaves its depth unknown (a fit from it lands
+// metres off). Dropped, with the reason.
+void DropUnconfirmedViews(FrameHandResult* frame) {
+  for (ViewHandResult& r : frame->views) {
+    if (!r.detected) continue;
+    r.detected = false;
+    r.reason = "unconfirmed_by_other_views";
+    r.source.clear();
+    r.keypoints = Keypoints2d();
+  }
+}
+
+// Step 4b: views still without a hand from the projected 3D keypoints (all views in a
+// second pass), each time re-triangulated.
+void LandmarksFromKeypoints(const MediapipeHands& detector, const Rig& rig,
+                            const std::vector<ImageU8>& images,
+                            const MultiViewDetectorOptions& options,
+                            FrameHandResult* frame) {
+  const int n = static_cast<int>(images.size());
+  const auto redo_from_3d = [&](int v, const std::string& source) {
+    KeypointPixels uv = KeypointPixels::Zero();
+    if (!ProjectHand(rig[v], *frame, options, &uv)) {
+      frame->views[v].detected = false;
+      frame->views[v].reason = "hand_outside_view";
+      return;
+    }
+    RunLandmarks(detector, images[v],
+                 RoiFromKeypoints(uv, images[v].width, images[v].height), source,
+                 options.min_presence_from_3d, &frame->views[v]);
+  };
+  for (int v = 0; v < n; ++v) {
+    if (!frame->views[v].detected && frame->views[v].reason != "hand_outside_view") {
+      redo_from_3d(v, "3d_hand");
+    }
+  }
+  TriangulateKeypoints(rig, images, options, frame);
+  if (options.second_pass) {
+    for (int v = 0; v < n; ++v) redo_from_3d(v, "second_pass");
+    TriangulateKeypoints(rig, images, options, frame);
+  }
+}
+
+// Steps 3-5 for the palms of `best` (indices into `palms`): `frame` as step 1 left it.
+void HandFromHypothesis(const MediapipeHands& detector, const Rig& rig,
+                        const std::vector<ImageU8>& images,
+                        const std::vector<std::vector<PalmDetection>>& palms,
+                        const PalmHypothesis& best,
+                        const MultiViewDetectorOptions& options, FrameHandResult* frame) {
+  frame->palm_views = static_cast<int>(best.members.size());
+  LandmarksFromPalms(detector, rig, images, palms, best, options, frame);
+  TriangulateKeypoints(rig, images, options, frame);
+  frame->found = frame->keypoint3d_valid[0];
+  if (!frame->found) {
+    VoteSide(frame);
+    DropUnconfirmedViews(frame);
+    return;
+  }
+  LandmarksFromKeypoints(detector, rig, images, options, frame);
+  DropInconsistentViews(rig, images, options, frame);
+  VoteSide(frame);
+}
+
+// Step 6: whether the 3D wrist of hypothesis `h` lies within same_hand_m of the
+// triangulated wrist of a hand already found (`first` or its other_hands).
+bool IsKnownHand(const Rig& rig, const std::vector<ImageU8>& images,
+                 const std::vector<std::vector<PalmDetection>>& palms,
+                 const PalmHypothesis& h, const FrameHandResult& first,
+                 const MultiViewDetectorOptions& options) {
+  const auto palm3d = TriangulatePalm(rig, images, palms, h.members);
+  if (!palm3d) return false;
+  for (int i = 0; i <= static_cast<int>(first.other_hands.size()); ++i) {
+    const FrameHandResult& hand = HandAt(first, i);
+    if (!hand.keypoint3d_valid[0]) continue;
+    const Eigen::Vector3d wrist = hand.keypoints3d.row(0).transpose();
+    if (((*palm3d)[0] - wrist).norm() < options.same_hand_m) return true;
+  }
+  return false;
+}
+
+// Step 6: whether a palm lies on the hand's projection in view v: its wrist and
+// middle-finger MCP (palm keypoints 0 and 2) within twice palm_agreement palm sizes of
+// the hand's (keypoints 0 and 9) on average. Twice: the palm model's keypoints and the
+// landmark model's are placed by two models, and differ more than two palms of one
+// model do.
+bool PalmOnHand(const RigCamera& camera, const PalmDetection& palm,
+                const FrameHandResult& hand, const MultiViewDetectorOptions& options,
+                int w, int h) {
+  double sum = 0;
+  const std::array<std::pair<int, int>, 2> pairs = {{{0, 0}, {2, 9}}};
+  for (const auto& [palm_k, hand_k] : pairs) {
+    if (!hand.keypoint3d_valid[hand_k]) return false;
+    Eigen::Vector2d uv;
+    if (!camera.ProjectWorld(hand.keypoints3d.row(hand_k).transpose(), &uv)) return false;
+    sum += (uv - PalmKeypointPx(palm, palm_k, w, h)).norm();
+  }
+  return sum / 2 < 2 * options.palm_agreement * std::max(PalmSizePx(palm, w, h), 1.0);
+}
+
+// Step 6: removes from `palms` those of `h` and, when `hand` was found, every view's
+// palms lying on its projection.
+void SetAsidePalms(const Rig& rig, const std::vector<ImageU8>& images,
+                   const FrameHandResult& hand, const PalmHypothesis& h,
+                   const MultiViewDetectorOptions& options,
+                   std::vector<std::vector<PalmDetection>>* palms) {
+  std::vector<std::vector<bool>> claimed(palms->size());
+  for (size_t v = 0; v < palms->size(); ++v) claimed[v].assign((*palms)[v].size(), false);
+  for (const auto& [v, index] : h.members) claimed[v][index] = true;
+  for (size_t v = 0; v < palms->size(); ++v) {
+    std::vector<PalmDetection> kept;
+    for (size_t i = 0; i < (*palms)[v].size(); ++i) {
+      const PalmDetection& palm = (*palms)[v][i];
+      const bool on_hand = hand.found && PalmOnHand(rig[v], palm, hand, options,
+                                                    images[v].width, images[v].height);
+      if (!claimed[v][i] && !on_hand) kept.push_back(palm);
+    }
+    (*palms)[v] = std::move(kept);
+  }
+}
+
+// Step 6: a view's landmarks belong to one hand. A detection whose keypoints agree
+// better with another hand's projection (median reprojection error) than with its own
+// hand's is dropped from its hand (decided for all views first, so the order of the
+// hands does not matter); a hand that lost views is re-triangulated and checked again,
+// and a further hand left without a 3D hand is dropped.
+void AssignSharedViews(const Rig& rig, const std::vector<ImageU8>& images,
+                       const MultiViewDetectorOptions& options, FrameHandResult* first) {
+  std::vector<FrameHandResult*> hands = {first};
+  for (FrameHandResult& other : first->other_hands) hands.push_back(&other);
+  std::vector<std::vector<int>> drop(hands.size());
+  for (size_t i = 0; i < hands.size(); ++i) {
+    for (int v = 0; v < static_cast<int>(images.size()); ++v) {
+      const ViewHandResult& r = hands[i]->views[v];
+      if (!r.detected) continue;
+      for (size_t j = 0; j < hands.size(); ++j) {
+        if (j == i) continue;
+        const double other = MedianReprojectionPx(rig[v], r.keypoints, *hands[j]);
+        const double own = r.median_reprojection_px;
+        if (other >= 0 && (own < 0 || other < own)) {
+          drop[i].push_back(v);
+          break;
+        }
+      }
+    }
+  }
+  for (size_t i = 0; i < hands.size(); ++i) {
+    if (drop[i].empty()) continue;
+    for (const int v : drop[i]) {
+      ViewHandResult& r = hands[i]->views[v];
+      r.detected = false;
+      r.reason = "belongs_to_other_hand";
+      r.source.clear();
+      r.keypoints = Keypoints2d();
+    }
+    TriangulateKeypoints(rig, images, options, hands[i]);
+    hands[i]->found = hands[i]->keypoint3d_valid[0];
+    if (!hands[i]->found) {
+      DropUnconfirmedViews(hands[i]);
+      continue;
+    }
+    DropInconsistentViews(rig, images, options, hands[i]);
+    VoteSide(hands[i]);
+  }
+  auto& others = first->other_hands;
+  others.erase(std::remove_if(others.begin(), others.end(),
+                              [](const FrameHandResult& h) { return !h.found; }),
+               others.end());
+}
+
+// The frame as step 1 left it, for a further hand: its views' palm times are 0 (palm
+// detection ran once, counted with the first hand).
+FrameHandResult WithoutPalmTimes(FrameHandResult frame) {
+  for (ViewHandResult& r : frame.views) r.palm_seconds = 0;
+  return frame;
+}
+
+// Step 6: the further hands, after `first` (found from the palms of `claimed`), into
+// first->other_hands. `no_hand`: the frame as step 1 left it.
+void FindOtherHands(const MediapipeHands& detector, const Rig& rig,
+                    const std::vector<ImageU8>& images,
+                    const MultiViewDetectorOptions& options,
+                    const FrameHandResult& no_hand, const PalmHypothesis& claimed,
+                    std::vector<std::vector<PalmDetection>> palms,
+                    FrameHandResult* first) {
+  SetAsidePalms(rig, images, *first, claimed, options, &palms);
+  while (1 + static_cast<int>(first->other_hands.size()) < options.max_hands) {
+    const PalmHypothesis h = BestPalmHypothesis(rig, images, palms, options);
+    if (static_cast<int>(h.members.size()) < options.min_palm_views) break;
+    FrameHandResult hand = WithoutPalmTimes(no_hand);
+    if (!IsKnownHand(rig, images, palms, h, *first, options)) {
+      HandFromHypothesis(detector, rig, images, palms, h, options, &hand);
+    }
+    SetAsidePalms(rig, images, hand, h, options, &palms);  // h's palms at least: ends
+    if (hand.found) first->other_hands.push_back(std::move(hand));
+  }
+  if (!first->other_hands.empty()) AssignSharedViews(rig, images, options, first);
+}
+
 }  // namespace
 
 void MultiViewDetectorOptions::Check(const std::string& source) const {
@@ -342,6 +588,8 @@ void MultiViewDetectorOptions::Check(const std::string& source) const {
                  "a value in [0, 1]");
   RequireInRange(source, "min_keypoints_in_view", min_keypoints_in_view, 0, 1,
                  "a value in [0, 1]");
+  RequireAtLeast(source, "max_hands", max_hands, 1);
+  RequireGreater(source, "same_hand_m", same_hand_m, 0);
 }
 
 FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& rig,
@@ -349,86 +597,32 @@ FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& r
                                     const MultiViewDetectorOptions& options) {
   options.Check("MultiViewDetectorOptions");
   HL_CHECK(images.size() == rig.size(), "one image per rig camera");
-  const int n = static_cast<int>(images.size());
-  FrameHandResult frame;
-  frame.views.resize(n);
-  std::vector<std::vector<PalmDetection>> palms(n);
-  for (int v = 0; v < n; ++v) {
-    const auto start = std::chrono::steady_clock::now();
-    palms[v] = detector.DetectPalms(images[v]);
-    frame.views[v].palm_seconds = SecondsSince(start);
-    frame.views[v].palm_candidates = static_cast<int>(palms[v].size());
-    frame.views[v].palms = palms[v];
-    frame.views[v].reason = "no_hand_in_frame";
-  }
+  std::vector<std::vector<PalmDetection>> palms;
+  const FrameHandResult no_hand = DetectPalmsInViews(detector, images, &palms);
+  FrameHandResult frame = no_hand;
+  frame.max_hands = options.max_hands;
   const PalmHypothesis best = BestPalmHypothesis(rig, images, palms, options);
   if (static_cast<int>(best.members.size()) < options.min_palm_views) return frame;
-  frame.palm_views = static_cast<int>(best.members.size());
-
-  // Step 3: landmarks where the palms agreed.
-  for (const auto& [v, index] : best.members) {
-    const NormalizedRect roi =
-        HandRoiFromPalm(palms[v][index], images[v].width, images[v].height);
-    RunLandmarks(detector, images[v], roi, "palm", detector.options().min_presence,
-                 &frame.views[v]);
+  HandFromHypothesis(detector, rig, images, palms, best, options, &frame);
+  if (options.max_hands > 1 && frame.found) {
+    FindOtherHands(detector, rig, images, options, no_hand, best, std::move(palms),
+                   &frame);
   }
-  // Step 4a: views whose palm detection missed, from the projected 3D palm.
-  const auto palm3d = TriangulatePalmWithBox(rig, images, palms, best);
-  for (int v = 0; v < n && palm3d; ++v) {
-    if (frame.views[v].detected || frame.views[v].reason == "low_presence") continue;
-    const auto palm = ProjectPalm(rig[v], *palm3d, images[v].width, images[v].height);
-    if (!palm) {
-      frame.views[v].reason = "hand_outside_view";
-      continue;
-    }
-    RunLandmarks(detector, images[v],
-                 HandRoiFromPalm(*palm, images[v].width, images[v].height), "3d_palm",
-                 options.min_presence_from_3d, &frame.views[v]);
-  }
-  TriangulateKeypoints(rig, images, options, &frame);
-  frame.found = frame.keypoint3d_valid[0];
-  if (!frame.found) {
-    VoteSide(&frame);
-    // Fewer than two views agree on the keypoints: no view's hand can be checked
-    // against the others (step 5), and one view alone leaves its depth unknown (a fit
-    // from it lands metres off). Dropped, with the reason.
-    for (ViewHandResult& r : frame.views) {
-      if (!r.detected) continue;
-      r.detected = false;
-      r.reason = "unconfirmed_by_other_views";
-      r.source.clear();
-      r.keypoints = Keypoints2d();
-    }
-    return frame;
-  }
-
-  // Step 4b: views still without a hand from the projected 3D keypoints (all views in
-  // a second pass).
-  const auto redo_from_3d = [&](int v, const std::string& source) {
-    KeypointPixels uv = KeypointPixels::Zero();
-    if (!ProjectHand(rig[v], frame, options, &uv)) {
-      frame.views[v].detected = false;
-      frame.views[v].reason = "hand_outside_view";
-      return;
-    }
-    RunLandmarks(detector, images[v],
-                 RoiFromKeypoints(uv, images[v].width, images[v].height), source,
-                 options.min_presence_from_3d, &frame.views[v]);
-  };
-  for (int v = 0; v < n; ++v) {
-    if (!frame.views[v].detected && frame.views[v].reason != "hand_outside_view") {
-      redo_from_3d(v, "3d_hand");
-    }
-  }
-  TriangulateKeypoints(rig, images, options, &frame);
-  if (options.second_pass) {
-    for (int v = 0; v < n; ++v) redo_from_3d(v, "second_pass");
-    TriangulateKeypoints(rig, images, options, &frame);
-  }
-
-  DropInconsistentViews(rig, images, options, &frame);
-  VoteSide(&frame);
   return frame;
+}
+
+int HandIndexOfSide(const FrameHandResult& frame, HandSide side) {
+  for (int i = 0; i <= static_cast<int>(frame.other_hands.size()); ++i) {
+    const FrameHandResult& hand = HandAt(frame, i);
+    if (hand.found && hand.side == side) return i;
+  }
+  return frame.max_hands > 1 ? -1 : 0;
+}
+
+const FrameHandResult& HandAt(const FrameHandResult& frame, int index) {
+  HL_CHECK(index >= 0 && index <= static_cast<int>(frame.other_hands.size()),
+           "a hand of the frame");
+  return index == 0 ? frame : frame.other_hands[index - 1];
 }
 
 std::optional<NormalizedRect> RoiOfTrackedHand(const RigCamera& camera,
@@ -457,6 +651,11 @@ FrameHandResult DetectHandInVideo(const MediapipeHands& detector, const Rig& rig
     }
     return frame;
   };
+  if (options.max_hands > 1) {
+    throw InputError("MultiViewDetectorOptions", "max_hands",
+                     "1 in video mode (it tracks one hand)",
+                     std::to_string(options.max_hands));
+  }
   if (!previous) return per_frame("start");
   if (!previous->found) return per_frame("lost");
   options.Check("MultiViewDetectorOptions");

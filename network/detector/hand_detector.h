@@ -18,6 +18,12 @@
 //     (`second_pass`) every view is redone from the keypoints triangulated from all.
 //  5. A view's detection that disagrees with the triangulated hand (median reprojection
 //     error above `max_reprojection` ROI sizes) is dropped.
+//  6. With max_hands > 1: the palms that confirmed the hand and every view's palms lying
+//     on its projection are set aside, and steps 2-5 repeat on the remaining palms, up
+//     to max_hands hands; a hypothesis whose 3D wrist lies within same_hand_m of an
+//     earlier hand's is that hand again (dropped). Then a view's landmarks belong to
+//     one hand: a detection that agrees better with another hand's projection than with
+//     its own hand's is dropped from its hand ("belongs_to_other_hand").
 // Each view without a detection records why (ViewHandResult::reason).
 //
 // Pixels are distorted image pixels (the models run on the images as they are);
@@ -56,6 +62,11 @@ struct MultiViewDetectorOptions {
   double min_presence_from_3d = 0.2;
   // Redo every view from the ROI of the keypoints triangulated from all views.
   bool second_pass = false;
+  // Hands looked for per frame (step 6); 1 = the one most views confirm.
+  int max_hands = 1;
+  // Step 6: a further palm hypothesis whose 3D wrist lies within this distance (metres)
+  // of an earlier hand's triangulated wrist is that hand again.
+  double same_hand_m = 0.04;
   // Throws InputError naming `source` when a field is out of range.
   void Check(const std::string& source) const;
 };
@@ -77,7 +88,8 @@ struct ViewHandResult {
   // camera), "low_presence" (the landmark model found no hand in the ROI),
   // "inconsistent_with_3d_hand" (its keypoints disagree with the triangulated hand),
   // "unconfirmed_by_other_views" (a hand in this view, but in no other: no 3D hand to
-  // check it against, and one view leaves its depth unknown).
+  // check it against, and one view leaves its depth unknown), "belongs_to_other_hand"
+  // (max_hands > 1: its keypoints agree better with another hand found in the frame).
   std::string reason;
   int palm_candidates = 0;           // palms the view's palm detection found
   std::vector<PalmDetection> palms;  // those palms (normalised to the image), best first
@@ -106,9 +118,28 @@ struct FrameHandResult {
   // than min_palm_views views held the track: detected as per-frame mode), "track"
   // (regions from the previous frame's 3D hand).
   std::string tracking;
+  // max_hands > 1: the frame's further hands, in the order found (each with its own
+  // views, keypoints, side; their views' palm_seconds are 0: palm detection ran once, for
+  // this first hand). Empty with max_hands 1, and in every element of the list.
+  std::vector<FrameHandResult> other_hands;
+  // Hands looked for (MultiViewDetectorOptions::max_hands; 1 in other_hands' elements):
+  // with more than 1 a frame without a hand of the wanted side has none
+  // (HandIndexOfSide).
+  int max_hands = 1;
 };
 
-// Runs steps 1-5 on one frame: images[c] is the RGB image of rig camera c.
+// Which hand of `frame` a single-hand job takes for a hand of side `side`: 0 = the frame
+// itself, k = other_hands[k - 1]; the first found hand whose voted side is `side`. When
+// there is none: -1 when several hands were looked for (frame.max_hands > 1: the hand of
+// that side was not found, and another hand is not it), else 0 (the hand most views
+// confirm, as the single-hand detector always gave).
+int HandIndexOfSide(const FrameHandResult& frame, HandSide side);
+// Hand `index` of `frame` as HandIndexOfSide counts (0 = the frame itself).
+const FrameHandResult& HandAt(const FrameHandResult& frame, int index);
+
+// Runs steps 1-6 on one frame: images[c] is the RGB image of rig camera c. The result
+// is the first hand found (the one most views confirm), any further ones in
+// other_hands; with max_hands 1 exactly the single-hand detector.
 FrameHandResult DetectHandMultiView(const MediapipeHands& detector, const Rig& rig,
                                     const std::vector<ImageU8>& images,
                                     const MultiViewDetectorOptions& options = {});
@@ -133,7 +164,8 @@ std::optional<NormalizedRect> RoiOfTrackedHand(const RigCamera& camera,
 // failing that the tracked landmarks count from min_presence_from_3d, as other ROIs
 // placed from 3D do. Then triangulation and the consistency check (steps 4-5). When the
 // previous frame has no hand, or fewer than min_palm_views views hold the track, or no
-// 3D hand results, the frame is detected as per-frame mode ("lost").
+// 3D hand results, the frame is detected as per-frame mode ("lost"). One hand: throws
+// InputError when options.max_hands > 1.
 FrameHandResult DetectHandInVideo(const MediapipeHands& detector, const Rig& rig,
                                   const std::vector<ImageU8>& images,
                                   const FrameHandResult* previous,

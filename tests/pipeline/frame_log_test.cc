@@ -49,6 +49,29 @@ TEST(FrameLog, RecordsSurviveReopenAndLaterRecordsSupersede) {
   EXPECT_EQ(latest[0].path, "fit");
 }
 
+// Which of several detected hands a frame was labelled from (FrameInput::evidence_hand):
+// kept through a reopen; records of one hand have no "hand".
+TEST(FrameLog, TheEvidenceHandRoundTrips) {
+  const std::string path = TempDir() + "/shard-0-of-1.jsonl";
+  FrameRecord two = Rec("000001", "ok", "fit", "", 0.5);
+  two.hand = "hand 2 of 2 (left)";
+  {
+    FrameLog log(path);
+    log.Record(two);
+    log.Record(Rec("000002", "ok", "fit", "", 0.2));
+  }
+  const auto latest = FrameLog::Read(path);
+  ASSERT_EQ(latest.size(), 2u);
+  EXPECT_EQ(latest[0].hand, "hand 2 of 2 (left)");
+  EXPECT_EQ(latest[1].hand, "");
+  std::ifstream in(path);
+  std::string first, second;
+  std::getline(in, first);
+  std::getline(in, second);
+  EXPECT_NE(first.find("\"hand\":\"hand 2 of 2 (left)\""), std::string::npos) << first;
+  EXPECT_EQ(second.find("\"hand\""), std::string::npos) << second;
+}
+
 TEST(FrameLog, StageTimesRoundTripAndOlderRecordsHaveNone) {
   const std::string path = TempDir() + "/shard-0-of-1.jsonl";
   FrameRecord timed = Rec("000001", "ok", "fit", "", 0.5);

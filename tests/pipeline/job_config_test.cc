@@ -288,6 +288,31 @@ TEST(JobConfig, DetectorVideoModeNeedsTheDetectorOnEveryFrame) {
       "evidence.detector_every", "1 (evidence.detector_mode video");
 }
 
+// evidence.detector_max_hands: several hands per frame from the job's own per-frame
+// detector; single-hand jobs keep their hash (the field enters only when set).
+TEST(JobConfig, DetectorMaxHandsNeedsThePerFrameDetector) {
+  const std::string fit_only =
+      "input: {path: c}\noutput: {dir: o}\nrefine: {mode: always}\n";
+  const JobConfig two = LoadJobConfig(
+      WriteJob(fit_only + "evidence: {keypoints_2d: detector, detector_max_hands: 2}\n"));
+  EXPECT_EQ(two.detector_max_hands, 2);
+  const JobConfig one =
+      LoadJobConfig(WriteJob(fit_only + "evidence: {keypoints_2d: detector}\n"));
+  EXPECT_EQ(one.detector_max_hands, 1);
+  EXPECT_NE(JobHash(two, ""), JobHash(one, ""));
+  JobConfig explicit_one = one;
+  explicit_one.detector_max_hands = 1;
+  EXPECT_EQ(JobHash(explicit_one, ""), JobHash(one, ""));
+  ExpectError(fit_only + "evidence: {keypoints_2d: detector, detector_max_hands: 0}\n",
+              "evidence.detector_max_hands", ">= 1");
+  ExpectError(fit_only + "evidence: {keypoints_2d: files, detector_max_hands: 2}\n",
+              "evidence.detector_max_hands", "evidence.keypoints_2d: detector");
+  ExpectError(fit_only +
+                  "evidence: {keypoints_2d: detector, detector_mode: video, "
+                  "detector_max_hands: 2}\n",
+              "evidence.detector_max_hands", "video (it tracks one hand)");
+}
+
 // The fields `handlabel fit` sets: unset fitter fields stay unset (the fitter's
 // defaults), set ones are read and checked naming the field.
 TEST(JobConfig, FitSectionAndFileEvidence) {
