@@ -162,7 +162,7 @@ int RunDetect(int argc, char** argv) {
       std::printf("; %.1f s\n", s.seconds);
       if (s.worker_parks > 0) {
         std::printf(
-            "other processes kept the cores busy: frames ran one at a time %d time(s) "
+            "other processes kept the cores busy: frames ran on fewer workers %d time(s) "
             "(docs/speed.md, \"Threads under load\")\n",
             s.worker_parks);
       }

@@ -1,6 +1,7 @@
 #include "core/worker_governor.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -82,14 +83,18 @@ void WorkerGovernor::Evaluate(Clock::time_point now) {
   const double wait = times->wait_ns - window_times_.wait_ns;
   window_start_ = now;
   window_times_ = *times;
-  if (running_ < workers_) {  // parked: only the first worker runs, it waits for no core
+  if (running_ < workers_) {  // parked: the running workers wait for no core
     if (now >= probe_at_) running_ = workers_;
     return;
   }
   // Nothing ran, or a thread ended and took its times with it: no verdict.
   if (run < 0 || wait < 0 || run + wait <= 0) return;
-  if (wait / (run + wait) > options_.max_wait_share) {
-    running_ = 1;
+  const double share = wait / (run + wait);
+  if (share > options_.max_wait_share) {
+    // As many workers as the cores they got between them (one when two share one core;
+    // as many as there are cores when more workers than cores were asked for).
+    running_ = std::clamp(static_cast<int>(std::lround(workers_ * (1 - share))), 1,
+                          workers_ - 1);
     ++parks_;
     probe_at_ = now + pause_;
     pause_ = std::min(2 * pause_, options_.max_pause);

@@ -10,7 +10,8 @@
 //
 // The governor watches that share over windows of the loop's own time. When the
 // workers wait for a core more than `max_wait_share` of their runnable time, it parks
-// all but the first worker; parked, the first one waits for no core, so the governor
+// workers until as many run as the cores they got between them (all but the first
+// when two share one core); the running ones then wait for no core, so the governor
 // cannot see the load leave: it lets every worker run again for one window after a
 // pause (probe) and parks them again, with a doubled pause, if they still wait.
 #include <chrono>

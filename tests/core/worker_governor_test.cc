@@ -79,6 +79,22 @@ TEST(WorkerGovernor, ParksWhenTheWorkersShareOneCoreAndProbesWithGrowingPauses) 
   EXPECT_TRUE(g.MayRun(1));
 }
 
+TEST(WorkerGovernor, MoreWorkersThanCoresKeepAsManyAsTheCores) {
+  // Four workers on two free cores: each runnable worker waits half of the time.
+  ScriptedMachine m;
+  WorkerGovernor g = m.Governor(4);
+  m.Pass(500, 2.0, 2.0);
+  EXPECT_TRUE(g.MayRun(1));
+  EXPECT_FALSE(g.MayRun(2));
+  EXPECT_FALSE(g.MayRun(3));
+  EXPECT_EQ(g.running(), 2);
+  // Four workers sharing one core (another process on the other): one runs.
+  WorkerGovernor busy = m.Governor(4);
+  m.Pass(500, 1.0, 3.0);
+  EXPECT_FALSE(busy.MayRun(1));
+  EXPECT_EQ(busy.running(), 1);
+}
+
 TEST(WorkerGovernor, KeepsRunningWhenTheOtherThreadsLeaveThemMoreThanOneCore) {
   // Two workers beside one more thread of the same session on two cores: each gets
   // two thirds of a core (wait 1/3), 1.33 cores between them: more than one worker.
